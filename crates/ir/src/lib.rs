@@ -1,0 +1,26 @@
+//! whitted-ir: the validated scene IR that the language produces and the tracer consumes.
+//!
+//! Plain data only: arenas with typed handles, spans kept beside every node, and a validator
+//! whose output type ([`ValidScene`]) is the proof that a scene is safe to render.
+
+mod arena;
+mod diagnostic;
+mod json;
+mod print;
+mod scene;
+mod source;
+mod validate;
+
+pub use arena::{Arena, Handle};
+pub use diagnostic::{Diagnostic, Label, Severity};
+pub use json::to_json;
+pub use print::print;
+pub use scene::{
+    Attenuation, Camera, Color, CsgOp, Fresnel, Light, LightKind, Material, Object, ObjectKind,
+    Pattern, PatternKind, Projection, Quadric, QuadricForm, Scene, Settings, ShadowMode, Shape,
+};
+pub use source::{FileId, LineCol, SourceFile, SourceMap, Span};
+pub use validate::{validate, InvalidScene, ValidScene};
+
+/// Re-exported so that every crate names the same vector and matrix types.
+pub use glam::{DMat4, DVec3};

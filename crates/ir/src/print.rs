@@ -1,0 +1,224 @@
+//! A readable text dump of the IR (`whitted ir`): one line per node, children indented,
+//! each with the source location that made it.
+
+use std::fmt::Write;
+
+use glam::{DMat4, DVec3};
+
+use crate::arena::Handle;
+use crate::scene::{Color, LightKind, Material, Object, ObjectKind, Projection, Scene, Shape};
+
+/// Prints the scene as indented text. Numbers use Rust's shortest round-trip form.
+pub fn print(scene: &Scene) -> String {
+    let mut out = String::new();
+    let s = &scene.settings;
+    let _ = writeln!(out, "settings");
+    let _ = writeln!(
+        out,
+        "  size {}x{}, samples {}, max depth {}, min weight {}",
+        s.width, s.height, s.samples_per_pixel, s.max_depth, s.min_weight
+    );
+    let _ = writeln!(
+        out,
+        "  background {}, ambient {}, epsilon {}, shadows {:?}",
+        color(&s.background),
+        color(&s.ambient),
+        s.epsilon,
+        s.shadows
+    );
+    let c = &scene.camera;
+    let projection = match c.projection {
+        Projection::Perspective {
+            vertical_fov_degrees,
+        } => format!("perspective fov {vertical_fov_degrees}"),
+        Projection::Orthographic { view_height } => format!("orthographic height {view_height}"),
+    };
+    let _ = writeln!(
+        out,
+        "camera {projection} eye {} look_at {} up {}  @ {}",
+        v(c.eye),
+        v(c.look_at),
+        v(c.up),
+        scene.sources.location(scene.camera_span)
+    );
+    for (handle, light, span) in scene.lights.iter_with_spans() {
+        let name = light
+            .name
+            .as_deref()
+            .map(|n| format!(" \"{n}\""))
+            .unwrap_or_default();
+        let kind = match &light.kind {
+            LightKind::Point {
+                position,
+                attenuation: a,
+            } => format!(
+                "point at {} attenuation ({}, {}, {})",
+                v(*position),
+                a.constant,
+                a.linear,
+                a.quadratic
+            ),
+            LightKind::Directional { direction } => {
+                format!("directional towards {}", v(*direction))
+            }
+            LightKind::Spot {
+                position,
+                direction,
+                inner_angle_degrees,
+                outer_angle_degrees,
+                attenuation: a,
+            } => format!(
+                "spot at {} towards {} cone {}..{} deg attenuation ({}, {}, {})",
+                v(*position),
+                v(*direction),
+                inner_angle_degrees,
+                outer_angle_degrees,
+                a.constant,
+                a.linear,
+                a.quadratic
+            ),
+        };
+        let _ = writeln!(
+            out,
+            "light {handle}{name} {kind} colour {}  @ {}",
+            color(&light.color),
+            scene.sources.location(span)
+        );
+    }
+    for (handle, material, span) in scene.materials.iter_with_spans() {
+        let _ = writeln!(
+            out,
+            "material {handle}{}  @ {}",
+            material_name(material),
+            scene.sources.location(span)
+        );
+        let _ = writeln!(out, "  {}", material_fields(material));
+        if let Some(p) = &material.pattern {
+            let _ = writeln!(
+                out,
+                "  pattern {:?} of {} and {} scale {}{}",
+                p.kind,
+                p.a,
+                p.b,
+                p.scale,
+                matrix_suffix(&p.pattern_from_object)
+            );
+        }
+    }
+    for &root in &scene.roots {
+        print_object(scene, root, 0, &mut out);
+    }
+    out
+}
+
+fn material_name(m: &Material) -> String {
+    m.name
+        .as_deref()
+        .map(|n| format!(" \"{n}\""))
+        .unwrap_or_default()
+}
+
+fn material_fields(m: &Material) -> String {
+    format!(
+        "ambient {} diffuse {} specular {} shininess {} reflective {} transmissive {} ior {} fresnel {:?} absorption {}",
+        color(&m.ambient), color(&m.diffuse), color(&m.specular), m.shininess, color(&m.reflective),
+        color(&m.transmissive), m.ior, m.fresnel, color(&m.absorption)
+    )
+}
+
+fn print_object(scene: &Scene, handle: Handle<Object>, depth: usize, out: &mut String) {
+    let object = &scene.objects[handle];
+    let indent = "  ".repeat(depth);
+    let name = object
+        .name
+        .as_deref()
+        .map(|n| format!(" \"{n}\""))
+        .unwrap_or_default();
+    let what = match &object.kind {
+        ObjectKind::Shape { shape } => shape_text(shape),
+        ObjectKind::Csg { op, .. } => op.name().to_string(),
+        ObjectKind::Group { .. } => "group".to_string(),
+    };
+    let location = scene.sources.location(scene.objects.span(handle));
+    let _ = writeln!(
+        out,
+        "{indent}object {handle}{name} {what} material {}{}  @ {location}",
+        object.material,
+        matrix_suffix(&object.world_from_object)
+    );
+    if let ObjectKind::Csg { children, .. } | ObjectKind::Group { children } = &object.kind {
+        for &child in children {
+            print_object(scene, child, depth + 1, out);
+        }
+    }
+}
+
+fn shape_text(shape: &Shape) -> String {
+    match shape {
+        Shape::Sphere { center, radius } => format!("sphere center {} radius {radius}", v(*center)),
+        Shape::Plane { normal, offset } => format!("plane normal {} offset {offset}", v(*normal)),
+        Shape::Box { min, max } => format!("box min {} max {}", v(*min), v(*max)),
+        Shape::Cylinder {
+            base,
+            apex,
+            radius,
+            capped,
+        } => {
+            format!(
+                "cylinder {} to {} radius {radius}{}",
+                v(*base),
+                v(*apex),
+                if *capped { "" } else { " open" }
+            )
+        }
+        Shape::Cone {
+            base,
+            base_radius,
+            apex,
+            apex_radius,
+            capped,
+        } => format!(
+            "cone {} radius {base_radius} to {} radius {apex_radius}{}",
+            v(*base),
+            v(*apex),
+            if *capped { "" } else { " open" }
+        ),
+        Shape::Disk {
+            center,
+            normal,
+            radius,
+        } => format!(
+            "disk center {} normal {} radius {radius}",
+            v(*center),
+            v(*normal)
+        ),
+        Shape::Triangle { a, b, c } => format!("triangle {} {} {}", v(*a), v(*b), v(*c)),
+        Shape::Quadric { quadric, .. } => {
+            let c = quadric.coefficients();
+            let list: Vec<String> = c.iter().map(|x| x.to_string()).collect();
+            format!("{} [{}]", shape.kind_name(), list.join(", "))
+        }
+    }
+}
+
+fn v(p: DVec3) -> String {
+    format!("<{}, {}, {}>", p.x, p.y, p.z)
+}
+
+fn color(c: &Color) -> String {
+    format!("rgb({}, {}, {})", c.r, c.g, c.b)
+}
+
+/// Nothing for the identity; otherwise the matrix rows, so the dump stays short.
+fn matrix_suffix(m: &DMat4) -> String {
+    if *m == DMat4::IDENTITY {
+        return String::new();
+    }
+    let rows: Vec<String> = (0..4)
+        .map(|r| {
+            let row = m.row(r);
+            format!("[{} {} {} {}]", row.x, row.y, row.z, row.w)
+        })
+        .collect();
+    format!(" transform {}", rows.join(" "))
+}

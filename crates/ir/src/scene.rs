@@ -1,0 +1,480 @@
+//! The scene IR itself: settings, camera, lights, materials and objects, as plain data.
+//!
+//! Everything is resolved: material inheritance is flattened, `let`/`for`/functions are gone,
+//! and every object carries its full `world_from_object` transform, so the tracer needs no
+//! knowledge of the language that produced it.
+
+use glam::{DMat4, DVec3};
+use serde::Serialize;
+
+use crate::arena::{Arena, Handle};
+use crate::source::{SourceMap, Span};
+
+/// A linear RGB triple. Not clamped: light intensities may exceed 1.
+#[derive(Clone, Copy, Debug, PartialEq, Default, Serialize)]
+pub struct Color {
+    pub r: f64,
+    pub g: f64,
+    pub b: f64,
+}
+
+impl Color {
+    pub const BLACK: Color = Color::gray(0.0);
+    pub const WHITE: Color = Color::gray(1.0);
+
+    pub const fn new(r: f64, g: f64, b: f64) -> Self {
+        Color { r, g, b }
+    }
+
+    pub const fn gray(v: f64) -> Self {
+        Color { r: v, g: v, b: v }
+    }
+
+    pub fn is_black(&self) -> bool {
+        self.r == 0.0 && self.g == 0.0 && self.b == 0.0
+    }
+
+    pub fn components(&self) -> [f64; 3] {
+        [self.r, self.g, self.b]
+    }
+}
+
+/// How a transparent object shadows the light behind it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShadowMode {
+    /// Every object blocks light completely (the classic model).
+    Opaque,
+    /// A transmissive blocker lets light through, multiplied by its transmissive colour.
+    Filtered,
+}
+
+/// Render settings. Defaults live here so that the language, the CLI and tests agree.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Settings {
+    pub width: u32,
+    pub height: u32,
+    /// Rays deeper than this are not spawned; the camera ray has depth 0.
+    pub max_depth: u32,
+    /// The contribution cut-off: a reflected or transmitted ray whose path weight (the
+    /// product of coefficients from the eye) is below this on every channel is not traced.
+    pub min_weight: f64,
+    pub samples_per_pixel: u32,
+    pub background: Color,
+    /// The global ambient light `Ia`.
+    pub ambient: Color,
+    /// Secondary rays start this far off the surface along the normal.
+    pub epsilon: f64,
+    pub shadows: ShadowMode,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Settings {
+            width: 640,
+            height: 480,
+            max_depth: 5,
+            min_weight: 0.001,
+            samples_per_pixel: 1,
+            background: Color::BLACK,
+            ambient: Color::WHITE,
+            epsilon: 1e-4,
+            shadows: ShadowMode::Opaque,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Projection {
+    Perspective { vertical_fov_degrees: f64 },
+    Orthographic { view_height: f64 },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Camera {
+    pub eye: DVec3,
+    pub look_at: DVec3,
+    pub up: DVec3,
+    pub projection: Projection,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera {
+            eye: DVec3::new(0.0, 0.0, 5.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+            projection: Projection::Perspective {
+                vertical_fov_degrees: 45.0,
+            },
+        }
+    }
+}
+
+/// Distance attenuation `fatt = min(1, 1 / (constant + linear·d + quadratic·d²))`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Attenuation {
+    pub constant: f64,
+    pub linear: f64,
+    pub quadratic: f64,
+}
+
+impl Attenuation {
+    /// No fall-off with distance.
+    pub const NONE: Attenuation = Attenuation {
+        constant: 1.0,
+        linear: 0.0,
+        quadratic: 0.0,
+    };
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum LightKind {
+    Point {
+        position: DVec3,
+        attenuation: Attenuation,
+    },
+    /// Light from infinitely far away, travelling along `direction`.
+    Directional { direction: DVec3 },
+    /// A point light limited to a cone: full inside `inner`, fading to zero at `outer`.
+    Spot {
+        position: DVec3,
+        direction: DVec3,
+        inner_angle_degrees: f64,
+        outer_angle_degrees: f64,
+        attenuation: Attenuation,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Light {
+    pub name: Option<String>,
+    /// The intensity `Ii` per channel.
+    pub color: Color,
+    pub kind: LightKind,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Fresnel {
+    /// Reflection and transmission use the reflective and transmissive colours as given.
+    Off,
+    /// Schlick's approximation splits the weight between reflection and transmission.
+    Schlick,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PatternKind {
+    /// Alternating cubes of side `scale` in pattern space.
+    Checker,
+    /// Alternating slabs of width `scale` along pattern-space x.
+    Stripes,
+}
+
+/// A procedural choice between two materials at each surface point.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Pattern {
+    pub kind: PatternKind,
+    pub a: Handle<Material>,
+    pub b: Handle<Material>,
+    pub scale: f64,
+    /// Maps the object-space hit point into pattern space (before dividing by `scale`).
+    pub pattern_from_object: DMat4,
+}
+
+/// A fully resolved material (inheritance already applied).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Material {
+    pub name: Option<String>,
+    /// `ka`: the ambient term is `ka·Ia·diffuse`.
+    pub ambient: Color,
+    /// `kd`: the diffuse colour.
+    pub diffuse: Color,
+    /// `ks`: the Phong specular colour.
+    pub specular: Color,
+    /// The Phong exponent `n`.
+    pub shininess: f64,
+    /// `kr`: weight of the mirror-reflected ray.
+    pub reflective: Color,
+    /// `kt`: weight of the refracted ray.
+    pub transmissive: Color,
+    pub ior: f64,
+    pub fresnel: Fresnel,
+    /// Beer-Lambert absorption per unit distance inside a transmissive solid.
+    pub absorption: Color,
+    /// When set, the surface takes pattern.a or pattern.b at each point instead of this.
+    pub pattern: Option<Pattern>,
+}
+
+impl Default for Material {
+    /// The documented default: a matte light grey.
+    fn default() -> Self {
+        Material {
+            name: None,
+            ambient: Color::gray(0.1),
+            diffuse: Color::gray(0.8),
+            specular: Color::BLACK,
+            shininess: 32.0,
+            reflective: Color::BLACK,
+            transmissive: Color::BLACK,
+            ior: 1.0,
+            fresnel: Fresnel::Off,
+            absorption: Color::BLACK,
+            pattern: None,
+        }
+    }
+}
+
+/// Which named quadric a [`Quadric`] was written as (informative: the coefficients rule).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum QuadricForm {
+    General,
+    Ellipsoid,
+    EllipticParaboloid,
+    HyperboloidOneSheet,
+    HyperboloidTwoSheets,
+}
+
+/// `A·x² + B·y² + C·z² + D·xy + E·xz + F·yz + G·x + H·y + I·z + J = 0`, a solid that is
+/// inside where the polynomial is negative.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Quadric {
+    pub a: f64,
+    pub b: f64,
+    pub c: f64,
+    pub d: f64,
+    pub e: f64,
+    pub f: f64,
+    pub g: f64,
+    pub h: f64,
+    pub i: f64,
+    pub j: f64,
+}
+
+impl Quadric {
+    pub fn coefficients(&self) -> [f64; 10] {
+        [
+            self.a, self.b, self.c, self.d, self.e, self.f, self.g, self.h, self.i, self.j,
+        ]
+    }
+
+    pub fn from_coefficients(c: [f64; 10]) -> Self {
+        Quadric {
+            a: c[0],
+            b: c[1],
+            c: c[2],
+            d: c[3],
+            e: c[4],
+            f: c[5],
+            g: c[6],
+            h: c[7],
+            i: c[8],
+            j: c[9],
+        }
+    }
+
+    /// The polynomial's value at `p` (negative inside).
+    pub fn eval(&self, p: DVec3) -> f64 {
+        let (x, y, z) = (p.x, p.y, p.z);
+        self.a * x * x
+            + self.b * y * y
+            + self.c * z * z
+            + self.d * x * y
+            + self.e * x * z
+            + self.f * y * z
+            + self.g * x
+            + self.h * y
+            + self.i * z
+            + self.j
+    }
+
+    /// The gradient at `p`: the outward (unnormalised) surface normal.
+    pub fn gradient(&self, p: DVec3) -> DVec3 {
+        let (x, y, z) = (p.x, p.y, p.z);
+        DVec3::new(
+            2.0 * self.a * x + self.d * y + self.e * z + self.g,
+            2.0 * self.b * y + self.d * x + self.f * z + self.h,
+            2.0 * self.c * z + self.e * x + self.f * y + self.i,
+        )
+    }
+}
+
+/// A primitive in object space. Solids (everything but disk, triangle and the open
+/// cylinder and cone) may take part in CSG.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum Shape {
+    Sphere {
+        center: DVec3,
+        radius: f64,
+    },
+    /// The points with `normal·p = offset`; the solid is the half-space `normal·p < offset`.
+    Plane {
+        normal: DVec3,
+        offset: f64,
+    },
+    Box {
+        min: DVec3,
+        max: DVec3,
+    },
+    /// A circular cylinder from `base` to `apex`; `capped: false` leaves the ends open.
+    Cylinder {
+        base: DVec3,
+        apex: DVec3,
+        radius: f64,
+        capped: bool,
+    },
+    /// A (possibly truncated) circular cone from `base` to `apex`.
+    Cone {
+        base: DVec3,
+        base_radius: f64,
+        apex: DVec3,
+        apex_radius: f64,
+        capped: bool,
+    },
+    /// A flat disk, facing `normal`. Not a solid.
+    Disk {
+        center: DVec3,
+        normal: DVec3,
+        radius: f64,
+    },
+    /// A single triangle. Not a solid.
+    Triangle {
+        a: DVec3,
+        b: DVec3,
+        c: DVec3,
+    },
+    Quadric {
+        form: QuadricForm,
+        quadric: Quadric,
+    },
+}
+
+impl Shape {
+    /// Whether the shape encloses a volume, so it has an inside for CSG and refraction.
+    pub fn is_solid(&self) -> bool {
+        match self {
+            Shape::Disk { .. } | Shape::Triangle { .. } => false,
+            Shape::Cylinder { capped, .. } | Shape::Cone { capped, .. } => *capped,
+            _ => true,
+        }
+    }
+
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Shape::Sphere { .. } => "sphere",
+            Shape::Plane { .. } => "plane",
+            Shape::Box { .. } => "box",
+            Shape::Cylinder { .. } => "cylinder",
+            Shape::Cone { .. } => "cone",
+            Shape::Disk { .. } => "disk",
+            Shape::Triangle { .. } => "triangle",
+            Shape::Quadric { form, .. } => match form {
+                QuadricForm::General => "quadric",
+                QuadricForm::Ellipsoid => "ellipsoid",
+                QuadricForm::EllipticParaboloid => "paraboloid",
+                QuadricForm::HyperboloidOneSheet => "hyperboloid",
+                QuadricForm::HyperboloidTwoSheets => "hyperboloid2",
+            },
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CsgOp {
+    /// Inside any child.
+    Union,
+    /// Inside every child.
+    Intersection,
+    /// Inside the first child and outside all the others.
+    Difference,
+}
+
+impl CsgOp {
+    pub fn name(&self) -> &'static str {
+        match self {
+            CsgOp::Union => "union",
+            CsgOp::Intersection => "intersection",
+            CsgOp::Difference => "difference",
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum ObjectKind {
+    Shape {
+        shape: Shape,
+    },
+    /// A solid made from solid children; children come before the node in the arena.
+    Csg {
+        op: CsgOp,
+        children: Vec<Handle<Object>>,
+    },
+    /// A plain collection that is not a solid; its children render as separate objects.
+    Group {
+        children: Vec<Handle<Object>>,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Object {
+    pub name: Option<String>,
+    pub kind: ObjectKind,
+    /// The full transform from this node's space to world space (parents already applied).
+    pub world_from_object: DMat4,
+    /// The material of this node's surfaces (a CSG hit uses the leaf's material).
+    pub material: Handle<Material>,
+}
+
+/// A whole scene: what one `.scene` file (with its imports) describes.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    pub settings: Settings,
+    pub camera: Camera,
+    /// Where the camera was defined (detached when the default camera is used).
+    pub camera_span: Span,
+    pub lights: Arena<Light>,
+    pub materials: Arena<Material>,
+    pub objects: Arena<Object>,
+    /// The top-level objects, in source order. Every other object is reachable from these.
+    pub roots: Vec<Handle<Object>>,
+    pub sources: SourceMap,
+}
+
+impl Default for Span {
+    fn default() -> Self {
+        Span::detached()
+    }
+}
+
+impl Scene {
+    /// The display name of an object: its own name, or its kind and handle.
+    pub fn object_label(&self, handle: Handle<Object>) -> String {
+        let object = &self.objects[handle];
+        match &object.name {
+            Some(name) => name.clone(),
+            None => {
+                let kind = match &object.kind {
+                    ObjectKind::Shape { shape } => shape.kind_name(),
+                    ObjectKind::Csg { op, .. } => op.name(),
+                    ObjectKind::Group { .. } => "group",
+                };
+                format!("{kind} {handle}")
+            }
+        }
+    }
+
+    /// The display name of a material: its own name or its handle.
+    pub fn material_label(&self, handle: Handle<Material>) -> String {
+        match &self.materials[handle].name {
+            Some(name) => name.clone(),
+            None => format!("material {handle}"),
+        }
+    }
+}

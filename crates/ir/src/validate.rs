@@ -1,0 +1,639 @@
+//! The validator: checks every invariant the tracer relies on and wraps the scene in
+//! [`ValidScene`], the only type the tracer accepts, so the tracer never re-checks.
+
+use glam::{DMat4, DVec3};
+
+use crate::arena::Handle;
+use crate::diagnostic::Diagnostic;
+use crate::scene::{
+    Attenuation, Color, LightKind, Material, Object, ObjectKind, Projection, Scene, Shape,
+};
+use crate::source::Span;
+
+/// A scene that passed [`validate`]. Dereferences to the [`Scene`].
+#[derive(Clone, Debug)]
+pub struct ValidScene(Scene);
+
+impl ValidScene {
+    pub fn scene(&self) -> &Scene {
+        &self.0
+    }
+
+    pub fn into_inner(self) -> Scene {
+        self.0
+    }
+}
+
+impl std::ops::Deref for ValidScene {
+    type Target = Scene;
+    fn deref(&self) -> &Scene {
+        &self.0
+    }
+}
+
+/// A scene that failed validation, returned whole so the caller can still show sources.
+#[derive(Debug)]
+pub struct InvalidScene {
+    pub scene: Scene,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// The smallest determinant a transform may have before it counts as singular.
+const MIN_DETERMINANT: f64 = 1e-12;
+
+/// Checks handles, transforms, shapes, materials, lights, camera and settings.
+pub fn validate(scene: Scene) -> Result<ValidScene, Box<InvalidScene>> {
+    let mut checker = Checker { errors: Vec::new() };
+    checker.settings(&scene);
+    checker.camera(&scene);
+    for (_, light, span) in scene.lights.iter_with_spans() {
+        checker.light(light, span);
+    }
+    for (handle, material, span) in scene.materials.iter_with_spans() {
+        checker.material(&scene, handle, material, span);
+    }
+    for (handle, object, span) in scene.objects.iter_with_spans() {
+        checker.object(&scene, handle, object, span);
+    }
+    for &root in &scene.roots {
+        if !scene.objects.contains(root) {
+            checker.errors.push(Diagnostic::new(
+                crate::Severity::Error,
+                format!("the scene lists a top-level object {root} that does not exist"),
+                None,
+            ));
+        }
+    }
+    if checker.errors.is_empty() {
+        Ok(ValidScene(scene))
+    } else {
+        Err(InvalidScene {
+            scene,
+            diagnostics: checker.errors,
+        })
+    }
+}
+
+struct Checker {
+    errors: Vec<Diagnostic>,
+}
+
+fn finite(v: DVec3) -> bool {
+    v.is_finite()
+}
+
+fn color_ok(c: &Color) -> bool {
+    c.components().iter().all(|v| v.is_finite() && *v >= 0.0)
+}
+
+impl Checker {
+    fn error(&mut self, message: String, span: Span) {
+        self.errors.push(Diagnostic::error(message, span));
+    }
+
+    fn settings(&mut self, scene: &Scene) {
+        let s = &scene.settings;
+        let span = Span::detached();
+        if s.width == 0 || s.height == 0 {
+            self.error(
+                format!("the image size {}x{} is empty", s.width, s.height),
+                span,
+            );
+        }
+        if s.samples_per_pixel == 0 {
+            self.error("samples per pixel must be at least 1".into(), span);
+        }
+        if !(s.min_weight.is_finite() && s.min_weight >= 0.0) {
+            self.error(
+                format!("the minimum path weight must be >= 0, not {}", s.min_weight),
+                span,
+            );
+        }
+        if !(s.epsilon.is_finite() && s.epsilon > 0.0) {
+            self.error(
+                format!("the surface offset epsilon must be > 0, not {}", s.epsilon),
+                span,
+            );
+        }
+        if !color_ok(&s.background) {
+            self.error("the background colour must be finite and >= 0".into(), span);
+        }
+        if !color_ok(&s.ambient) {
+            self.error(
+                "the global ambient light must be finite and >= 0".into(),
+                span,
+            );
+        }
+    }
+
+    fn camera(&mut self, scene: &Scene) {
+        let camera = &scene.camera;
+        let span = scene.camera_span;
+        if !(finite(camera.eye) && finite(camera.look_at) && finite(camera.up)) {
+            self.error(
+                "the camera has a coordinate that is not a finite number".into(),
+                span,
+            );
+            return;
+        }
+        let view = camera.look_at - camera.eye;
+        if view.length() < 1e-12 {
+            self.error(
+                "the camera looks at its own eye point: `eye` and `look_at` are equal".into(),
+                span,
+            );
+        } else if view.normalize().cross(camera.up).length() < 1e-9 {
+            self.error(
+                "the camera's `up` is parallel to its view direction".into(),
+                span,
+            );
+        }
+        match camera.projection {
+            Projection::Perspective {
+                vertical_fov_degrees: fov,
+            } => {
+                if !(fov > 0.0 && fov < 180.0) {
+                    self.error(
+                        format!("the field of view must be between 0 and 180 degrees, not {fov}"),
+                        span,
+                    );
+                }
+            }
+            Projection::Orthographic { view_height } => {
+                if !(view_height.is_finite() && view_height > 0.0) {
+                    self.error(
+                        format!("the orthographic view height must be > 0, not {view_height}"),
+                        span,
+                    );
+                }
+            }
+        }
+    }
+
+    fn attenuation(&mut self, a: &Attenuation, span: Span) {
+        let terms = [a.constant, a.linear, a.quadratic];
+        if terms.iter().any(|t| !t.is_finite() || *t < 0.0) {
+            self.error("attenuation terms must be finite and >= 0".into(), span);
+        } else if terms.iter().all(|t| *t == 0.0) {
+            self.error(
+                "attenuation terms cannot all be zero (the light would be infinitely bright)"
+                    .into(),
+                span,
+            );
+        }
+    }
+
+    fn light(&mut self, light: &crate::Light, span: Span) {
+        if !color_ok(&light.color) {
+            self.error("a light's colour must be finite and >= 0".into(), span);
+        }
+        match &light.kind {
+            LightKind::Point {
+                position,
+                attenuation,
+            } => {
+                if !finite(*position) {
+                    self.error("the light's position is not finite".into(), span);
+                }
+                self.attenuation(attenuation, span);
+            }
+            LightKind::Directional { direction } => {
+                if !finite(*direction) || direction.length() < 1e-12 {
+                    self.error(
+                        "a directional light needs a non-zero direction".into(),
+                        span,
+                    );
+                }
+            }
+            LightKind::Spot {
+                position,
+                direction,
+                inner_angle_degrees,
+                outer_angle_degrees,
+                attenuation,
+            } => {
+                if !finite(*position) {
+                    self.error("the light's position is not finite".into(), span);
+                }
+                if !finite(*direction) || direction.length() < 1e-12 {
+                    self.error("a spot light needs a non-zero direction".into(), span);
+                }
+                let (inner, outer) = (*inner_angle_degrees, *outer_angle_degrees);
+                if !(inner >= 0.0 && inner <= outer && outer < 180.0) {
+                    self.error(format!(
+                        "a spot light needs 0 <= inner <= outer < 180 degrees, not inner {inner} and outer {outer}"
+                    ), span);
+                }
+                self.attenuation(attenuation, span);
+            }
+        }
+    }
+
+    fn material(&mut self, scene: &Scene, handle: Handle<Material>, m: &Material, span: Span) {
+        let colors = [
+            ("ambient", &m.ambient),
+            ("diffuse", &m.diffuse),
+            ("specular", &m.specular),
+            ("reflective", &m.reflective),
+            ("transmissive", &m.transmissive),
+            ("absorption", &m.absorption),
+        ];
+        for (field, color) in colors {
+            if !color_ok(color) {
+                self.error(
+                    format!("the material's {field} coefficient must be finite and >= 0"),
+                    span,
+                );
+            }
+        }
+        if !(m.shininess.is_finite() && m.shininess >= 0.0) {
+            self.error(format!("shininess must be >= 0, not {}", m.shininess), span);
+        }
+        if !(m.ior.is_finite() && m.ior > 0.0) {
+            self.error(
+                format!("the index of refraction must be > 0, not {}", m.ior),
+                span,
+            );
+        }
+        if let Some(pattern) = &m.pattern {
+            for part in [pattern.a, pattern.b] {
+                if part >= handle {
+                    self.error(
+                        format!(
+                            "a pattern refers to material {part}, which is not defined before it"
+                        ),
+                        span,
+                    );
+                } else if !scene.materials.contains(part) {
+                    self.error(
+                        format!("a pattern refers to a missing material {part}"),
+                        span,
+                    );
+                }
+            }
+            if !(pattern.scale.is_finite() && pattern.scale > 0.0) {
+                self.error(
+                    format!("a pattern's scale must be > 0, not {}", pattern.scale),
+                    span,
+                );
+            }
+            self.transform(&pattern.pattern_from_object, "pattern transform", span);
+        }
+    }
+
+    fn transform(&mut self, m: &DMat4, what: &str, span: Span) {
+        if !m.is_finite() {
+            self.error(format!("the {what} has a number that is not finite"), span);
+        } else if m.determinant().abs() < MIN_DETERMINANT {
+            self.error(
+                format!("the {what} is not invertible (a scale by zero flattens the object)"),
+                span,
+            );
+        }
+    }
+
+    fn object(&mut self, scene: &Scene, handle: Handle<Object>, object: &Object, span: Span) {
+        self.transform(&object.world_from_object, "object's transform", span);
+        if !scene.materials.contains(object.material) {
+            self.error(
+                format!(
+                    "the object refers to a missing material {}",
+                    object.material
+                ),
+                span,
+            );
+        }
+        match &object.kind {
+            ObjectKind::Shape { shape } => self.shape(shape, span),
+            ObjectKind::Csg { op, children } => {
+                if children.is_empty() {
+                    self.error(format!("this {} has no children", op.name()), span);
+                }
+                for &child in children {
+                    if !self.child_ok(scene, handle, child, span) {
+                        continue;
+                    }
+                    if !is_solid(scene, child) {
+                        let child_span = scene.objects.span(child);
+                        self.errors.push(
+                            Diagnostic::error(
+                                format!("a {} needs solid children, and this is not a solid", op.name()),
+                                child_span,
+                            )
+                            .with_secondary(span, "in this CSG operation")
+                            .with_hint("disks, triangles, open cylinders and cones, and groups have no inside; use a capped shape or a union"),
+                        );
+                    }
+                }
+            }
+            ObjectKind::Group { children } => {
+                for &child in children {
+                    self.child_ok(scene, handle, child, span);
+                }
+            }
+        }
+    }
+
+    fn child_ok(
+        &mut self,
+        scene: &Scene,
+        parent: Handle<Object>,
+        child: Handle<Object>,
+        span: Span,
+    ) -> bool {
+        if child >= parent || !scene.objects.contains(child) {
+            self.error(
+                format!("object {parent} has a child {child} that is not defined before it"),
+                span,
+            );
+            return false;
+        }
+        true
+    }
+
+    fn shape(&mut self, shape: &Shape, span: Span) {
+        let bad = |ok: bool, message: &str, this: &mut Self| {
+            if !ok {
+                this.error(message.to_string(), span);
+            }
+        };
+        match shape {
+            Shape::Sphere { center, radius } => {
+                bad(finite(*center), "the sphere's centre is not finite", self);
+                bad(
+                    radius.is_finite() && *radius > 0.0,
+                    "a sphere's radius must be > 0",
+                    self,
+                );
+            }
+            Shape::Plane { normal, offset } => {
+                bad(
+                    finite(*normal) && normal.length() > 1e-12,
+                    "a plane needs a non-zero normal",
+                    self,
+                );
+                bad(offset.is_finite(), "the plane's offset is not finite", self);
+            }
+            Shape::Box { min, max } => {
+                bad(
+                    finite(*min) && finite(*max),
+                    "the box's corners are not finite",
+                    self,
+                );
+                bad(
+                    min.cmplt(*max).all(),
+                    "a box needs min < max on every axis (it has no volume)",
+                    self,
+                );
+            }
+            Shape::Cylinder {
+                base, apex, radius, ..
+            } => {
+                bad(
+                    finite(*base) && finite(*apex),
+                    "the cylinder's end points are not finite",
+                    self,
+                );
+                bad(
+                    (*apex - *base).length() > 1e-12,
+                    "a cylinder's two end points must differ",
+                    self,
+                );
+                bad(
+                    radius.is_finite() && *radius > 0.0,
+                    "a cylinder's radius must be > 0",
+                    self,
+                );
+            }
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                apex_radius,
+                ..
+            } => {
+                bad(
+                    finite(*base) && finite(*apex),
+                    "the cone's end points are not finite",
+                    self,
+                );
+                bad(
+                    (*apex - *base).length() > 1e-12,
+                    "a cone's two end points must differ",
+                    self,
+                );
+                bad(
+                    base_radius.is_finite()
+                        && apex_radius.is_finite()
+                        && *base_radius >= 0.0
+                        && *apex_radius >= 0.0,
+                    "a cone's radii must be >= 0",
+                    self,
+                );
+                bad(
+                    *base_radius != *apex_radius,
+                    "a cone with equal radii is a cylinder: use `cylinder`",
+                    self,
+                );
+            }
+            Shape::Disk {
+                center,
+                normal,
+                radius,
+            } => {
+                bad(finite(*center), "the disk's centre is not finite", self);
+                bad(
+                    finite(*normal) && normal.length() > 1e-12,
+                    "a disk needs a non-zero normal",
+                    self,
+                );
+                bad(
+                    radius.is_finite() && *radius > 0.0,
+                    "a disk's radius must be > 0",
+                    self,
+                );
+            }
+            Shape::Triangle { a, b, c } => {
+                bad(
+                    finite(*a) && finite(*b) && finite(*c),
+                    "the triangle's corners are not finite",
+                    self,
+                );
+                bad(
+                    (*b - *a).cross(*c - *a).length() > 1e-14,
+                    "the triangle is degenerate (its corners are in a line)",
+                    self,
+                );
+            }
+            Shape::Quadric { quadric, .. } => {
+                let c = quadric.coefficients();
+                bad(
+                    c.iter().all(|v| v.is_finite()),
+                    "the quadric has a coefficient that is not finite",
+                    self,
+                );
+                bad(
+                    c[..6].iter().any(|v| *v != 0.0),
+                    "the quadric is degenerate: A to F are all zero, so it is a plane or nothing (use `plane`)",
+                    self,
+                );
+            }
+        }
+    }
+}
+
+fn is_solid(scene: &Scene, handle: Handle<Object>) -> bool {
+    match &scene.objects[handle].kind {
+        ObjectKind::Shape { shape } => shape.is_solid(),
+        ObjectKind::Csg { .. } => true,
+        ObjectKind::Group { .. } => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Fresnel;
+    use crate::source::FileId;
+
+    fn span(n: usize) -> Span {
+        Span::new(FileId(0), n, n + 1)
+    }
+
+    fn scene_with(shape: Shape) -> Scene {
+        let mut scene = Scene::default();
+        let material = scene.materials.append(Material::default(), span(0));
+        let object = scene.objects.append(
+            Object {
+                name: None,
+                kind: ObjectKind::Shape { shape },
+                world_from_object: DMat4::IDENTITY,
+                material,
+            },
+            span(1),
+        );
+        scene.roots.push(object);
+        scene
+    }
+
+    fn errors(scene: Scene) -> Vec<String> {
+        match validate(scene) {
+            Ok(_) => Vec::new(),
+            Err(invalid) => invalid.diagnostics.into_iter().map(|d| d.message).collect(),
+        }
+    }
+
+    #[test]
+    fn a_simple_scene_is_valid() {
+        assert!(errors(scene_with(Shape::Sphere {
+            center: DVec3::ZERO,
+            radius: 1.0
+        }))
+        .is_empty());
+    }
+
+    #[test]
+    fn degenerate_shapes_are_rejected() {
+        let cases = [
+            Shape::Sphere {
+                center: DVec3::ZERO,
+                radius: 0.0,
+            },
+            Shape::Box {
+                min: DVec3::ONE,
+                max: DVec3::ONE,
+            },
+            Shape::Quadric {
+                form: crate::QuadricForm::General,
+                quadric: Quadric::from_coefficients([
+                    0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0,
+                ]),
+            },
+            Shape::Triangle {
+                a: DVec3::ZERO,
+                b: DVec3::X,
+                c: DVec3::X * 2.0,
+            },
+            Shape::Plane {
+                normal: DVec3::ZERO,
+                offset: 0.0,
+            },
+        ];
+        for shape in cases {
+            let name = shape.kind_name();
+            assert_eq!(
+                errors(scene_with(shape)).len(),
+                1,
+                "{name} should give one error"
+            );
+        }
+    }
+
+    use crate::scene::Quadric;
+
+    #[test]
+    fn singular_transform_and_bad_material_are_reported_together() {
+        let mut scene = scene_with(Shape::Sphere {
+            center: DVec3::ZERO,
+            radius: 1.0,
+        });
+        scene.objects[Handle::from_index(0)].world_from_object =
+            DMat4::from_scale(DVec3::new(1.0, 0.0, 1.0));
+        let m = &mut scene.materials[Handle::from_index(0)];
+        m.ior = 0.0;
+        m.diffuse = Color::new(-1.0, 0.0, 0.0);
+        m.fresnel = Fresnel::Schlick;
+        let messages = errors(scene);
+        assert_eq!(messages.len(), 3, "{messages:?}");
+        assert!(messages.iter().any(|m| m.contains("not invertible")));
+        assert!(messages.iter().any(|m| m.contains("index of refraction")));
+        assert!(messages.iter().any(|m| m.contains("diffuse")));
+    }
+
+    #[test]
+    fn csg_children_must_be_solid_and_defined_first() {
+        let mut scene = scene_with(Shape::Disk {
+            center: DVec3::ZERO,
+            normal: DVec3::Y,
+            radius: 1.0,
+        });
+        let disk = Handle::from_index(0);
+        let material = Handle::from_index(0);
+        let csg = scene.objects.append(
+            Object {
+                name: None,
+                kind: ObjectKind::Csg {
+                    op: crate::CsgOp::Union,
+                    children: vec![disk],
+                },
+                world_from_object: DMat4::IDENTITY,
+                material,
+            },
+            span(2),
+        );
+        scene.roots = vec![csg];
+        let messages = errors(scene.clone());
+        assert_eq!(messages.len(), 1);
+        assert!(messages[0].contains("solid"));
+        // A forward reference (a cycle in the making) is refused.
+        scene.objects[disk].kind = ObjectKind::Group {
+            children: vec![csg],
+        };
+        assert!(errors(scene)
+            .iter()
+            .any(|m| m.contains("not defined before")));
+    }
+
+    #[test]
+    fn degenerate_camera_is_rejected() {
+        let mut scene = scene_with(Shape::Sphere {
+            center: DVec3::ZERO,
+            radius: 1.0,
+        });
+        scene.camera.look_at = scene.camera.eye;
+        assert_eq!(errors(scene.clone()).len(), 1);
+        scene.camera.look_at = DVec3::ZERO;
+        scene.camera.up = DVec3::Z;
+        assert!(errors(scene)[0].contains("parallel"));
+    }
+}
