@@ -67,10 +67,10 @@ pub fn validate(scene: Scene) -> Result<ValidScene, Box<InvalidScene>> {
     if checker.errors.is_empty() {
         Ok(ValidScene(scene))
     } else {
-        Err(InvalidScene {
+        Err(Box::new(InvalidScene {
             scene,
             diagnostics: checker.errors,
-        })
+        }))
     }
 }
 
