@@ -1,1 +1,77 @@
-fn main() {}
+//! `cargo xtask`: the project's own automation (ci, bench, golden), in Rust so it runs anywhere
+//! cargo does.
+
+mod bench;
+mod ci;
+mod golden;
+
+use std::process::ExitCode;
+
+const USAGE: &str = "\
+usage: cargo xtask <command>
+
+commands:
+  ci       fmt check, clippy -D warnings, every test, dependency-direction checks
+  deps     only the dependency-direction checks
+  golden   render the golden scenes and compare with tests/golden/ (--bless to update;
+           --scenes DIR --refs DIR for your own folders)
+  bench    release build, then time the benchmark scenes (prints Mrays/s)";
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(command) = args.first() else {
+        eprintln!("{USAGE}");
+        return ExitCode::from(2);
+    };
+    let rest = &args[1..];
+    let result = match command.as_str() {
+        "ci" => ci::run(rest),
+        "deps" => ci::check_dependency_directions(),
+        "golden" => golden::run(rest),
+        "bench" => bench::run(rest),
+        "-h" | "--help" | "help" => {
+            println!("{USAGE}");
+            Ok(())
+        }
+        other => {
+            eprintln!("unknown command `{other}`\n\n{USAGE}");
+            return ExitCode::from(2);
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("xtask: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The workspace root (xtask lives one level below it).
+pub fn workspace_root() -> std::path::PathBuf {
+    let manifest_dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    manifest_dir
+        .parent()
+        .map(|p| p.to_path_buf())
+        .unwrap_or(manifest_dir)
+}
+
+/// Runs a command in the workspace root, echoing it, and fails if it fails.
+pub fn run_cargo(args: &[&str]) -> anyhow::Result<()> {
+    eprintln!("$ cargo {}", args.join(" "));
+    let status = std::process::Command::new(cargo())
+        .args(args)
+        .current_dir(workspace_root())
+        .status()?;
+    anyhow::ensure!(
+        status.success(),
+        "`cargo {}` failed ({status})",
+        args.join(" ")
+    );
+    Ok(())
+}
+
+/// The cargo that runs us, so a rustup toolchain override is honoured.
+pub fn cargo() -> String {
+    std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string())
+}

@@ -1,0 +1,193 @@
+//! `cargo xtask bench`: builds the release binary and times the benchmark scenes.
+//!
+//! Prints figures; asserts nothing about time (machines are noisy and shared). Each render
+//! runs with one thread (the honest per-core figure) and with every core.
+
+use std::path::Path;
+use std::process::Command;
+use std::time::Instant;
+
+use anyhow::{bail, Context};
+use serde::Deserialize;
+
+use crate::{run_cargo, workspace_root};
+
+/// One benchmark render: a scene, its `-D` overrides and what to print it as.
+struct Case {
+    label: &'static str,
+    scene: &'static str,
+    defines: &'static [&'static str],
+}
+
+const RENDERS: &[Case] = &[
+    Case {
+        label: "classic (Whitted 1980)",
+        scene: "scenes/bench/classic.scene",
+        defines: &[],
+    },
+    Case {
+        label: "1,000 spheres",
+        scene: "scenes/bench/spheres1000.scene",
+        defines: &[],
+    },
+    Case {
+        label: "grid 1,000,000 spheres",
+        scene: "scenes/bench/grid.scene",
+        defines: &["N=1000"],
+    },
+];
+
+const COMPILES: &[Case] = &[
+    Case {
+        label: "grid N=316 (99,856 spheres)",
+        scene: "scenes/bench/grid.scene",
+        defines: &["N=316"],
+    },
+    Case {
+        label: "grid N=1000 (1,000,000 spheres)",
+        scene: "scenes/bench/grid.scene",
+        defines: &["N=1000"],
+    },
+];
+
+/// The fields of `whitted render --stats=json` that the table needs.
+#[derive(Deserialize)]
+struct Stats {
+    width: u32,
+    height: u32,
+    max_depth: u32,
+    objects: u64,
+    compile_seconds: f64,
+    build_seconds: f64,
+    render_seconds: f64,
+    total_rays: u64,
+}
+
+pub fn run(args: &[String]) -> anyhow::Result<()> {
+    let mut width = 640;
+    let mut height = 480;
+    let mut iter = args.iter();
+    while let Some(arg) = iter.next() {
+        match arg.as_str() {
+            "--size" => {
+                let value = iter.next().context("--size needs WxH")?;
+                let (w, h) = value
+                    .split_once('x')
+                    .context("--size needs WxH, e.g. 320x240")?;
+                width = w.parse().context("bad width")?;
+                height = h.parse().context("bad height")?;
+            }
+            other => bail!("unknown bench option `{other}` (known: --size WxH)"),
+        }
+    }
+    run_cargo(&["build", "--release", "--locked", "--bin", "whitted"])?;
+    let root = workspace_root();
+    let exe = root.join("target/release/whitted");
+    let out_dir = root.join("target/bench");
+    std::fs::create_dir_all(&out_dir)?;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+
+    println!("\nrenders ({width}x{height}, max depth 5, 1 spp; release build)");
+    println!(
+        "{:<26} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>10} {:>9}",
+        "scene", "threads", "objects", "compile", "bvh", "render", "wall", "rays", "Mrays/s/core"
+    );
+    for case in RENDERS {
+        for threads in [1, cores] {
+            let output = out_dir.join(format!("{}.png", case.scene.replace(['/', '.'], "_")));
+            let mut command = Command::new(&exe);
+            command.arg("render").arg(root.join(case.scene));
+            for define in case.defines {
+                command.args(["-D", define]);
+            }
+            command
+                .args([
+                    "--width",
+                    &width.to_string(),
+                    "--height",
+                    &height.to_string(),
+                ])
+                .args([
+                    "--max-depth",
+                    "5",
+                    "--spp",
+                    "1",
+                    "--threads",
+                    &threads.to_string(),
+                ])
+                .args(["--stats=json", "--quiet", "-o"])
+                .arg(&output);
+            let started = Instant::now();
+            let result = command
+                .output()
+                .with_context(|| format!("cannot run {}", exe.display()))?;
+            let wall = started.elapsed().as_secs_f64();
+            if !result.status.success() {
+                bail!(
+                    "{} failed:\n{}",
+                    case.scene,
+                    String::from_utf8_lossy(&result.stderr)
+                );
+            }
+            let stats: Stats = serde_json::from_slice(&result.stdout)
+                .with_context(|| format!("cannot read the stats of {}", case.scene))?;
+            let per_core =
+                stats.total_rays as f64 / stats.render_seconds.max(1e-9) / threads as f64 / 1e6;
+            println!(
+                "{:<26} {:>7} {:>9} {:>7.3}s {:>7.3}s {:>7.3}s {:>7.3}s {:>10} {:>9.2}",
+                case.label,
+                threads,
+                stats.objects,
+                stats.compile_seconds,
+                stats.build_seconds,
+                stats.render_seconds,
+                wall,
+                stats.total_rays,
+                per_core
+            );
+            debug_assert!(stats.width == width && stats.height == height && stats.max_depth == 5);
+        }
+    }
+
+    println!("\ncompile only (`whitted check`, one core; wall includes process start)");
+    println!("{:<34} {:>8} {:>12}", "scene", "wall", "peak memory");
+    for case in COMPILES {
+        let (wall, peak_kib) = time_check(&exe, &root.join(case.scene), case.defines)?;
+        let memory = peak_kib.map_or("n/a".to_string(), |k| {
+            format!("{:.0} MiB", k as f64 / 1024.0)
+        });
+        println!("{:<34} {:>7.3}s {:>12}", case.label, wall, memory);
+    }
+    Ok(())
+}
+
+/// Wall time and, where /usr/bin/time exists, peak resident memory of `whitted check`.
+fn time_check(exe: &Path, scene: &Path, defines: &[&str]) -> anyhow::Result<(f64, Option<u64>)> {
+    let gnu_time = Path::new("/usr/bin/time");
+    let mut command = if gnu_time.exists() {
+        let mut c = Command::new(gnu_time);
+        c.args(["-f", "%M"]).arg(exe);
+        c
+    } else {
+        Command::new(exe)
+    };
+    command.arg("check").arg(scene);
+    for define in defines {
+        command.args(["-D", define]);
+    }
+    let started = Instant::now();
+    let result = command.output()?;
+    let wall = started.elapsed().as_secs_f64();
+    if !result.status.success() {
+        bail!(
+            "check {} failed:\n{}",
+            scene.display(),
+            String::from_utf8_lossy(&result.stderr)
+        );
+    }
+    let peak = String::from_utf8_lossy(&result.stderr)
+        .lines()
+        .last()
+        .and_then(|line| line.trim().parse::<u64>().ok());
+    Ok((wall, peak))
+}

@@ -1,0 +1,126 @@
+//! `cargo xtask ci`: everything CI checks, in the order that fails fastest.
+
+use std::collections::BTreeSet;
+use std::time::Instant;
+
+use anyhow::{bail, Context};
+
+use crate::{cargo, run_cargo, workspace_root};
+
+/// Which crates each workspace crate must never depend on (DESIGN.md, "Dependency directions").
+/// `ir <- lang`, `ir <- tracer <- debugger`; the tracer never sees syntax, the debugger never parses.
+const FORBIDDEN: &[(&str, &[&str])] = &[
+    (
+        "whitted-ir",
+        &["whitted-lang", "whitted-tracer", "whitted-debugger", "pest"],
+    ),
+    (
+        "whitted-lang",
+        &["whitted-tracer", "whitted-debugger", "ratatui"],
+    ),
+    (
+        "whitted-tracer",
+        &[
+            "whitted-lang",
+            "whitted-debugger",
+            "pest",
+            "pest_derive",
+            "ratatui",
+        ],
+    ),
+    ("whitted-debugger", &["whitted-lang", "pest", "pest_derive"]),
+];
+
+/// Edges that must exist, so that a renamed crate cannot make the checks above vacuous.
+const REQUIRED: &[(&str, &str)] = &[
+    ("whitted-lang", "whitted-ir"),
+    ("whitted-tracer", "whitted-ir"),
+    ("whitted-debugger", "whitted-tracer"),
+];
+
+pub fn run(args: &[String]) -> anyhow::Result<()> {
+    if let Some(arg) = args.first() {
+        bail!("`cargo xtask ci` takes no arguments (got `{arg}`)");
+    }
+    let started = Instant::now();
+    step("format", || run_cargo(&["fmt", "--all", "--check"]))?;
+    step("clippy", || {
+        run_cargo(&[
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--locked",
+            "--",
+            "-D",
+            "warnings",
+        ])
+    })?;
+    step("tests", || run_cargo(&["test", "--workspace", "--locked"]))?;
+    step("dependency directions", check_dependency_directions)?;
+    eprintln!(
+        "\nci: all checks passed in {:.0} s",
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn step(name: &str, f: impl FnOnce() -> anyhow::Result<()>) -> anyhow::Result<()> {
+    eprintln!("\n== {name}");
+    let started = Instant::now();
+    f().with_context(|| format!("ci step `{name}` failed"))?;
+    eprintln!("== {name}: ok ({:.1} s)", started.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// The names of every crate `package` depends on through normal dependencies, transitively.
+fn normal_dependencies(package: &str) -> anyhow::Result<BTreeSet<String>> {
+    let output = std::process::Command::new(cargo())
+        .args([
+            "tree", "--locked", "-p", package, "-e", "normal", "--prefix", "none", "--format",
+            "{p}",
+        ])
+        .current_dir(workspace_root())
+        .output()
+        .context("cannot run cargo tree")?;
+    if !output.status.success() {
+        bail!(
+            "cargo tree -p {package} failed: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+    let text = String::from_utf8_lossy(&output.stdout);
+    Ok(text
+        .lines()
+        .skip(1) // the package itself
+        .filter_map(|line| line.split_whitespace().next())
+        .map(str::to_string)
+        .collect())
+}
+
+pub fn check_dependency_directions() -> anyhow::Result<()> {
+    let mut problems = Vec::new();
+    for (package, forbidden) in FORBIDDEN {
+        let deps = normal_dependencies(package)?;
+        for name in *forbidden {
+            if deps.contains(*name) {
+                problems.push(format!("{package} must not depend on {name}, but it does"));
+            }
+        }
+        for (from, to) in REQUIRED.iter().filter(|(from, _)| from == package) {
+            if !deps.contains(*to) {
+                problems.push(format!(
+                    "{from} is expected to depend on {to}, and does not"
+                ));
+            }
+        }
+    }
+    if problems.is_empty() {
+        eprintln!(
+            "dependency directions: ok ({} crates checked)",
+            FORBIDDEN.len()
+        );
+        Ok(())
+    } else {
+        bail!("dependency directions broken:\n  {}", problems.join("\n  "))
+    }
+}
