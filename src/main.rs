@@ -1,1 +1,53 @@
-fn main() {}
+//! The `whitted` command line: the only place that reads files, prints and exits.
+//!
+//! Exit codes: 0 success; 1 the scene has errors or an IO error; 2 bad command-line usage
+//! (clap's own code for usage errors).
+
+mod cli;
+mod image_output;
+mod render_cmd;
+mod scene_input;
+
+use std::io::Write;
+use std::process::ExitCode;
+
+use clap::Parser;
+
+use cli::{Cli, Command};
+
+/// How a command failed, so that `main` can pick the exit code and print one clear line.
+pub enum Failure {
+    /// The scene had errors; its diagnostics were already printed.
+    SceneErrors,
+    /// Anything else the user must fix (a missing file, an unwritable output): one line.
+    Message(String),
+    /// Bad usage that clap could not catch (e.g. a pixel outside the image).
+    Usage(String),
+}
+
+impl From<std::io::Error> for Failure {
+    fn from(error: std::io::Error) -> Self {
+        Failure::Message(error.to_string())
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Check(args) => scene_input::check(&args),
+        Command::Ir(args) => scene_input::ir(&args),
+        Command::Render(args) => render_cmd::render(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::SceneErrors) => ExitCode::from(1),
+        Err(Failure::Message(message)) => {
+            let _ = writeln!(std::io::stderr(), "error: {message}");
+            ExitCode::from(1)
+        }
+        Err(Failure::Usage(message)) => {
+            let _ = writeln!(std::io::stderr(), "error: {message}");
+            ExitCode::from(2)
+        }
+    }
+}

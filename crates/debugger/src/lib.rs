@@ -1,1 +1,3 @@
-//! placeholder
+//! whitted-debugger: the terminal ray-tree debugger (ratatui).
+
+pub mod image_view;

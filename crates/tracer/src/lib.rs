@@ -1,1 +1,41 @@
-//! placeholder
+//! whitted-tracer: renders a validated scene with Whitted's recursive model.
+//!
+//! [`PreparedScene::new`] turns a `whitted_ir::ValidScene` into f32 shapes, materials,
+//! lights, CSG trees and a BVH; [`render`] traces it over tiles in parallel. Tracing is one
+//! code path generic over a [`Recorder`]: [`render`] uses [`NoRecord`], while
+//! [`trace_pixel_with`] runs the same code for one pixel sample with any recorder (ray
+//! trees, statistics), so a recorded tree is always what the renderer computed.
+
+mod bounds;
+mod bvh;
+mod camera;
+mod csg;
+mod light;
+mod material;
+pub mod optics;
+mod query;
+mod ray;
+mod recorder;
+mod render;
+mod sampling;
+mod scene;
+mod shapes;
+mod solve;
+pub mod testing;
+mod trace;
+
+#[cfg(test)]
+mod tests;
+
+pub use recorder::{
+    Interface, LightSample, NoRecord, PixelStats, RayKind, RayStart, Recorder, ShadowRay,
+    ShadowResult, SkippedRay, SurfaceHit, Termination, TerminationSet,
+};
+pub use render::{
+    render, render_with_pixel_stats, trace_pixel_with, Image, NoObserver, PixelAccumulator,
+    RenderObserver, RenderOptions, RenderStats, TileResult, MAX_DEPTH_LIMIT, TILE_SIZE,
+};
+pub use scene::PreparedScene;
+
+/// Re-exported so that recorder users name the same vector type as the tracer.
+pub use glam::Vec3A;

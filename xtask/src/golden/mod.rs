@@ -385,8 +385,7 @@ fn bless(
 ) -> anyhow::Result<()> {
     for scene in scenes {
         let actual_path = out_dir.join(format!("{}.actual.png", scene.name));
-        let actual =
-            render(exe, root, scene, &actual_path).with_context(|| scene.name.clone())?;
+        let actual = render(exe, root, scene, &actual_path).with_context(|| scene.name.clone())?;
         let reference = refs_dir.join(format!("{}.png", scene.name));
         let verdict = match image::open(&reference) {
             Ok(old) => {

@@ -1,0 +1,466 @@
+//! The driver: loads the root file and its imports, then runs parse, resolve, evaluate and
+//! validate, stopping after the first phase that reports an error.
+//!
+//! Everything runs on a thread with a large stack, so that deep (but within-limit) nesting
+//! never meets the small stack of a test thread or a user's worker thread. The loader stays
+//! on the caller's thread: the compile thread asks for files over a channel.
+
+use std::collections::{HashMap, HashSet};
+use std::path::{Component, Path, PathBuf};
+use std::sync::mpsc;
+
+use whitted_ir::{Diagnostic, FileId, Severity, SourceFile, SourceMap, Span};
+
+use crate::ast::{FileAst, FileIndex, ItemKind, Program};
+use crate::intern::Interner;
+use crate::parser::{self, ParseContext};
+use crate::resolve::{Define, Resolver};
+use crate::{Compilation, CompileOptions, Limits, SourceLoader};
+
+/// Stack for the compile thread. Only the pages actually touched are committed; the deepest
+/// legal nesting uses a fraction of this.
+const COMPILE_STACK_BYTES: usize = 512 * 1024 * 1024;
+
+/// Expressions and blocks may nest this many times deeper than brackets (an operator adds a
+/// level without a bracket).
+const EXPRESSION_DEPTH_PER_NESTING: usize = 16;
+
+/// Compiles the file at `path` (read through `loader`, as are its imports).
+pub fn compile_file(
+    path: &Path,
+    loader: &mut dyn SourceLoader,
+    options: &CompileOptions,
+) -> Compilation {
+    let path = normalize(path);
+    on_big_stack(loader, move |loader| {
+        let display = path.to_string_lossy().into_owned();
+        match loader.load(&path) {
+            Ok(text) => compile_root(&path, display, text, loader, options),
+            Err(error) => Compilation {
+                sources: SourceMap::new(),
+                scene: None,
+                diagnostics: vec![Diagnostic::new(
+                    Severity::Error,
+                    format!("cannot read `{display}`: {error}"),
+                    None,
+                )],
+            },
+        }
+    })
+}
+
+/// For tests and the docs checker: compiles text named `name`; imports go to `loader`.
+pub fn compile_source(
+    name: &str,
+    text: &str,
+    loader: &mut dyn SourceLoader,
+    options: &CompileOptions,
+) -> Compilation {
+    let path = normalize(Path::new(name));
+    let text = text.to_string();
+    on_big_stack(loader, move |loader| {
+        compile_root(&path, name.to_string(), text, loader, options)
+    })
+}
+
+/// A loader that forwards requests to the caller's thread.
+struct ChannelLoader {
+    requests: mpsc::Sender<PathBuf>,
+    replies: mpsc::Receiver<std::io::Result<String>>,
+}
+
+impl SourceLoader for ChannelLoader {
+    fn load(&mut self, path: &Path) -> std::io::Result<String> {
+        let gone = || std::io::Error::other("the loader is no longer available");
+        self.requests.send(path.to_path_buf()).map_err(|_| gone())?;
+        self.replies.recv().map_err(|_| gone())?
+    }
+}
+
+fn on_big_stack<F>(loader: &mut dyn SourceLoader, work: F) -> Compilation
+where
+    F: FnOnce(&mut dyn SourceLoader) -> Compilation + Send,
+{
+    let (request_tx, request_rx) = mpsc::channel::<PathBuf>();
+    let (reply_tx, reply_rx) = mpsc::channel();
+    std::thread::scope(|scope| {
+        let spawned = std::thread::Builder::new()
+            .name("whitted-lang compile".into())
+            .stack_size(COMPILE_STACK_BYTES)
+            .spawn_scoped(scope, move || {
+                let mut channel = ChannelLoader {
+                    requests: request_tx,
+                    replies: reply_rx,
+                };
+                work(&mut channel)
+            });
+        let handle = match spawned {
+            Ok(handle) => handle,
+            Err(error) => {
+                // No thread (a resource limit): say so rather than risk the caller's stack.
+                return Compilation {
+                    sources: SourceMap::new(),
+                    scene: None,
+                    diagnostics: vec![Diagnostic::new(
+                        Severity::Error,
+                        format!("cannot start the compiler thread: {error}"),
+                        None,
+                    )],
+                };
+            }
+        };
+        // Serve file requests until the compile thread drops its sender.
+        for path in request_rx {
+            if reply_tx.send(loader.load(&path)).is_err() {
+                break;
+            }
+        }
+        match handle.join() {
+            Ok(compilation) => compilation,
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
+    })
+}
+
+/// `a/./b/../c` → `a/c`, without touching the disk (the loader decides what paths mean).
+fn normalize(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for component in path.components() {
+        match component {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                let last_is_normal =
+                    matches!(out.components().next_back(), Some(Component::Normal(_)));
+                if last_is_normal {
+                    out.pop();
+                } else {
+                    out.push("..");
+                }
+            }
+            other => out.push(other.as_os_str()),
+        }
+    }
+    out
+}
+
+/// Everything one compilation accumulates while loading files.
+struct Loading<'a> {
+    loader: &'a mut dyn SourceLoader,
+    limits: &'a Limits,
+    sources: SourceMap,
+    program: Program,
+    interner: Interner,
+    diagnostics: Vec<Diagnostic>,
+    /// Files by normalized path, so a file imported twice is loaded once.
+    loaded: HashMap<PathBuf, FileIndex>,
+    /// The chain of files being loaded, for cycle detection.
+    stack: Vec<PathBuf>,
+    total_bytes: usize,
+}
+
+impl Loading<'_> {
+    fn add_file(&mut self, path: PathBuf, display: String, text: String) -> FileIndex {
+        self.total_bytes += text.len();
+        let file = self.sources.add(SourceFile::new(display, text));
+        let index = file.0 as usize;
+        self.program.files.push(FileAst {
+            items: Vec::new(),
+            frame_size: 0,
+        });
+        self.loaded.insert(path.clone(), index);
+        let text = match self.sources.get(file) {
+            Some(source) => source.text.clone(),
+            None => return index,
+        };
+        let max_depth = self
+            .limits
+            .max_nesting
+            .saturating_mul(EXPRESSION_DEPTH_PER_NESTING);
+        let mut cx = ParseContext::new(
+            file,
+            &mut self.interner,
+            &mut self.program.functions,
+            max_depth,
+        );
+        let parsed = parser::parse_file(&text, &mut cx, self.limits.max_nesting);
+        let build_errors = std::mem::take(&mut cx.errors);
+        self.diagnostics.extend(build_errors);
+        let mut items = match parsed {
+            Ok(items) => items,
+            Err(diagnostic) => {
+                self.diagnostics.push(diagnostic);
+                return index;
+            }
+        };
+        self.stack.push(path.clone());
+        for item in &mut items {
+            if let ItemKind::Import { path: import, file } = &mut item.kind {
+                *file = self.import(&path, &import.value, import.span);
+            }
+        }
+        self.stack.pop();
+        self.program.files[index].items = items;
+        index
+    }
+
+    fn import(&mut self, importer: &Path, name: &str, span: Span) -> Option<FileIndex> {
+        let target = normalize(&importer.parent().unwrap_or(Path::new("")).join(name));
+        if let Some(position) = self.stack.iter().position(|p| *p == target) {
+            let chain: Vec<String> = self.stack[position..]
+                .iter()
+                .chain(std::iter::once(&target))
+                .map(|p| format!("`{}`", p.display()))
+                .collect();
+            self.diagnostics.push(
+                Diagnostic::error(
+                    format!("import cycle: `{name}` imports this file again"),
+                    span,
+                )
+                .with_label("closes the cycle")
+                .with_hint(format!("the chain is {}", chain.join(" → ")))
+                .with_hint("move what both files need into a third file that imports neither"),
+            );
+            return None;
+        }
+        if let Some(&index) = self.loaded.get(&target) {
+            return Some(index);
+        }
+        // The stack holds the importing chain; its length is this import's depth.
+        if self.stack.len() > self.limits.max_import_depth {
+            self.diagnostics.push(
+                Diagnostic::error(
+                    format!(
+                        "imports are nested too deeply: the import depth limit is {}",
+                        self.limits.max_import_depth
+                    ),
+                    span,
+                )
+                .with_label("one import too deep"),
+            );
+            return None;
+        }
+        let text = match self.loader.load(&target) {
+            Ok(text) => text,
+            Err(error) => {
+                self.diagnostics.push(
+                    Diagnostic::error(format!("cannot import `{name}`: {error}"), span)
+                        .with_label(format!("looked for `{}`", target.display()))
+                        .with_hint("import paths are relative to the importing file's folder"),
+                );
+                return None;
+            }
+        };
+        if self.total_bytes.saturating_add(text.len()) > self.limits.max_source_bytes {
+            self.diagnostics.push(
+                Diagnostic::error(
+                    format!(
+                        "the source size limit ({} bytes in total) was reached by this import",
+                        self.limits.max_source_bytes
+                    ),
+                    span,
+                )
+                .with_label(format!("`{name}` has {} bytes", text.len())),
+            );
+            return None;
+        }
+        let display = target.to_string_lossy().into_owned();
+        Some(self.add_file(target, display, text))
+    }
+}
+
+fn has_error(diagnostics: &[Diagnostic]) -> bool {
+    diagnostics.iter().any(Diagnostic::is_error)
+}
+
+fn compile_root(
+    path: &Path,
+    display: String,
+    text: String,
+    loader: &mut dyn SourceLoader,
+    options: &CompileOptions,
+) -> Compilation {
+    // Expected-token detail makes syntax errors name punctuation (`,`, `;`); it costs only
+    // on the failing path.
+    pest::set_error_detail(true);
+    let limits = &options.limits;
+    let mut loading = Loading {
+        loader,
+        limits,
+        sources: SourceMap::new(),
+        program: Program::default(),
+        interner: Interner::default(),
+        diagnostics: Vec::new(),
+        loaded: HashMap::new(),
+        stack: Vec::new(),
+        total_bytes: 0,
+    };
+    if text.len() > limits.max_source_bytes {
+        let size = text.len();
+        loading.sources.add(SourceFile::new(display.clone(), ""));
+        return finish(
+            loading.sources,
+            None,
+            vec![Diagnostic::new(
+                Severity::Error,
+                format!(
+                    "`{display}` has {size} bytes, more than the source size limit ({} bytes)",
+                    limits.max_source_bytes
+                ),
+                None,
+            )],
+        );
+    }
+    loading.add_file(path.to_path_buf(), display, text);
+    let defines = parse_defines(&mut loading, &options.defines);
+
+    let Loading {
+        sources,
+        mut program,
+        interner,
+        mut diagnostics,
+        ..
+    } = loading;
+    let Some(mut defines) = defines else {
+        return finish(sources, None, diagnostics);
+    };
+    if has_error(&diagnostics) {
+        return finish(sources, None, diagnostics);
+    }
+
+    let (resolution, resolve_diagnostics) = {
+        let mut values: Vec<_> = defines.iter_mut().map(|d| &mut d.value).collect();
+        let mut resolver = Resolver::new(&interner, program.files.len(), &[]);
+        for value in values.iter_mut() {
+            resolver.resolve_define_value(value, &mut program);
+        }
+        let define_errors = std::mem::take(&mut resolver.diagnostics);
+        diagnostics.extend(define_errors);
+        let resolver = Resolver::new(&interner, program.files.len(), &defines);
+        resolver.resolve_program(&mut program)
+    };
+    diagnostics.extend(resolve_diagnostics);
+    // Evaluation runs even after resolution errors (unresolved names evaluate quietly to
+    // nothing), so that one run reports every error it can find.
+
+    let evaluator = crate::eval::Evaluator::new(
+        &program,
+        &interner,
+        limits,
+        &resolution,
+        &defines,
+        sources.clone(),
+    );
+    let (scene, eval_diagnostics, failed) = evaluator.run();
+    diagnostics.extend(eval_diagnostics);
+    if failed || has_error(&diagnostics) {
+        return finish(sources, None, diagnostics);
+    }
+    match whitted_ir::validate(scene) {
+        Ok(valid) => finish(sources, Some(valid), diagnostics),
+        Err(invalid) => {
+            diagnostics.extend(invalid.diagnostics);
+            finish(sources, None, diagnostics)
+        }
+    }
+}
+
+/// Parses each `-D NAME=VALUE` in a pseudo-file of its own. `None` if any is malformed.
+fn parse_defines(loading: &mut Loading<'_>, defines: &[(String, String)]) -> Option<Vec<Define>> {
+    let mut parsed = Vec::new();
+    let mut ok = true;
+    for (name, value) in defines {
+        let text = format!("{name}={value}");
+        let file: FileId = loading
+            .sources
+            .add(SourceFile::new(format!("<-D {name}>"), text.clone()));
+        let name_span = Span::new(file, 0, name.len());
+        let valid_name = name
+            .chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+            && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !valid_name {
+            loading.diagnostics.push(
+                Diagnostic::error(
+                    format!("`-D {name}=...` needs a constant's name before `=`"),
+                    name_span,
+                )
+                .with_label("not a name")
+                .with_hint(
+                    "names are letters, digits and `_`, starting with a letter or `_`: `-D N=100`",
+                ),
+            );
+            ok = false;
+            continue;
+        }
+        let max_depth = loading
+            .limits
+            .max_nesting
+            .saturating_mul(EXPRESSION_DEPTH_PER_NESTING);
+        let mut cx = ParseContext::new(
+            file,
+            &mut loading.interner,
+            &mut loading.program.functions,
+            max_depth,
+        );
+        let result =
+            parser::parse_define_value(&text, name.len() + 1, &mut cx, loading.limits.max_nesting);
+        let build_errors = std::mem::take(&mut cx.errors);
+        let sym = loading.interner.intern(name);
+        loading.diagnostics.extend(build_errors);
+        match result {
+            Ok(value) => parsed.push(Define {
+                name: sym,
+                name_span,
+                value,
+            }),
+            Err(diagnostic) => {
+                loading.diagnostics.push(diagnostic);
+                ok = false;
+            }
+        }
+    }
+    ok.then_some(parsed)
+}
+
+/// Drops repeated diagnostics (a validation error on a million spheres from one line is one
+/// error) and packs the result.
+fn finish(
+    sources: SourceMap,
+    scene: Option<whitted_ir::ValidScene>,
+    diagnostics: Vec<Diagnostic>,
+) -> Compilation {
+    let mut seen = HashSet::new();
+    // With errors, warnings and notes are mostly their echoes (a material whose definition
+    // failed is "never used"); they come back once the errors are fixed.
+    let errors = has_error(&diagnostics);
+    let diagnostics: Vec<Diagnostic> = diagnostics
+        .into_iter()
+        .filter(|d| !errors || d.is_error())
+        .filter(|d| seen.insert((d.severity as u8, d.span, d.message.clone())))
+        .collect();
+    let scene = if errors { None } else { scene };
+    Compilation {
+        sources,
+        scene,
+        diagnostics,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paths_normalize_lexically() {
+        assert_eq!(
+            normalize(Path::new("a/./b/../c.scene")),
+            PathBuf::from("a/c.scene")
+        );
+        assert_eq!(
+            normalize(Path::new("../x.scene")),
+            PathBuf::from("../x.scene")
+        );
+        assert_eq!(normalize(Path::new("a/../../x")), PathBuf::from("../x"));
+    }
+}

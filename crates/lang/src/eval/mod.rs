@@ -1,0 +1,681 @@
+//! The evaluator: runs the resolved tree (`let`, `for`, `if`, calls, imports) and builds the
+//! IR as it goes.
+//!
+//! Objects are appended to the IR arena as soon as their body has run, children before their
+//! parents. A parent's transforms and material are only known once its own body has run, so
+//! on completion it walks its subtree once: it premultiplies its transform into each
+//! descendant's `world_from_object` and hands its material to descendants that have none.
+//!
+//! Errors: a failing statement is reported and skipped, and evaluation goes on so that one
+//! run reports every error it can. Limits (objects, loop iterations, call depth) stop the run.
+
+mod builders;
+mod expr;
+mod materials;
+mod objects;
+
+use std::collections::HashSet;
+
+use whitted_ir::{Diagnostic, Handle, Material, Object, Scene, Severity, Span};
+
+use crate::ast::*;
+use crate::intern::Interner;
+use crate::resolve::{Define, Resolution};
+use crate::value::Value;
+use crate::Limits;
+
+use builders::Target;
+use materials::{MaterialDef, PatternDef};
+
+/// Why evaluation of a statement stopped early.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Abort {
+    /// An error was reported; the enclosing statement is skipped and evaluation goes on.
+    Reported,
+    /// A limit was reached (or too many errors): evaluation stops.
+    Fatal,
+}
+
+pub(crate) type Eval<T> = Result<T, Abort>;
+
+/// What running a block ended with.
+enum Flow {
+    Normal,
+    Return(Value),
+}
+
+/// Where object statements put the objects they make.
+enum Sink {
+    Collect(Vec<Handle<Object>>),
+    /// Inside a function called for its value: objects cannot be made here.
+    Forbidden {
+        call: Span,
+    },
+}
+
+/// A marker material handle for "not set; take the parent's". Never left in the output:
+/// the last pass replaces it with the default material.
+const INHERIT: u32 = u32::MAX;
+
+fn inherit() -> Handle<Material> {
+    Handle::from_index(INHERIT as usize)
+}
+
+/// Unique errors beyond this many stop evaluation (the rest would be noise).
+const MAX_ERRORS: usize = 100;
+
+/// How deep blocks, expressions and calls may nest while running. Parsing bounds each file's
+/// tree; this bounds what recursion through calls adds on top, so the stack always suffices.
+pub(crate) const MAX_EVALUATION_DEPTH: usize = 20_000;
+
+pub(crate) struct Evaluator<'a> {
+    program: &'a Program,
+    interner: &'a Interner,
+    limits: &'a Limits,
+    resolution: &'a Resolution,
+    defines: &'a [Define],
+
+    globals: Vec<Value>,
+    /// Call frames, each `frame_size` values; `base` is where the current frame starts.
+    stack: Vec<Value>,
+    base: usize,
+
+    pub(crate) scene: Scene,
+    pub(crate) diagnostics: Vec<Diagnostic>,
+    /// Where errors were already reported, so that a loop repeats none of them (the values
+    /// in the message may differ from one iteration to the next; the place does not).
+    reported: HashSet<Span>,
+    unique_errors: usize,
+    /// Every error reported or repeated: an object whose body adds to this is not built.
+    error_events: usize,
+
+    materials: Vec<MaterialDef>,
+    patterns: Vec<PatternDef>,
+    default_material: Option<Handle<Material>>,
+
+    sinks: Vec<Sink>,
+    targets: Vec<Target>,
+    /// Spare vectors for container children, so nested objects do not allocate each time.
+    spare_children: Vec<Vec<Handle<Object>>>,
+    scratch: Vec<Handle<Object>>,
+
+    call_depth: usize,
+    depth: usize,
+    iterations: u64,
+    files_run: Vec<bool>,
+    camera_span: Option<Span>,
+    settings_set: Vec<(crate::schema::Prop, Span)>,
+}
+
+impl<'a> Evaluator<'a> {
+    pub(crate) fn new(
+        program: &'a Program,
+        interner: &'a Interner,
+        limits: &'a Limits,
+        resolution: &'a Resolution,
+        defines: &'a [Define],
+        sources: whitted_ir::SourceMap,
+    ) -> Self {
+        let scene = Scene {
+            sources,
+            ..Scene::default()
+        };
+        Evaluator {
+            program,
+            interner,
+            limits,
+            resolution,
+            defines,
+            globals: vec![Value::Poisoned; resolution.global_count as usize],
+            stack: Vec::with_capacity(256),
+            base: 0,
+            scene,
+            diagnostics: Vec::new(),
+            reported: HashSet::new(),
+            unique_errors: 0,
+            error_events: 0,
+            materials: Vec::new(),
+            patterns: Vec::new(),
+            default_material: None,
+            sinks: vec![Sink::Collect(Vec::new())],
+            targets: Vec::new(),
+            spare_children: Vec::new(),
+            scratch: Vec::new(),
+            call_depth: 0,
+            depth: 0,
+            iterations: 0,
+            files_run: vec![false; program.files.len()],
+            camera_span: None,
+            settings_set: Vec::new(),
+        }
+    }
+
+    /// Runs the root file (and its imports), then gives every object without a material the
+    /// default one. Returns the scene; errors are in `diagnostics`.
+    pub(crate) fn run(mut self) -> (Scene, Vec<Diagnostic>, bool) {
+        let outcome = self.run_file(0);
+        let failed = outcome.is_err() || self.unique_errors > 0;
+        if let Some(Sink::Collect(roots)) = self.sinks.pop() {
+            self.scene.roots = roots;
+        }
+        if !failed {
+            self.assign_default_materials();
+        }
+        if let Some(span) = self.camera_span {
+            self.scene.camera_span = span;
+        }
+        (self.scene, self.diagnostics, failed)
+    }
+
+    fn name(&self, sym: crate::intern::Sym) -> &'a str {
+        self.interner.name(sym)
+    }
+
+    /// Reports an error (once per span and message) and returns `Abort::Reported`.
+    fn fail<T>(&mut self, diagnostic: Diagnostic) -> Eval<T> {
+        self.error_events += 1;
+        let key = diagnostic.span.unwrap_or_else(Span::detached);
+        if !self.reported.insert(key) {
+            return Err(Abort::Reported);
+        }
+        self.unique_errors += 1;
+        self.diagnostics.push(diagnostic);
+        if self.unique_errors >= MAX_ERRORS {
+            self.diagnostics.push(Diagnostic::new(
+                Severity::Error,
+                format!("too many errors ({MAX_ERRORS}); stopping here"),
+                None,
+            ));
+            return Err(Abort::Fatal);
+        }
+        Err(Abort::Reported)
+    }
+
+    /// Reports an error that stops evaluation (a limit).
+    fn fatal<T>(&mut self, diagnostic: Diagnostic) -> Eval<T> {
+        self.unique_errors += 1;
+        self.error_events += 1;
+        self.diagnostics.push(diagnostic);
+        Err(Abort::Fatal)
+    }
+
+    fn enter(&mut self, span: Span) -> Eval<()> {
+        self.depth += 1;
+        if self.depth > MAX_EVALUATION_DEPTH {
+            self.depth -= 1;
+            return self.fatal(
+                Diagnostic::error(
+                    format!(
+                        "the scene nests too deeply while running: more than {MAX_EVALUATION_DEPTH} levels of calls, blocks and expressions"
+                    ),
+                    span,
+                )
+                .with_hint("a function that calls itself many times goes this deep; lower the recursion"),
+            );
+        }
+        Ok(())
+    }
+
+    fn leave(&mut self) {
+        self.depth -= 1;
+    }
+
+    // ---- files, blocks and statements ------------------------------------------------------
+
+    fn run_file(&mut self, index: FileIndex) -> Eval<()> {
+        let program = self.program;
+        let Some(file) = program.files.get(index) else {
+            return Ok(());
+        };
+        if self.files_run[index] {
+            return Ok(());
+        }
+        self.files_run[index] = true;
+        let saved_base = self.base;
+        self.base = self.stack.len();
+        self.stack
+            .resize(self.base + file.frame_size as usize, Value::Poisoned);
+        let result = self.items(&file.items);
+        self.stack.truncate(self.base);
+        self.base = saved_base;
+        result.map(|_| ())
+    }
+
+    fn items(&mut self, items: &'a [Item]) -> Eval<Flow> {
+        for item in items {
+            match self.item(item) {
+                Ok(Flow::Normal) | Err(Abort::Reported) => {}
+                Ok(flow @ Flow::Return(_)) => return Ok(flow),
+                Err(Abort::Fatal) => return Err(Abort::Fatal),
+            }
+        }
+        Ok(Flow::Normal)
+    }
+
+    fn set_slot(&mut self, slot: Slot, value: Value) {
+        match slot {
+            Slot::Local(i) => {
+                if let Some(cell) = self.stack.get_mut(self.base + i as usize) {
+                    *cell = value;
+                }
+            }
+            Slot::Global(g) => {
+                if let Some(cell) = self.globals.get_mut(g as usize) {
+                    *cell = value;
+                }
+            }
+            Slot::None => {}
+        }
+    }
+
+    fn item(&mut self, item: &'a Item) -> Eval<Flow> {
+        self.enter(item.span)?;
+        let result = self.item_inner(item);
+        self.leave();
+        result
+    }
+
+    fn item_inner(&mut self, item: &'a Item) -> Eval<Flow> {
+        match &item.kind {
+            ItemKind::Import { file, .. } => {
+                if let Some(index) = *file {
+                    self.run_file(index)?;
+                }
+            }
+            ItemKind::Const(binding) => {
+                let value = self.constant(binding);
+                self.set_slot(binding.slot, *value.as_ref().unwrap_or(&Value::Poisoned));
+                value?;
+            }
+            ItemKind::Let(binding) => {
+                let value = self.eval(&binding.value);
+                self.set_slot(binding.slot, *value.as_ref().unwrap_or(&Value::Poisoned));
+                value?;
+            }
+            ItemKind::Fn(_) => {}
+            ItemKind::For {
+                slot,
+                start,
+                end,
+                inclusive,
+                body,
+                ..
+            } => return self.for_loop(*slot, start, end, *inclusive, body),
+            ItemKind::If {
+                condition,
+                then,
+                otherwise,
+            } => {
+                let go = self.boolean(condition, "an `if` condition")?;
+                if go {
+                    return self.items(&then.items);
+                }
+                match otherwise {
+                    Some(Else::If(item)) => return self.item(item),
+                    Some(Else::Block(block)) => return self.items(&block.items),
+                    None => {}
+                }
+            }
+            ItemKind::Return(value) => {
+                let value = self.eval(value)?;
+                return Ok(Flow::Return(value));
+            }
+            ItemKind::Settings(body) => self.settings(body)?,
+            ItemKind::Camera { tag, body, kind } => {
+                if let Some(tag) = tag {
+                    let header = Span::new(
+                        kind.span.file,
+                        item.span.start as usize,
+                        kind.span.end as usize,
+                    );
+                    self.camera(*tag, header, body)?;
+                }
+            }
+            ItemKind::Light {
+                tag,
+                body,
+                name,
+                kind,
+            } => {
+                if let Some(tag) = tag {
+                    let end = name.as_ref().map_or(kind.span.end, |n| n.span.end);
+                    let header = Span::new(kind.span.file, item.span.start as usize, end as usize);
+                    self.light(*tag, header, name.as_ref(), body)?;
+                }
+            }
+            ItemKind::Material { name, slot, body } => {
+                let text = self.name(name.sym).to_string();
+                let value = self.material(body, Some(text)).map(Value::Material);
+                self.set_slot(*slot, *value.as_ref().unwrap_or(&Value::Poisoned));
+                value?;
+            }
+            ItemKind::Object {
+                kind,
+                tag,
+                name,
+                body,
+            } => {
+                if let Some(tag) = tag {
+                    self.object(*tag, *kind, name.as_ref(), body)?;
+                }
+            }
+            ItemKind::Call { call, modifiers } => self.call_statement(call, modifiers.as_ref())?,
+            ItemKind::Property(property) => self.property(property)?,
+        }
+        Ok(Flow::Normal)
+    }
+
+    /// A `const`, with its `-D` override if there is one.
+    fn constant(&mut self, binding: &'a Binding) -> Eval<Value> {
+        let value = self.eval(&binding.value)?;
+        let Slot::Global(slot) = binding.slot else {
+            return Ok(value);
+        };
+        let Some(&index) = self.resolution.overrides.get(&slot) else {
+            return Ok(value);
+        };
+        let defines = self.defines;
+        let Some(define) = defines.get(index) else {
+            return Ok(value);
+        };
+        if matches!(define.value.kind, ExprKind::Material(_)) {
+            // Refused by the resolver.
+            return Err(Abort::Reported);
+        }
+        let overridden = self.eval(&define.value)?;
+        if !overridden.same_type(&value) {
+            let name = self.name(binding.name.sym);
+            return self.fail(
+                Diagnostic::error(
+                    format!(
+                        "`-D {name}` gives {}, but `{name}` is {}",
+                        overridden.type_name(),
+                        value.type_name()
+                    ),
+                    define.value.span,
+                )
+                .with_label(format!("{} here", overridden.type_name()))
+                .with_secondary(binding.name.span, "the constant is defined here"),
+            );
+        }
+        Ok(overridden)
+    }
+
+    fn for_loop(
+        &mut self,
+        slot: Slot,
+        start: &'a Expr,
+        end: &'a Expr,
+        inclusive: bool,
+        body: &'a Block,
+    ) -> Eval<Flow> {
+        let first = self.whole_number(start, "a loop's start")?;
+        let last = self.whole_number(end, "a loop's end")?;
+        let stop = if inclusive { last + 1 } else { last };
+        let count = (stop - first).max(0) as u64;
+        let limit = self.limits.max_loop_iterations;
+        if self.iterations.saturating_add(count) > limit {
+            let range = start.span.to(end.span);
+            let mut diagnostic = Diagnostic::error(
+                format!(
+                    "this loop would run {count} times, past the limit of {limit} loop iterations in total"
+                ),
+                range,
+            )
+            .with_label(format!("{count} iterations"));
+            if self.iterations > 0 {
+                diagnostic = diagnostic.with_hint(format!(
+                    "{} iterations have already run in other loops",
+                    self.iterations
+                ));
+            }
+            return self.fatal(diagnostic.with_hint(
+                "the limit (`max_loop_iterations`) keeps a mistake from running forever",
+            ));
+        }
+        self.iterations += count;
+        for i in first..stop {
+            self.set_slot(slot, Value::Number(i as f64));
+            match self.items(&body.items)? {
+                Flow::Normal => {}
+                flow @ Flow::Return(_) => return Ok(flow),
+            }
+        }
+        Ok(Flow::Normal)
+    }
+
+    // ---- calls -----------------------------------------------------------------------------
+
+    /// A call used as a statement: its objects go where the statement is, after the
+    /// modifier block's transforms and material are applied to them.
+    fn call_statement(&mut self, call: &'a Call, modifiers: Option<&'a Block>) -> Eval<()> {
+        let CallTarget::User(id) = call.target else {
+            // A built-in as a statement has nothing to make; evaluate it for its errors.
+            self.call_value(call)?;
+            return Ok(());
+        };
+        let Some(modifiers) = modifiers else {
+            self.call_user(id, call)?;
+            return Ok(());
+        };
+        let children = self.spare_children.pop().unwrap_or_default();
+        self.sinks.push(Sink::Collect(children));
+        let result = self.call_user(id, call);
+        let made = match self.sinks.pop() {
+            Some(Sink::Collect(made)) => made,
+            _ => Vec::new(),
+        };
+        result?;
+        let placement = self.modifiers(modifiers)?;
+        let material = match placement.material {
+            Some(id) => Some(self.lower_material(id)?),
+            None => None,
+        };
+        self.place_subtree(&made, placement.transform, material);
+        for &handle in &made {
+            self.emit(handle);
+        }
+        let mut made = made;
+        made.clear();
+        self.spare_children.push(made);
+        Ok(())
+    }
+
+    /// A call in an expression: its value. Objects made inside are an error.
+    fn call_value(&mut self, call: &'a Call) -> Eval<Value> {
+        match call.target {
+            CallTarget::Builtin(function) => self.call_builtin(function, call),
+            CallTarget::User(id) => {
+                self.sinks.push(Sink::Forbidden { call: call.span });
+                let result = self.call_user(id, call);
+                self.sinks.pop();
+                match result? {
+                    Some(value) => Ok(value),
+                    None => {
+                        let name = self.name(call.callee.sym);
+                        self.fail(
+                            Diagnostic::error(
+                                format!("`{name}` returns no value"),
+                                call.span,
+                            )
+                            .with_label("used as a value here")
+                            .with_hint(format!(
+                                "end `{name}` with `return ...;`, or call it as a statement to make its objects"
+                            )),
+                        )
+                    }
+                }
+            }
+            CallTarget::Unresolved | CallTarget::Error => Err(Abort::Reported),
+        }
+    }
+
+    /// Runs a user function: arguments become the first slots of a fresh frame.
+    fn call_user(&mut self, id: FnId, call: &'a Call) -> Eval<Option<Value>> {
+        let program = self.program;
+        let Some(function) = program.functions.get(id) else {
+            return Err(Abort::Reported);
+        };
+        if self.call_depth >= self.limits.max_call_depth {
+            let name = self.name(call.callee.sym);
+            return self.fatal(
+                Diagnostic::error(
+                    format!(
+                        "the call depth limit ({}) was reached when calling `{name}`",
+                        self.limits.max_call_depth
+                    ),
+                    call.span,
+                )
+                .with_label("one call too many")
+                .with_secondary(function.name.span, "the function")
+                .with_hint(format!(
+                    "does `{name}` call itself without a condition that ends the recursion?"
+                )),
+            );
+        }
+        let base = self.stack.len();
+        for arg in &call.args {
+            match self.eval(arg) {
+                Ok(value) => self.stack.push(value),
+                Err(abort) => {
+                    self.stack.truncate(base);
+                    return Err(abort);
+                }
+            }
+        }
+        self.stack.resize(
+            base + (function.frame_size as usize).max(call.args.len()),
+            Value::Poisoned,
+        );
+        let saved_base = std::mem::replace(&mut self.base, base);
+        self.call_depth += 1;
+        let result = self.items(&function.body.items);
+        self.call_depth -= 1;
+        self.base = saved_base;
+        self.stack.truncate(base);
+        match result? {
+            Flow::Return(value) => Ok(Some(value)),
+            Flow::Normal => Ok(None),
+        }
+    }
+
+    // ---- objects into sinks ----------------------------------------------------------------
+
+    /// Checks that objects may be made here, before any work is done for one.
+    fn check_sink(&mut self, span: Span) -> Eval<()> {
+        if let Some(Sink::Forbidden { call }) = self.sinks.last() {
+            let call = *call;
+            return self.fail(
+                Diagnostic::error(
+                    "this object is made inside a function that was called for its value",
+                    span,
+                )
+                .with_label("an object")
+                .with_secondary(call, "called here, in an expression")
+                .with_hint("call the function as a statement (on its own line) to make objects"),
+            );
+        }
+        if self.scene.objects.len() >= self.limits.max_objects {
+            return self.fatal(
+                Diagnostic::error(
+                    format!("the object limit ({}) was reached", self.limits.max_objects),
+                    span,
+                )
+                .with_label("one object too many")
+                .with_hint(
+                    "the limit (`max_objects`) keeps a runaway loop from filling the memory",
+                ),
+            );
+        }
+        Ok(())
+    }
+
+    fn emit(&mut self, handle: Handle<Object>) {
+        if let Some(Sink::Collect(list)) = self.sinks.last_mut() {
+            list.push(handle);
+        }
+    }
+
+    /// Applies a parent's transform and material to a finished subtree: the transform is
+    /// premultiplied into every descendant, the material given to those without one.
+    fn place_subtree(
+        &mut self,
+        roots: &[Handle<Object>],
+        transform: whitted_ir::DMat4,
+        material: Option<Handle<Material>>,
+    ) {
+        let identity = transform == whitted_ir::DMat4::IDENTITY;
+        if identity && material.is_none() {
+            return;
+        }
+        let mut work = std::mem::take(&mut self.scratch);
+        work.clear();
+        work.extend_from_slice(roots);
+        while let Some(handle) = work.pop() {
+            let Some(object) = self.scene.objects.get_mut(handle) else {
+                continue;
+            };
+            if !identity {
+                object.world_from_object = transform * object.world_from_object;
+            }
+            if let Some(material) = material {
+                if object.material.index() == INHERIT as usize {
+                    object.material = material;
+                }
+            }
+            if let whitted_ir::ObjectKind::Csg { children, .. }
+            | whitted_ir::ObjectKind::Group { children } = &object.kind
+            {
+                work.extend_from_slice(children);
+            }
+        }
+        self.scratch = work;
+    }
+
+    /// The last pass: every object still without a material gets the default one, and each
+    /// source statement that made such a shape gets one note.
+    fn assign_default_materials(&mut self) {
+        let mut noted: HashSet<Span> = HashSet::new();
+        let mut notes = Vec::new();
+        let count = self.scene.objects.len();
+        for index in 0..count {
+            let handle = Handle::<Object>::from_index(index);
+            if self.scene.objects[handle].material.index() != INHERIT as usize {
+                continue;
+            }
+            let default = match self.default_material {
+                Some(h) => h,
+                None => {
+                    let material = Material {
+                        name: Some("default".to_string()),
+                        ..Material::default()
+                    };
+                    let h = self.scene.materials.append(material, Span::detached());
+                    self.default_material = Some(h);
+                    h
+                }
+            };
+            let span = self.scene.objects.span(handle);
+            let object = &mut self.scene.objects[handle];
+            object.material = default;
+            if let whitted_ir::ObjectKind::Shape { shape } = &object.kind {
+                if noted.insert(span) {
+                    notes.push(
+                        Diagnostic::note(
+                            format!(
+                                "this {} has no material, so it gets the default",
+                                shape.kind_name()
+                            ),
+                            span,
+                        )
+                        .with_label("no material here or on any enclosing object")
+                        .with_hint(
+                            "the default is a matte light grey; add `material ...` to choose",
+                        ),
+                    );
+                }
+            }
+        }
+        self.diagnostics.extend(notes);
+    }
+}

@@ -1,0 +1,11 @@
+//! The language's integration tests, in one binary: constructs compiled to IR, every class of
+//! error rendered, the examples in docs/language.md, the scenes in scenes/, limits, and a
+//! fuzz test that throws thousands of broken inputs at the compiler.
+
+mod constructs;
+mod docs;
+mod errors;
+mod fuzz;
+mod limits;
+mod scenes;
+mod support;

@@ -1,0 +1,403 @@
+//! CSG by interval lists along the ray (Roth, 1982).
+//!
+//! Every leaf solid reports the spans of the ray parameter where the ray is inside it; an
+//! operation combines its children's sorted span lists by a sweep over their boundaries;
+//! the first surviving boundary after `tmin` is the hit, and it remembers which leaf made
+//! it and whether that leaf's normal must be flipped (surfaces of subtracted solids are
+//! seen from outside the subtrahend, so their outward normal points the other way).
+//!
+//! Evaluation is iterative over an explicit stack and works in a per-thread [`CsgScratch`]
+//! whose buffers grow to the largest tree seen and are then reused: no allocation per ray,
+//! no recursion limit, and no fixed cap on the number of spans.
+
+use whitted_ir::CsgOp;
+
+use crate::bounds::{inverse_direction, Bound};
+use crate::ray::Ray;
+use crate::scene::Leaf;
+use crate::shapes::Part;
+
+/// A point where the ray crosses into or out of a solid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Boundary {
+    pub t: f32,
+    /// The index of the leaf in its tree whose surface this is.
+    pub leaf: u32,
+    pub part: Part,
+    /// Whether the leaf's outward normal must be reversed to point out of the result.
+    pub flip: bool,
+}
+
+/// An interval of the ray parameter inside a solid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Span {
+    pub enter: Boundary,
+    pub exit: Boundary,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum CsgNode {
+    Leaf {
+        leaf: u32,
+        bound: Bound,
+    },
+    Op {
+        op: CsgOp,
+        /// Range into [`CsgTree::children`].
+        first_child: u32,
+        child_count: u32,
+        bound: Bound,
+    },
+}
+
+/// One top-level CSG object: nodes in bottom-up order (the root is last) and its leaves.
+#[derive(Clone, Debug, Default)]
+pub struct CsgTree {
+    pub nodes: Vec<CsgNode>,
+    pub children: Vec<u32>,
+    pub leaves: Vec<Leaf>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Frame {
+    node: u32,
+    /// How many children have been started.
+    next: u32,
+    /// Where this node's accumulated spans begin in the scratch list.
+    start: u32,
+    /// Where the most recent child's spans begin.
+    middle: u32,
+}
+
+/// Reusable buffers for CSG evaluation; one per worker thread (or per tile).
+#[derive(Clone, Debug, Default)]
+pub struct CsgScratch {
+    spans: Vec<Span>,
+    merged: Vec<Span>,
+    stack: Vec<Frame>,
+}
+
+impl CsgTree {
+    fn root(&self) -> u32 {
+        self.nodes.len().saturating_sub(1) as u32
+    }
+
+    /// The nearest boundary of the whole solid strictly inside `(tmin, tmax)`.
+    pub fn first_hit(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut CsgScratch,
+    ) -> Option<Boundary> {
+        self.evaluate(ray, tmin, tmax, scratch);
+        first_boundary(&scratch.spans, tmin, tmax)
+    }
+
+    /// Leaves the solid's spans along the ray in `scratch.spans`. Spans are exact inside
+    /// the window `(tmin, tmax)`; children whose bound the window misses are skipped, so
+    /// outside the window the list may be incomplete (nothing looks there).
+    fn evaluate(&self, ray: &Ray, tmin: f32, tmax: f32, scratch: &mut CsgScratch) {
+        let inv_direction = inverse_direction(ray.direction);
+        scratch.spans.clear();
+        scratch.stack.clear();
+        if self.nodes.is_empty() {
+            return;
+        }
+        scratch.stack.push(Frame {
+            node: self.root(),
+            next: 0,
+            start: 0,
+            middle: 0,
+        });
+        while let Some(&frame) = scratch.stack.last() {
+            let top = scratch.stack.len() - 1;
+            match &self.nodes[frame.node as usize] {
+                CsgNode::Leaf { leaf, bound } => {
+                    if bound.admits(ray, inv_direction, tmin, tmax) {
+                        let shape_spans = self.leaves[*leaf as usize].geometry.spans(ray);
+                        for raw in shape_spans.as_slice() {
+                            let boundary = |t, part| Boundary {
+                                t,
+                                leaf: *leaf,
+                                part,
+                                flip: false,
+                            };
+                            scratch.spans.push(Span {
+                                enter: boundary(raw.t_in, raw.part_in),
+                                exit: boundary(raw.t_out, raw.part_out),
+                            });
+                        }
+                    }
+                    scratch.stack.pop();
+                }
+                CsgNode::Op {
+                    op,
+                    first_child,
+                    child_count,
+                    bound,
+                } => {
+                    let len = scratch.spans.len() as u32;
+                    if frame.next == 0 {
+                        if *child_count == 0 || !bound.admits(ray, inv_direction, tmin, tmax) {
+                            scratch.stack.pop();
+                            continue;
+                        }
+                        scratch.stack[top].start = len;
+                    } else if frame.next >= 2 {
+                        // The child started last has finished: fold it into the accumulator.
+                        combine_in_place(*op, frame.start as usize, frame.middle as usize, scratch);
+                    }
+                    let accumulated_empty = scratch.spans.len() as u32 == frame.start;
+                    let finished = frame.next == *child_count
+                        || (frame.next > 0 && accumulated_empty && *op != CsgOp::Union);
+                    if finished {
+                        scratch.stack.pop();
+                        continue;
+                    }
+                    let child = self.children[(*first_child + frame.next) as usize];
+                    scratch.stack[top].middle = scratch.spans.len() as u32;
+                    scratch.stack[top].next += 1;
+                    scratch.stack.push(Frame {
+                        node: child,
+                        next: 0,
+                        start: 0,
+                        middle: 0,
+                    });
+                }
+            }
+        }
+    }
+}
+
+/// Replaces `spans[start..]` (accumulator `[start, middle)` and child `[middle, ..)`) by
+/// their combination.
+fn combine_in_place(op: CsgOp, start: usize, middle: usize, scratch: &mut CsgScratch) {
+    if scratch.spans.len() == middle {
+        // The child is empty within the window.
+        if op == CsgOp::Intersection {
+            scratch.spans.truncate(start);
+        }
+        return;
+    }
+    let (accumulated, child) = scratch.spans.split_at(middle);
+    scratch.merged.clear();
+    combine(op, &accumulated[start..], child, &mut scratch.merged);
+    scratch.spans.truncate(start);
+    scratch.spans.extend_from_slice(&scratch.merged);
+}
+
+/// Combines two sorted, disjoint span lists by a sweep over their boundaries. At equal `t`
+/// entries are taken before exits (so solids that touch fuse without a seam) and `a`
+/// before `b`; empty results are dropped.
+pub fn combine(op: CsgOp, a: &[Span], b: &[Span], out: &mut Vec<Span>) {
+    let (mut i, mut j) = (0usize, 0usize);
+    let (mut in_a, mut in_b) = (false, false);
+    let mut inside = false;
+    let mut open: Option<Boundary> = None;
+    loop {
+        let next_a = a.get(i).map(|s| {
+            if in_a {
+                (s.exit, true)
+            } else {
+                (s.enter, false)
+            }
+        });
+        let next_b = b.get(j).map(|s| {
+            if in_b {
+                (s.exit, true)
+            } else {
+                (s.enter, false)
+            }
+        });
+        let boundary = match (next_a, next_b) {
+            (None, None) => break,
+            (Some((boundary_a, exit_a)), other) => {
+                let take_a = match other {
+                    None => true,
+                    Some((boundary_b, exit_b)) => {
+                        if boundary_a.t != boundary_b.t {
+                            boundary_a.t < boundary_b.t
+                        } else {
+                            !exit_a || exit_b
+                        }
+                    }
+                };
+                if take_a {
+                    in_a = !exit_a;
+                    i += usize::from(exit_a);
+                    boundary_a
+                } else {
+                    take_b(op, other, &mut in_b, &mut j)
+                }
+            }
+            (None, other) => take_b(op, other, &mut in_b, &mut j),
+        };
+        let now = match op {
+            CsgOp::Union => in_a || in_b,
+            CsgOp::Intersection => in_a && in_b,
+            CsgOp::Difference => in_a && !in_b,
+        };
+        if now != inside {
+            if now {
+                open = Some(boundary);
+            } else if let Some(enter) = open {
+                if boundary.t > enter.t {
+                    out.push(Span {
+                        enter,
+                        exit: boundary,
+                    });
+                }
+            }
+            inside = now;
+        }
+    }
+}
+
+/// Advances through list `b`; in a difference its surfaces bound the result from the
+/// other side, so their normals flip.
+fn take_b(op: CsgOp, next_b: Option<(Boundary, bool)>, in_b: &mut bool, j: &mut usize) -> Boundary {
+    let Some((mut boundary, exit)) = next_b else {
+        // Unreachable by construction (the caller has a boundary from `b`); an empty
+        // boundary at +∞ is harmless if it ever happened.
+        return Boundary {
+            t: f32::INFINITY,
+            leaf: u32::MAX,
+            part: 0,
+            flip: false,
+        };
+    };
+    *in_b = !exit;
+    *j += usize::from(exit);
+    if op == CsgOp::Difference {
+        boundary.flip = !boundary.flip;
+    }
+    boundary
+}
+
+fn first_boundary(spans: &[Span], tmin: f32, tmax: f32) -> Option<Boundary> {
+    for span in spans {
+        if span.enter.t > tmin {
+            return (span.enter.t < tmax).then_some(span.enter);
+        }
+        if span.exit.t > tmin {
+            return (span.exit.t < tmax).then_some(span.exit);
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn span(t0: f32, t1: f32, leaf: u32) -> Span {
+        let boundary = |t| Boundary {
+            t,
+            leaf,
+            part: 0,
+            flip: false,
+        };
+        Span {
+            enter: boundary(t0),
+            exit: boundary(t1),
+        }
+    }
+
+    fn run(op: CsgOp, a: &[Span], b: &[Span]) -> Vec<(f32, u32, bool, f32, u32, bool)> {
+        let mut out = Vec::new();
+        combine(op, a, b, &mut out);
+        out.iter()
+            .map(|s| {
+                (
+                    s.enter.t,
+                    s.enter.leaf,
+                    s.enter.flip,
+                    s.exit.t,
+                    s.exit.leaf,
+                    s.exit.flip,
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn union_merges_overlaps_and_keeps_gaps() {
+        let a = [span(1.0, 3.0, 0), span(6.0, 7.0, 0)];
+        let b = [span(2.0, 4.0, 1), span(8.0, 9.0, 1)];
+        assert_eq!(
+            run(CsgOp::Union, &a, &b),
+            vec![
+                (1.0, 0, false, 4.0, 1, false),
+                (6.0, 0, false, 7.0, 0, false),
+                (8.0, 1, false, 9.0, 1, false),
+            ]
+        );
+    }
+
+    #[test]
+    fn intersection_keeps_the_common_part() {
+        let a = [span(1.0, 3.0, 0), span(6.0, 9.0, 0)];
+        let b = [span(2.0, 7.0, 1)];
+        assert_eq!(
+            run(CsgOp::Intersection, &a, &b),
+            vec![
+                (2.0, 1, false, 3.0, 0, false),
+                (6.0, 0, false, 7.0, 1, false)
+            ]
+        );
+        assert!(run(CsgOp::Intersection, &a, &[]).is_empty());
+    }
+
+    #[test]
+    fn difference_flips_the_subtracted_surfaces() {
+        let a = [span(1.0, 5.0, 0)];
+        let b = [span(2.0, 3.0, 1)];
+        assert_eq!(
+            run(CsgOp::Difference, &a, &b),
+            vec![(1.0, 0, false, 2.0, 1, true), (3.0, 1, true, 5.0, 0, false)]
+        );
+        // Subtracting something that covers the start leaves the flipped exit of b.
+        let cover = [span(0.0, 2.0, 1)];
+        assert_eq!(
+            run(CsgOp::Difference, &a, &cover),
+            vec![(2.0, 1, true, 5.0, 0, false)]
+        );
+        // Subtracting everything leaves nothing.
+        assert!(run(CsgOp::Difference, &a, &[span(0.0, 6.0, 1)]).is_empty());
+    }
+
+    #[test]
+    fn touching_solids_fuse_without_a_seam() {
+        let a = [span(1.0, 2.0, 0)];
+        let b = [span(2.0, 3.0, 1)];
+        assert_eq!(
+            run(CsgOp::Union, &a, &b),
+            vec![(1.0, 0, false, 3.0, 1, false)]
+        );
+        // Their intersection is a single point: nothing.
+        assert!(run(CsgOp::Intersection, &a, &b).is_empty());
+    }
+
+    #[test]
+    fn infinite_spans_combine() {
+        let half_space = [span(f32::NEG_INFINITY, 4.0, 0)];
+        let ball = [span(2.0, 6.0, 1)];
+        assert_eq!(
+            run(CsgOp::Intersection, &half_space, &ball),
+            vec![(2.0, 1, false, 4.0, 0, false)]
+        );
+        assert_eq!(
+            run(CsgOp::Difference, &ball, &half_space),
+            vec![(4.0, 0, true, 6.0, 1, false)]
+        );
+    }
+
+    #[test]
+    fn first_boundary_respects_the_window() {
+        let spans = [span(-2.0, 1.0, 0), span(3.0, 4.0, 1)];
+        assert_eq!(first_boundary(&spans, 0.0, 10.0).map(|b| b.t), Some(1.0));
+        assert_eq!(first_boundary(&spans, 1.5, 10.0).map(|b| b.t), Some(3.0));
+        assert_eq!(first_boundary(&spans, 1.5, 2.5), None);
+    }
+}

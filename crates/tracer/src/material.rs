@@ -1,0 +1,225 @@
+//! Materials in the tracer's f32 form, and procedural patterns resolved at a hit point.
+
+use glam::{Affine3A, DAffine3, DVec3, Vec3A};
+use whitted_ir::{Color, Fresnel, Handle, Material, PatternKind};
+
+use crate::shapes::Part;
+
+/// An IR material with colours as `Vec3A`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PreparedMaterial {
+    pub ambient: Vec3A,
+    pub diffuse: Vec3A,
+    pub specular: Vec3A,
+    pub shininess: f32,
+    /// The same exponent when it is a small whole number, for the faster `powi`.
+    pub shininess_integer: Option<i32>,
+    pub reflective: Vec3A,
+    pub transmissive: Vec3A,
+    pub ior: f32,
+    pub schlick: bool,
+    pub absorption: Vec3A,
+    pub pattern: Option<PreparedPattern>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct PreparedPattern {
+    pub kind: PatternKind,
+    pub a: Handle<Material>,
+    pub b: Handle<Material>,
+    /// `pattern_from_object` followed by the division by `scale`.
+    pub cell_from_object: Affine3A,
+}
+
+pub fn color(c: &Color) -> Vec3A {
+    Vec3A::new(c.r as f32, c.g as f32, c.b as f32)
+}
+
+impl PreparedMaterial {
+    /// The Phong specular factor `max(R·V, 0)^n`.
+    #[inline]
+    pub fn phong(&self, r_dot_v: f32) -> f32 {
+        let x = r_dot_v.max(0.0);
+        match self.shininess_integer {
+            Some(n) => x.powi(n),
+            None => x.powf(self.shininess),
+        }
+    }
+
+    pub fn new(m: &Material) -> PreparedMaterial {
+        PreparedMaterial {
+            ambient: color(&m.ambient),
+            diffuse: color(&m.diffuse),
+            specular: color(&m.specular),
+            shininess: m.shininess as f32,
+            shininess_integer: (m.shininess.fract() == 0.0 && m.shininess <= 4096.0)
+                .then_some(m.shininess as i32),
+            reflective: color(&m.reflective),
+            transmissive: color(&m.transmissive),
+            ior: m.ior as f32,
+            schlick: m.fresnel == Fresnel::Schlick,
+            absorption: color(&m.absorption),
+            pattern: m.pattern.as_ref().map(|p| PreparedPattern {
+                kind: p.kind,
+                a: p.a,
+                b: p.b,
+                cell_from_object: (DAffine3::from_scale(DVec3::splat(1.0 / p.scale))
+                    * DAffine3::from_mat4(p.pattern_from_object))
+                .as_affine3a(),
+            }),
+        }
+    }
+}
+
+impl PreparedPattern {
+    /// Which of the two materials covers the object-space point.
+    #[inline]
+    pub fn choose(&self, object_point: Vec3A) -> Handle<Material> {
+        let p = self.cell_from_object.transform_point3a(object_point);
+        let cells = match self.kind {
+            PatternKind::Checker => cell(p.x).wrapping_add(cell(p.y)).wrapping_add(cell(p.z)),
+            PatternKind::Stripes => cell(p.x),
+        };
+        if cells & 1 == 0 {
+            self.a
+        } else {
+            self.b
+        }
+    }
+}
+
+/// `floor(x)` as an integer, without a libm call (x86-64's baseline SSE2 has no rounding
+/// instruction). Values beyond ±2⁶³ saturate, NaN gives 0: either way a valid cell.
+#[inline]
+fn cell(x: f32) -> i64 {
+    let truncated = x as i64;
+    if (truncated as f32) > x {
+        truncated.saturating_sub(1)
+    } else {
+        truncated
+    }
+}
+
+/// What a patterned leaf needs to find its object-space hit point: the inverse of its
+/// transform, and how to put the point exactly back onto flat faces. Without that last
+/// step a checker on the plane `y = 0` speckles, because the computed hit point lands a
+/// hair above or below 0 and `floor` flips between the two cells.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatternFrame {
+    pub object_from_world: Affine3A,
+    pub snap: Snap,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Snap {
+    None,
+    /// The object-space plane `normal·p = offset`; `step` is `normal / |normal|²`.
+    Plane {
+        normal: Vec3A,
+        offset: f32,
+        step: Vec3A,
+    },
+    /// The object-space box; the part names the face.
+    Box {
+        min: Vec3A,
+        max: Vec3A,
+    },
+}
+
+impl Snap {
+    pub fn plane(normal: DVec3, offset: f64) -> Snap {
+        Snap::Plane {
+            normal: normal.as_vec3a(),
+            offset: offset as f32,
+            step: (normal / normal.length_squared()).as_vec3a(),
+        }
+    }
+}
+
+impl PatternFrame {
+    #[inline]
+    pub fn object_point(&self, world_point: Vec3A, part: Part) -> Vec3A {
+        let mut p = self.object_from_world.transform_point3a(world_point);
+        match self.snap {
+            Snap::None => {}
+            Snap::Plane {
+                normal,
+                offset,
+                step,
+            } => {
+                p -= step * (normal.dot(p) - offset);
+            }
+            Snap::Box { min, max } => {
+                let axis = usize::from(part / 2).min(2);
+                p[axis] = if part % 2 == 1 { max[axis] } else { min[axis] };
+            }
+        }
+        p
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DMat4;
+
+    fn pattern(kind: PatternKind, scale: f64) -> PreparedPattern {
+        let material = whitted_ir::Material {
+            pattern: Some(whitted_ir::Pattern {
+                kind,
+                a: Handle::from_index(0),
+                b: Handle::from_index(1),
+                scale,
+                pattern_from_object: DMat4::IDENTITY,
+            }),
+            ..whitted_ir::Material::default()
+        };
+        PreparedMaterial::new(&material)
+            .pattern
+            .unwrap_or_else(|| unreachable!("the material has a pattern"))
+    }
+
+    #[test]
+    fn checker_alternates_in_every_direction() {
+        let p = pattern(PatternKind::Checker, 1.0);
+        let a = Handle::from_index(0);
+        let b = Handle::from_index(1);
+        assert_eq!(p.choose(Vec3A::new(0.5, 0.0, 0.5)), a);
+        assert_eq!(p.choose(Vec3A::new(1.5, 0.0, 0.5)), b);
+        assert_eq!(p.choose(Vec3A::new(1.5, 0.0, 1.5)), a);
+        assert_eq!(p.choose(Vec3A::new(-0.5, 0.0, 0.5)), b);
+        // The scale widens the cells.
+        let wide = pattern(PatternKind::Checker, 2.0);
+        assert_eq!(wide.choose(Vec3A::new(1.5, 0.0, 0.5)), a);
+    }
+
+    #[test]
+    fn cells_are_floors() {
+        for x in [
+            -2.5f32, -2.0, -1.0e-9, 0.0, 1.0e-9, 0.999, 1.0, 7.5, -1.0e30, 1.0e30,
+        ] {
+            let expected = f64::from(x).floor().clamp(i64::MIN as f64, i64::MAX as f64) as i64;
+            assert_eq!(cell(x), expected, "{x}");
+        }
+        assert_eq!(cell(f32::NAN), 0);
+    }
+
+    #[test]
+    fn stripes_depend_on_x_only() {
+        let p = pattern(PatternKind::Stripes, 0.5);
+        assert_eq!(p.choose(Vec3A::new(0.25, 9.0, -3.0)), Handle::from_index(0));
+        assert_eq!(p.choose(Vec3A::new(0.75, 9.0, -3.0)), Handle::from_index(1));
+    }
+
+    #[test]
+    fn plane_points_snap_onto_the_plane() {
+        let frame = PatternFrame {
+            object_from_world: Affine3A::IDENTITY,
+            snap: Snap::plane(DVec3::Y, 0.0),
+        };
+        let p = frame.object_point(Vec3A::new(0.3, -1e-7, 0.2), 0);
+        assert_eq!(p.y, 0.0);
+        let p = frame.object_point(Vec3A::new(0.3, 1e-7, 0.2), 0);
+        assert_eq!(p.y, 0.0);
+    }
+}

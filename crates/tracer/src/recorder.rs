@@ -1,0 +1,322 @@
+//! The recorder: hooks through which the one tracing code path reports every ray it traces.
+//!
+//! Rendering uses [`NoRecord`], whose empty methods inline away, so the renderer pays
+//! nothing. Ray trees (`whitted trace`, the debugger) and per-pixel statistics implement the
+//! same trait and see exactly the rays the renderer traced: there is no second tracer.
+//!
+//! # Order of calls for one ray
+//!
+//! ```text
+//! ray_started
+//! ├─ ray_missed                                  (then ray_finished with Miss)
+//! └─ surface_hit
+//!    ambient
+//!    light_sampled           × every light, in scene order (with its shadow ray, if any)
+//!    reflected ray:   ray_started … ray_finished (nested), or secondary_skipped
+//!    transmitted ray: ray_started … ray_finished (nested), or secondary_skipped
+//! ray_finished
+//! ```
+//!
+//! A secondary ray that the material does not ask for (a zero coefficient) is neither
+//! started nor skipped. Colours are linear RGB; "weight" is always the path weight: the
+//! product of every coefficient (and Beer-Lambert factor) from the eye up to and including
+//! this ray's own coefficient, i.e. how much this ray's returned colour counts in the pixel.
+
+use glam::Vec3A;
+use serde::Serialize;
+use whitted_ir::{Handle, Light, Material, Object};
+
+/// What a ray is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RayKind {
+    Camera,
+    Reflected,
+    Transmitted,
+    Shadow,
+}
+
+impl RayKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            RayKind::Camera => "camera",
+            RayKind::Reflected => "reflected",
+            RayKind::Transmitted => "transmitted",
+            RayKind::Shadow => "shadow",
+        }
+    }
+}
+
+/// Why recursion stopped at a ray (or why a secondary ray was not traced).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Termination {
+    /// The ray spawned at least one secondary ray.
+    NotEnded,
+    /// The ray left the scene: it returns the background colour.
+    Miss,
+    /// A secondary ray would have been deeper than the maximum depth.
+    MaxDepth,
+    /// A secondary ray's path weight was below the minimum on every channel.
+    WeightCutoff,
+    /// Refraction was impossible; the transmitted weight went to the reflected ray.
+    TotalInternalReflection,
+    /// The surface neither reflects nor transmits: only its local colour returns.
+    Absorbed,
+}
+
+impl Termination {
+    pub const ALL: [Termination; 6] = [
+        Termination::NotEnded,
+        Termination::Miss,
+        Termination::MaxDepth,
+        Termination::WeightCutoff,
+        Termination::TotalInternalReflection,
+        Termination::Absorbed,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Termination::NotEnded => "not_ended",
+            Termination::Miss => "miss",
+            Termination::MaxDepth => "max_depth",
+            Termination::WeightCutoff => "weight_cutoff",
+            Termination::TotalInternalReflection => "total_internal_reflection",
+            Termination::Absorbed => "absorbed",
+        }
+    }
+
+    fn bit(self) -> u8 {
+        1 << (self as u8)
+    }
+}
+
+/// A small set of terminations (a bit mask).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
+pub struct TerminationSet(u8);
+
+impl TerminationSet {
+    pub fn insert(&mut self, termination: Termination) {
+        self.0 |= termination.bit();
+    }
+
+    pub fn contains(self, termination: Termination) -> bool {
+        self.0 & termination.bit() != 0
+    }
+
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    pub fn iter(self) -> impl Iterator<Item = Termination> {
+        Termination::ALL
+            .into_iter()
+            .filter(move |t| self.contains(*t))
+    }
+
+    pub fn bits(self) -> u8 {
+        self.0
+    }
+}
+
+/// The optics at the surface a reflected or transmitted ray leaves from.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Interface {
+    /// Cosine of the angle between the incoming ray and the shading normal (1 = head on).
+    pub cos_incidence: f32,
+    /// The refractive indices (from, to) when the material transmits; the outside of every
+    /// solid is taken to be air (1.0), and thin surfaces (disks, triangles, open cylinders
+    /// and cones) have (1.0, 1.0) on both sides.
+    pub ior: Option<(f32, f32)>,
+    /// Whether the incoming ray was entering a solid (it hit the outside of the surface).
+    pub entering: bool,
+    /// Schlick's reflectance `R` when the material asks for Fresnel (transmission is `1 − R`).
+    pub fresnel_reflectance: Option<f32>,
+    pub total_internal_reflection: bool,
+}
+
+impl Interface {
+    pub fn incidence_degrees(&self) -> f32 {
+        self.cos_incidence.clamp(-1.0, 1.0).acos().to_degrees()
+    }
+}
+
+/// A camera, reflected or transmitted ray about to be traced.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayStart {
+    pub kind: RayKind,
+    /// 0 for camera rays; a secondary ray is one deeper than the ray that spawned it.
+    pub depth: u32,
+    pub origin: Vec3A,
+    pub direction: Vec3A,
+    /// The path weight, including this ray's own coefficient.
+    pub weight: Vec3A,
+    /// This ray's own coefficient: the reflective or transmissive colour, after Fresnel
+    /// and total internal reflection (1 for camera rays).
+    pub coefficient: Vec3A,
+    /// The surface this ray leaves from (`None` for camera rays).
+    pub interface: Option<Interface>,
+}
+
+/// Full data about the surface a ray hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceHit {
+    pub t: f32,
+    pub point: Vec3A,
+    /// The outward normal of the solid at the point (reversed on subtracted CSG surfaces).
+    pub geometric_normal: Vec3A,
+    /// The normal used for shading: the geometric normal turned to face the incoming ray.
+    pub shading_normal: Vec3A,
+    /// Whether the ray hit the outside of the surface.
+    pub front_face: bool,
+    /// The top-level object hit (a shape, or the root of a CSG solid; groups are flattened).
+    pub object: Handle<Object>,
+    /// The shape whose surface was hit (the CSG leaf; the object itself otherwise).
+    pub leaf: Handle<Object>,
+    /// The leaf's material, as the scene gives it.
+    pub material: Handle<Material>,
+    /// The material in effect at the point once patterns are resolved.
+    pub resolved_material: Handle<Material>,
+    /// Beer-Lambert transmittance over this ray's path when it travels inside an
+    /// absorbing solid (1 otherwise); the returned colour includes it.
+    pub absorption: Vec3A,
+}
+
+/// What a shadow ray found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShadowResult {
+    Unblocked,
+    /// Stopped at the first blocker found (not necessarily the nearest).
+    Blocked {
+        object: Handle<Object>,
+        leaf: Handle<Object>,
+        t: f32,
+    },
+    /// Filtered shadows: the light passed through transmissive objects only.
+    Filtered {
+        transmittance: Vec3A,
+        blockers: u32,
+    },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowRay {
+    pub origin: Vec3A,
+    pub direction: Vec3A,
+    /// The distance to the light (infinite for directional lights).
+    pub max_t: f32,
+    pub result: ShadowResult,
+}
+
+/// One light's share of the local illumination at a hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSample {
+    pub light: Handle<Light>,
+    pub to_light: Vec3A,
+    pub distance: f32,
+    /// `N·L` with the shading normal; the light counts only when it is positive.
+    pub n_dot_l: f32,
+    /// `fatt` (1 for directional lights).
+    pub attenuation: f32,
+    /// The spot cone factor (1 for other lights).
+    pub spot: f32,
+    /// `None` when no shadow ray was needed: the light is behind the surface, outside its
+    /// cone, or too far to count.
+    pub shadow_ray: Option<ShadowRay>,
+    /// `fatt·spot·Ii·shadow·kd·(N·L)`, as added to the colour.
+    pub diffuse: Vec3A,
+    /// `fatt·spot·Ii·shadow·ks·(R·V)^n`, as added to the colour.
+    pub specular: Vec3A,
+}
+
+/// A reflected or transmitted ray the material asked for but that was not traced.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SkippedRay {
+    pub kind: RayKind,
+    pub depth: u32,
+    pub weight: Vec3A,
+    pub coefficient: Vec3A,
+    pub reason: Termination,
+}
+
+/// Hooks called by the tracer; every method has an empty default. See the module
+/// documentation for the order of calls.
+pub trait Recorder {
+    #[inline(always)]
+    fn ray_started(&mut self, _ray: &RayStart) {}
+    #[inline(always)]
+    fn surface_hit(&mut self, _hit: &SurfaceHit) {}
+    #[inline(always)]
+    fn ray_missed(&mut self, _background: Vec3A) {}
+    /// The ambient term `ka·Ia·kd` at the hit.
+    #[inline(always)]
+    fn ambient(&mut self, _ambient: Vec3A) {}
+    #[inline(always)]
+    fn light_sampled(&mut self, _sample: &LightSample) {}
+    #[inline(always)]
+    fn secondary_skipped(&mut self, _skipped: &SkippedRay) {}
+    /// The colour this ray returns to its parent (or to the pixel), and why it ended.
+    #[inline(always)]
+    fn ray_finished(&mut self, _color: Vec3A, _termination: Termination) {}
+}
+
+/// The recorder of plain rendering: records nothing and costs nothing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NoRecord;
+
+impl Recorder for NoRecord {}
+
+/// Per-pixel statistics, cheap enough to gather on a whole render: rays traced (camera,
+/// secondary and shadow), the deepest level reached, and which terminations occurred
+/// (including secondary rays skipped for depth, weight or total internal reflection).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct PixelStats {
+    pub rays: u32,
+    pub deepest: u32,
+    pub terminations: TerminationSet,
+}
+
+impl Recorder for PixelStats {
+    #[inline]
+    fn ray_started(&mut self, ray: &RayStart) {
+        self.rays = self.rays.saturating_add(1);
+        self.deepest = self.deepest.max(ray.depth);
+    }
+
+    #[inline]
+    fn light_sampled(&mut self, sample: &LightSample) {
+        if sample.shadow_ray.is_some() {
+            self.rays = self.rays.saturating_add(1);
+        }
+    }
+
+    #[inline]
+    fn secondary_skipped(&mut self, skipped: &SkippedRay) {
+        self.terminations.insert(skipped.reason);
+    }
+
+    #[inline]
+    fn ray_finished(&mut self, _color: Vec3A, termination: Termination) {
+        self.terminations.insert(termination);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn termination_set_round_trips() {
+        let mut set = TerminationSet::default();
+        assert!(set.is_empty());
+        set.insert(Termination::Miss);
+        set.insert(Termination::MaxDepth);
+        set.insert(Termination::Miss);
+        assert!(set.contains(Termination::Miss));
+        assert!(!set.contains(Termination::Absorbed));
+        assert_eq!(
+            set.iter().collect::<Vec<_>>(),
+            vec![Termination::Miss, Termination::MaxDepth]
+        );
+    }
+}

@@ -1,0 +1,327 @@
+//! The prepared scene: everything a render needs that depends only on the scene, built once
+//! from a validated IR scene: f32 shapes with their transforms folded in, resolved materials
+//! and lights, the camera basis, CSG trees, and the BVH over bounded objects.
+
+use std::time::Instant;
+
+use glam::{DAffine3, Vec3A};
+use obvhs::aabb::Aabb;
+use rayon::prelude::*;
+use whitted_ir::{
+    CsgOp, Handle, Material, Object, ObjectKind, Scene, Settings, ShadowMode, Shape, ValidScene,
+};
+
+use crate::bounds::Bound;
+use crate::bvh::Bvh;
+use crate::camera::PreparedCamera;
+use crate::csg::{CsgNode, CsgTree};
+use crate::light::PreparedLight;
+use crate::material::{color, PatternFrame, PreparedMaterial, Snap};
+use crate::shapes::Geometry;
+
+/// A primitive shape ready to intersect, with what shading needs to know about it.
+#[derive(Clone, Debug)]
+pub struct Leaf {
+    pub geometry: Geometry,
+    /// The IR object of this shape (a CSG leaf reports itself, not the CSG root).
+    pub object: Handle<Object>,
+    pub material: Handle<Material>,
+    /// Only for leaves whose material has a pattern.
+    pub pattern_frame: Option<Box<PatternFrame>>,
+}
+
+/// One top-level thing to intersect: a shape or a whole CSG solid. Groups are flattened
+/// into their members, so they never appear here.
+#[derive(Clone, Debug)]
+pub struct Item {
+    /// The IR object this item stands for (the shape, or the CSG root).
+    pub object: Handle<Object>,
+    pub kind: ItemKind,
+}
+
+#[derive(Clone, Debug)]
+pub enum ItemKind {
+    Shape(Leaf),
+    Csg(Box<CsgTree>),
+}
+
+impl Item {
+    /// The leaf that made a hit: the shape itself, or leaf `index` of the CSG tree.
+    #[inline]
+    pub fn leaf(&self, index: u32) -> &Leaf {
+        match &self.kind {
+            ItemKind::Shape(leaf) => leaf,
+            ItemKind::Csg(tree) => &tree.leaves[index as usize],
+        }
+    }
+}
+
+/// Everything a render needs that depends only on the scene: f32 copies of shapes with
+/// inverse transforms, resolved materials, lights, the camera basis, and the obvhs BVH.
+#[derive(Clone, Debug)]
+pub struct PreparedScene {
+    pub(crate) settings: Settings,
+    pub(crate) camera: PreparedCamera,
+    pub(crate) lights: Vec<PreparedLight>,
+    pub(crate) materials: Vec<PreparedMaterial>,
+    /// Items with a finite bound, in BVH primitive order (so BVH ids index it directly).
+    pub(crate) bounded: Vec<Item>,
+    /// Planes, unbounded quadrics and CSG solids with an infinite bound: tested one by one.
+    pub(crate) unbounded: Vec<Item>,
+    pub(crate) bvh: Option<Bvh>,
+    pub(crate) background: Vec3A,
+    pub(crate) ambient: Vec3A,
+    pub(crate) epsilon: f32,
+    pub(crate) shadows: ShadowMode,
+    build_seconds: f64,
+}
+
+impl PreparedScene {
+    /// Prepares a validated scene: converts shapes (in parallel on the current rayon pool)
+    /// and builds the BVH.
+    pub fn new(valid: &ValidScene) -> PreparedScene {
+        let started = Instant::now();
+        let scene: &Scene = valid.scene();
+        let materials: Vec<PreparedMaterial> = scene
+            .materials
+            .iter()
+            .map(|(_, m)| PreparedMaterial::new(m))
+            .collect();
+        let lights = scene
+            .lights
+            .iter()
+            .map(|(handle, light)| PreparedLight::new(handle, light))
+            .collect();
+        let roots = flatten_groups(scene);
+        let prepared: Vec<(Item, Bound)> = roots
+            .par_iter()
+            .map(|&handle| prepare_item(scene, &materials, handle))
+            .collect();
+
+        let mut bounded = Vec::new();
+        let mut aabbs = Vec::new();
+        let mut unbounded = Vec::new();
+        for (item, bound) in prepared {
+            match bound {
+                Bound::Empty => {}
+                Bound::Infinite => unbounded.push(item),
+                Bound::Finite(aabb) => {
+                    bounded.push(item);
+                    aabbs.push(aabb);
+                }
+            }
+        }
+        let (bounded, bvh) = build_bvh(bounded, &aabbs);
+        let settings = scene.settings.clone();
+        PreparedScene {
+            camera: PreparedCamera::new(&scene.camera),
+            lights,
+            materials,
+            bounded,
+            unbounded,
+            bvh,
+            background: color(&settings.background),
+            ambient: color(&settings.ambient),
+            epsilon: settings.epsilon as f32,
+            shadows: settings.shadows,
+            settings,
+            build_seconds: started.elapsed().as_secs_f64(),
+        }
+    }
+
+    /// Seconds spent in [`PreparedScene::new`]: shape preparation and the BVH build.
+    pub fn build_seconds(&self) -> f64 {
+        self.build_seconds
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Top-level objects after flattening groups (a CSG solid counts once).
+    pub fn object_count(&self) -> usize {
+        self.bounded.len() + self.unbounded.len()
+    }
+
+    /// Nodes in the BVH (0 when there is none).
+    pub fn bvh_node_count(&self) -> usize {
+        self.bvh.as_ref().map_or(0, Bvh::node_count)
+    }
+
+    /// How many of those are unbounded (planes and the like) and kept out of the BVH.
+    pub fn unbounded_count(&self) -> usize {
+        self.unbounded.len()
+    }
+}
+
+/// The objects to render, with groups replaced by their members (depth first, in source
+/// order). An explicit stack, so deep nesting cannot overflow the call stack.
+fn flatten_groups(scene: &Scene) -> Vec<Handle<Object>> {
+    let mut out = Vec::with_capacity(scene.roots.len());
+    let mut stack: Vec<Handle<Object>> = scene.roots.iter().rev().copied().collect();
+    while let Some(handle) = stack.pop() {
+        match &scene.objects[handle].kind {
+            ObjectKind::Group { children } => stack.extend(children.iter().rev().copied()),
+            ObjectKind::Shape { .. } | ObjectKind::Csg { .. } => out.push(handle),
+        }
+    }
+    out
+}
+
+fn prepare_item(
+    scene: &Scene,
+    materials: &[PreparedMaterial],
+    handle: Handle<Object>,
+) -> (Item, Bound) {
+    match &scene.objects[handle].kind {
+        ObjectKind::Csg { .. } => {
+            let tree = build_csg(scene, materials, handle);
+            let bound = match tree.nodes.last() {
+                Some(CsgNode::Leaf { bound, .. } | CsgNode::Op { bound, .. }) => *bound,
+                None => Bound::Empty,
+            };
+            let item = Item {
+                object: handle,
+                kind: ItemKind::Csg(Box::new(tree)),
+            };
+            (item, bound)
+        }
+        ObjectKind::Shape { .. } | ObjectKind::Group { .. } => {
+            let (leaf, bound) = prepare_leaf(scene, materials, handle);
+            let item = Item {
+                object: handle,
+                kind: ItemKind::Shape(leaf),
+            };
+            (item, bound)
+        }
+    }
+}
+
+fn prepare_leaf(
+    scene: &Scene,
+    materials: &[PreparedMaterial],
+    handle: Handle<Object>,
+) -> (Leaf, Bound) {
+    let object = &scene.objects[handle];
+    // Projective rows are ignored: the language only makes affine transforms.
+    let world_from_object = DAffine3::from_mat4(object.world_from_object);
+    let (geometry, bound, snap) = match &object.kind {
+        ObjectKind::Shape { shape } => {
+            let (geometry, bound) = Geometry::new(shape, &world_from_object);
+            let snap = match shape {
+                Shape::Plane { normal, offset } => Snap::plane(*normal, *offset),
+                Shape::Box { min, max } => Snap::Box {
+                    min: min.as_vec3a(),
+                    max: max.as_vec3a(),
+                },
+                _ => Snap::None,
+            };
+            (geometry, bound, snap)
+        }
+        // Validation keeps groups out of CSG and flattening keeps them out of items; should
+        // one arrive anyway it is an empty solid.
+        ObjectKind::Group { .. } | ObjectKind::Csg { .. } => (
+            Geometry::Triangle {
+                a: Vec3A::ZERO,
+                edge1: Vec3A::ZERO,
+                edge2: Vec3A::ZERO,
+            },
+            Bound::Empty,
+            Snap::None,
+        ),
+    };
+    let patterned = materials
+        .get(object.material.index())
+        .is_some_and(|m| m.pattern.is_some());
+    let pattern_frame = patterned.then(|| {
+        Box::new(PatternFrame {
+            object_from_world: world_from_object.inverse().as_affine3a(),
+            snap,
+        })
+    });
+    let leaf = Leaf {
+        geometry,
+        object: handle,
+        material: object.material,
+        pattern_frame,
+    };
+    (leaf, bound)
+}
+
+/// Builds a CSG tree bottom-up (post-order over an explicit stack). Node bounds: a union
+/// is bounded by its children's union, an intersection by their intersection, a
+/// difference by its first child.
+fn build_csg(scene: &Scene, materials: &[PreparedMaterial], root: Handle<Object>) -> CsgTree {
+    let mut tree = CsgTree::default();
+    let mut work: Vec<(Handle<Object>, bool)> = vec![(root, false)];
+    let mut finished: Vec<u32> = Vec::new();
+    while let Some((handle, expanded)) = work.pop() {
+        match &scene.objects[handle].kind {
+            ObjectKind::Csg { children, .. } if !expanded => {
+                work.push((handle, true));
+                work.extend(children.iter().rev().map(|&child| (child, false)));
+            }
+            ObjectKind::Csg { op, children } => {
+                let child_nodes = finished.split_off(finished.len().saturating_sub(children.len()));
+                let bounds = child_nodes
+                    .iter()
+                    .map(|&n| node_bound(&tree.nodes[n as usize]));
+                let bound = match op {
+                    CsgOp::Union => bounds.fold(Bound::Empty, Bound::union),
+                    CsgOp::Intersection => {
+                        bounds.reduce(Bound::intersection).unwrap_or(Bound::Empty)
+                    }
+                    CsgOp::Difference => bounds.take(1).next().unwrap_or(Bound::Empty),
+                };
+                let first_child = tree.children.len() as u32;
+                tree.children.extend_from_slice(&child_nodes);
+                tree.nodes.push(CsgNode::Op {
+                    op: *op,
+                    first_child,
+                    child_count: child_nodes.len() as u32,
+                    bound,
+                });
+                finished.push(tree.nodes.len() as u32 - 1);
+            }
+            ObjectKind::Shape { .. } | ObjectKind::Group { .. } => {
+                let (leaf, bound) = prepare_leaf(scene, materials, handle);
+                tree.leaves.push(leaf);
+                tree.nodes.push(CsgNode::Leaf {
+                    leaf: tree.leaves.len() as u32 - 1,
+                    bound,
+                });
+                finished.push(tree.nodes.len() as u32 - 1);
+            }
+        }
+    }
+    tree
+}
+
+fn node_bound(node: &CsgNode) -> Bound {
+    match node {
+        CsgNode::Leaf { bound, .. } | CsgNode::Op { bound, .. } => *bound,
+    }
+}
+
+/// Builds the BVH over the items' boxes and reorders the items into BVH primitive order.
+fn build_bvh(items: Vec<Item>, aabbs: &[Aabb]) -> (Vec<Item>, Option<Bvh>) {
+    if items.is_empty() || items.len() > crate::bvh::MAX_PRIMITIVES {
+        return (items, None);
+    }
+    let (bvh, primitive_indices) = Bvh::build(aabbs);
+    let count = items.len();
+    let mut slots: Vec<Option<Item>> = items.into_iter().map(Some).collect();
+    let ordered: Vec<Item> = primitive_indices
+        .iter()
+        .filter_map(|&index| slots.get_mut(index as usize).and_then(Option::take))
+        .collect();
+    if ordered.len() == count && primitive_indices.len() == count {
+        (ordered, Some(bvh))
+    } else {
+        // Not a permutation (obvhs never does this without spatial splits): keep every item
+        // and test them all, which is slow but right.
+        let mut all = ordered;
+        all.extend(slots.into_iter().flatten());
+        (all, None)
+    }
+}

@@ -1,0 +1,170 @@
+//! Command-line syntax: every subcommand and flag, parsed by clap.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+#[derive(Parser)]
+#[command(
+    name = "whitted",
+    version,
+    about = "A Whitted ray tracer that can explain every pixel"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Render a scene to an image (.png, .exr, .hdr or .ppm).
+    Render(RenderArgs),
+    /// Compile and validate a scene; print its diagnostics.
+    Check(SceneArgs),
+    /// Print the compiled IR of a scene, as text or JSON.
+    Ir(IrArgs),
+}
+
+/// The scene file and the `-D` overrides every scene-reading command takes.
+#[derive(Args, Clone, Debug)]
+pub struct SceneArgs {
+    /// The .scene file.
+    pub scene: PathBuf,
+    /// Override a top-level `const`: -D N=316 (VALUE is an expression).
+    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+    pub define: Vec<(String, String)>,
+}
+
+#[derive(Args)]
+pub struct IrArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum StatsFormat {
+    Text,
+    Json,
+}
+
+#[derive(Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Output image; the extension picks the format: .png (8-bit sRGB), .exr and .hdr
+    /// (linear float), .ppm (8-bit sRGB). Default: the scene's name with .png, here.
+    #[arg(short = 'o', long = "output", value_name = "OUT", value_parser = parse_output)]
+    pub output: Option<PathBuf>,
+    /// Image width in pixels (overrides the scene's settings).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub width: Option<u32>,
+    /// Image height in pixels (overrides the scene's settings).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub height: Option<u32>,
+    /// Samples per pixel, on a stratified pattern (overrides the scene's settings).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub spp: Option<u32>,
+    /// Maximum recursion depth; the camera ray is depth 0 (overrides the scene's settings).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=64))]
+    pub max_depth: Option<u32>,
+    /// Worker threads (default: one per core). The image is identical for any count.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Print ray counts, timings and rays per second (text, or --stats=json).
+    #[arg(long, value_name = "FORMAT", num_args = 0..=1, default_missing_value = "text")]
+    pub stats: Option<StatsFormat>,
+    /// Print nothing but errors (no progress bar, no warnings).
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+}
+
+fn parse_define(text: &str) -> Result<(String, String), String> {
+    let Some((name, value)) = text.split_once('=') else {
+        return Err(format!("`{text}` is not NAME=VALUE (for example -D N=316)"));
+    };
+    let name = name.trim();
+    let valid_name = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if !valid_name {
+        return Err(format!("`{name}` is not a valid constant name"));
+    }
+    if value.trim().is_empty() {
+        return Err(format!("-D {name}= needs a value after `=`"));
+    }
+    Ok((name.to_string(), value.to_string()))
+}
+
+/// The image formats `render` can write, chosen by the output's extension.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    Png,
+    Exr,
+    Hdr,
+    Ppm,
+}
+
+impl ImageFormat {
+    pub fn from_path(path: &std::path::Path) -> Option<ImageFormat> {
+        let extension = path.extension()?.to_str()?.to_ascii_lowercase();
+        match extension.as_str() {
+            "png" => Some(ImageFormat::Png),
+            "exr" => Some(ImageFormat::Exr),
+            "hdr" => Some(ImageFormat::Hdr),
+            "ppm" => Some(ImageFormat::Ppm),
+            _ => None,
+        }
+    }
+}
+
+fn parse_output(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    match ImageFormat::from_path(&path) {
+        Some(_) => Ok(path),
+        None => Err(format!(
+            "cannot tell the image format of `{text}`: use a .png, .exr, .hdr or .ppm extension"
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defines_need_a_name_and_a_value() {
+        assert_eq!(parse_define("N=316"), Ok(("N".into(), "316".into())));
+        assert_eq!(
+            parse_define("color=<1, 0, 0>"),
+            Ok(("color".into(), "<1, 0, 0>".into()))
+        );
+        assert!(parse_define("N").is_err());
+        assert!(parse_define("1N=3").is_err());
+        assert!(parse_define("N=").is_err());
+    }
+
+    #[test]
+    fn output_format_follows_the_extension() {
+        assert_eq!(
+            ImageFormat::from_path("a/b.PNG".as_ref()),
+            Some(ImageFormat::Png)
+        );
+        assert_eq!(
+            ImageFormat::from_path("x.exr".as_ref()),
+            Some(ImageFormat::Exr)
+        );
+        assert!(parse_output("out.jpg").is_err());
+        assert!(parse_output("out").is_err());
+    }
+
+    #[test]
+    fn the_command_line_definition_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
+    }
+}

@@ -1,0 +1,148 @@
+//! Encoding a linear-light image to PNG, EXR, HDR or PPM, written atomically.
+
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use crate::cli::ImageFormat;
+
+/// The sRGB transfer function (IEC 61966-2-1) of a linear value, clamped to [0, 1].
+pub fn linear_to_srgb(linear: f32) -> f32 {
+    let v = if linear.is_nan() {
+        0.0
+    } else {
+        linear.clamp(0.0, 1.0)
+    };
+    if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// 8-bit sRGB bytes, three per pixel, rounded to nearest.
+pub fn to_srgb8(pixels: &[[f32; 3]]) -> Vec<u8> {
+    pixels
+        .iter()
+        .flat_map(|p| p.map(|c| (linear_to_srgb(c) * 255.0 + 0.5) as u8))
+        .collect()
+}
+
+/// Writes `pixels` (linear RGB, row-major, top first) to `path` in `format`.
+///
+/// The bytes go to a temporary file beside the target, which is renamed over it only when
+/// complete: a failed write never leaves half an image or clobbers the old one.
+pub fn write_image(
+    path: &Path,
+    format: ImageFormat,
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 3]],
+) -> Result<(), String> {
+    let dir = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let describe = |e: &dyn std::fmt::Display| format!("cannot write {}: {e}", path.display());
+    let mut temp = tempfile::Builder::new()
+        .prefix(".whitted-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| describe(&e))?;
+    encode(temp.as_file_mut(), format, width, height, pixels).map_err(|e| describe(&e))?;
+    temp.as_file().sync_all().map_err(|e| describe(&e))?;
+    temp.persist(path).map_err(|e| describe(&e.error))?;
+    Ok(())
+}
+
+fn encode(
+    file: &mut std::fs::File,
+    format: ImageFormat,
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 3]],
+) -> Result<(), String> {
+    let mut writer = BufWriter::new(file);
+    match format {
+        ImageFormat::Png => {
+            let image = image::RgbImage::from_raw(width, height, to_srgb8(pixels))
+                .ok_or("the image has the wrong number of pixels")?;
+            image
+                .write_to(&mut writer, image::ImageFormat::Png)
+                .map_err(|e| e.to_string())?;
+        }
+        ImageFormat::Exr | ImageFormat::Hdr => {
+            let floats: Vec<f32> = pixels.iter().flatten().copied().collect();
+            let image = image::Rgb32FImage::from_raw(width, height, floats)
+                .ok_or("the image has the wrong number of pixels")?;
+            let kind = if format == ImageFormat::Exr {
+                image::ImageFormat::OpenExr
+            } else {
+                image::ImageFormat::Hdr
+            };
+            image::DynamicImage::ImageRgb32F(image)
+                .write_to(&mut writer, kind)
+                .map_err(|e| e.to_string())?;
+        }
+        ImageFormat::Ppm => {
+            write!(writer, "P6\n{width} {height}\n255\n").map_err(|e| e.to_string())?;
+            writer
+                .write_all(&to_srgb8(pixels))
+                .map_err(|e| e.to_string())?;
+        }
+    }
+    writer.flush().map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_encoding_matches_the_standard_at_known_points() {
+        assert_eq!(linear_to_srgb(0.0), 0.0);
+        assert!((linear_to_srgb(1.0) - 1.0).abs() < 1e-6);
+        // Mid grey: linear 0.2140 is sRGB 0.5 (127.5 / 255).
+        assert!((linear_to_srgb(0.214_041) - 0.5).abs() < 1e-4);
+        assert_eq!(linear_to_srgb(-3.0), 0.0);
+        assert_eq!(linear_to_srgb(f32::NAN), 0.0);
+        assert_eq!(to_srgb8(&[[0.0, 1.0, 7.0]]), vec![0, 255, 255]);
+    }
+
+    #[test]
+    fn every_format_round_trips_its_size_and_a_failed_write_keeps_the_old_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let pixels = vec![[0.25f32, 0.5, 1.0]; 6];
+        for (name, format) in [
+            ("a.png", ImageFormat::Png),
+            ("a.exr", ImageFormat::Exr),
+            ("a.hdr", ImageFormat::Hdr),
+        ] {
+            let path = dir.path().join(name);
+            write_image(&path, format, 3, 2, &pixels).unwrap();
+            let decoded = image::open(&path).unwrap();
+            assert_eq!((decoded.width(), decoded.height()), (3, 2), "{name}");
+        }
+        let ppm = dir.path().join("a.ppm");
+        write_image(&ppm, ImageFormat::Ppm, 3, 2, &pixels).unwrap();
+        let bytes = std::fs::read(&ppm).unwrap();
+        assert!(bytes.starts_with(b"P6\n3 2\n255\n"));
+        assert_eq!(bytes.len(), 11 + 18);
+
+        // A wrong pixel count fails before the rename: the old image stays intact.
+        let png = dir.path().join("a.png");
+        let before = std::fs::read(&png).unwrap();
+        assert!(write_image(&png, ImageFormat::Png, 4, 4, &pixels).is_err());
+        assert_eq!(std::fs::read(&png).unwrap(), before);
+        let leftovers = std::fs::read_dir(dir.path())
+            .unwrap()
+            .filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .file_name()
+                    .to_string_lossy()
+                    .ends_with(".tmp")
+            })
+            .count();
+        assert_eq!(leftovers, 0, "the temporary file must be removed");
+    }
+}

@@ -1,0 +1,125 @@
+//! Reading and compiling scenes from disk, printing their diagnostics, and the two commands
+//! that do nothing else: `check` and `ir`.
+
+use std::io::{IsTerminal, Write};
+use std::path::Path;
+
+use whitted_ir::{Severity, ValidScene};
+use whitted_lang::{compile_file, render_diagnostics, CompileOptions, SourceLoader};
+
+use crate::cli::{IrArgs, SceneArgs};
+use crate::Failure;
+
+/// Reads scene files from the file system for the compiler.
+struct FileLoader;
+
+impl SourceLoader for FileLoader {
+    fn load(&mut self, path: &Path) -> std::io::Result<String> {
+        std::fs::read_to_string(path)
+    }
+}
+
+/// Whether to colour what goes to stderr: only on a terminal, and never under NO_COLOR.
+pub fn stderr_wants_color() -> bool {
+    std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none()
+}
+
+/// A compiled scene plus what the user should hear about it.
+pub struct Loaded {
+    pub scene: ValidScene,
+    pub warnings: usize,
+}
+
+/// Compiles `args.scene`, prints diagnostics (all of them, or only errors when `quiet`),
+/// and returns the scene or `Failure::SceneErrors`.
+pub fn load_scene(args: &SceneArgs, quiet: bool) -> Result<Loaded, Failure> {
+    // Report a missing or unreadable root file as one line, before the compiler sees it.
+    if let Err(error) = std::fs::metadata(&args.scene) {
+        return Err(Failure::Message(format!(
+            "cannot read {}: {error}",
+            args.scene.display()
+        )));
+    }
+    let options = CompileOptions {
+        defines: args.define.clone(),
+        ..CompileOptions::default()
+    };
+    let compilation = compile_file(&args.scene, &mut FileLoader, &options);
+    let shown: Vec<_> = compilation
+        .diagnostics
+        .iter()
+        .filter(|d| !quiet || d.severity == Severity::Error)
+        .cloned()
+        .collect();
+    if !shown.is_empty() {
+        let text = render_diagnostics(&compilation.sources, &shown, stderr_wants_color());
+        let _ = std::io::stderr().write_all(text.as_bytes());
+    }
+    let warnings = compilation
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity == Severity::Warning)
+        .count();
+    match compilation.scene {
+        Some(scene) => Ok(Loaded { scene, warnings }),
+        None => {
+            let errors = compilation
+                .diagnostics
+                .iter()
+                .filter(|d| d.is_error())
+                .count();
+            let _ = writeln!(
+                std::io::stderr(),
+                "error: {} has {errors} error{}",
+                args.scene.display(),
+                if errors == 1 { "" } else { "s" }
+            );
+            Err(Failure::SceneErrors)
+        }
+    }
+}
+
+/// `whitted check`: compile, validate, summarise.
+pub fn check(args: &SceneArgs) -> Result<(), Failure> {
+    let loaded = load_scene(args, false)?;
+    let scene = &loaded.scene;
+    let summary = format!(
+        "{}: ok ({} objects, {} light{}, {} materials{})\n",
+        args.scene.display(),
+        scene.objects.len(),
+        scene.lights.len(),
+        if scene.lights.len() == 1 { "" } else { "s" },
+        scene.materials.len(),
+        match loaded.warnings {
+            0 => String::new(),
+            1 => ", 1 warning".to_string(),
+            n => format!(", {n} warnings"),
+        }
+    );
+    write_stdout(&summary)
+}
+
+/// `whitted ir`: the compiled IR as text or JSON on stdout.
+pub fn ir(args: &IrArgs) -> Result<(), Failure> {
+    let loaded = load_scene(&args.scene, false)?;
+    let text = if args.json {
+        let value = whitted_ir::to_json(&loaded.scene);
+        serde_json::to_string_pretty(&value).map_err(|e| Failure::Message(e.to_string()))? + "\n"
+    } else {
+        whitted_ir::print(&loaded.scene)
+    };
+    write_stdout(&text)
+}
+
+/// Writes to stdout, treating a closed pipe (`| head`) as success rather than a crash.
+pub fn write_stdout(text: &str) -> Result<(), Failure> {
+    let mut stdout = std::io::stdout().lock();
+    match stdout
+        .write_all(text.as_bytes())
+        .and_then(|_| stdout.flush())
+    {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(Failure::Message(format!("cannot write to stdout: {e}"))),
+    }
+}
