@@ -1,1 +1,4 @@
+//! The one integration-test binary: runs the real `whitted` executable and the libraries
+//! together, the way a user does.
 
+mod cli;

@@ -35,11 +35,11 @@ fn main() -> std::process::ExitCode {
     let start = Instant::now();
     let compilation = compile_file(Path::new(&path), &mut DiskLoader, &options);
     let seconds = start.elapsed().as_secs_f64();
+    eprint!(
+        "{}",
+        render_diagnostics(&compilation.sources, &compilation.diagnostics, false)
+    );
     let Some(scene) = &compilation.scene else {
-        eprint!(
-            "{}",
-            render_diagnostics(&compilation.sources, &compilation.diagnostics, false)
-        );
         return std::process::ExitCode::FAILURE;
     };
     println!(

@@ -17,9 +17,10 @@ use crate::parser::{self, ParseContext};
 use crate::resolve::{Define, Resolver};
 use crate::{Compilation, CompileOptions, Limits, SourceLoader};
 
-/// Stack for the compile thread. Only the pages actually touched are committed; the deepest
-/// legal nesting uses a fraction of this.
-const COMPILE_STACK_BYTES: usize = 512 * 1024 * 1024;
+/// Stacks to try for the compile thread, largest first. Only the pages actually touched are
+/// committed; the deepest legal nesting uses a fraction of the first. The smaller one is for
+/// systems that refuse to reserve that much address space (strict overcommit).
+const COMPILE_STACK_BYTES: [usize; 2] = [512 * 1024 * 1024, 64 * 1024 * 1024];
 
 /// Expressions and blocks may nest this many times deeper than brackets (an operator adds a
 /// level without a bracket).
@@ -83,17 +84,26 @@ where
 {
     let (request_tx, request_rx) = mpsc::channel::<PathBuf>();
     let (reply_tx, reply_rx) = mpsc::channel();
+    // The closure moves into whichever spawn succeeds; a failed spawn hands nothing back,
+    // so the work is parked in an Option that the successful thread takes.
+    let parcel = std::sync::Mutex::new(Some((work, request_tx, reply_rx)));
     std::thread::scope(|scope| {
-        let spawned = std::thread::Builder::new()
-            .name("whitted-lang compile".into())
-            .stack_size(COMPILE_STACK_BYTES)
-            .spawn_scoped(scope, move || {
-                let mut channel = ChannelLoader {
-                    requests: request_tx,
-                    replies: reply_rx,
-                };
-                work(&mut channel)
-            });
+        let mut spawned = Err(std::io::Error::other("no stack size to try"));
+        for stack in COMPILE_STACK_BYTES {
+            let parcel = &parcel;
+            spawned = std::thread::Builder::new()
+                .name("whitted-lang compile".into())
+                .stack_size(stack)
+                .spawn_scoped(scope, move || {
+                    let taken = parcel.lock().ok().and_then(|mut p| p.take());
+                    let (work, requests, replies) = taken?;
+                    let mut channel = ChannelLoader { requests, replies };
+                    Some(work(&mut channel))
+                });
+            if spawned.is_ok() {
+                break;
+            }
+        }
         let handle = match spawned {
             Ok(handle) => handle,
             Err(error) => {
@@ -116,7 +126,16 @@ where
             }
         }
         match handle.join() {
-            Ok(compilation) => compilation,
+            Ok(Some(compilation)) => compilation,
+            Ok(None) => Compilation {
+                sources: SourceMap::new(),
+                scene: None,
+                diagnostics: vec![Diagnostic::new(
+                    Severity::Error,
+                    "the compiler thread started without its work",
+                    None,
+                )],
+            },
             Err(panic) => std::panic::resume_unwind(panic),
         }
     })

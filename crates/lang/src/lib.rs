@@ -2,9 +2,9 @@
 //! user can act on.
 //!
 //! The phases, each in its own module: a lexical pass over brackets, strings and comments
-//! ([`lexical`]); the pest grammar (`grammar/scene.pest`) and the tree it builds ([`parser`],
-//! [`ast`]); name resolution and static checks ([`resolve`]); evaluation straight into the IR
-//! ([`eval`]); and the IR validator. [`compile_file`] runs them all; [`render_diagnostics`]
+//! (`lexical`); the pest grammar (`grammar/scene.pest`) and the tree it builds (`parser`,
+//! `ast`); name resolution and static checks (`resolve`); evaluation straight into the IR
+//! (`eval`); and the IR validator. [`compile_file`] runs them all; [`render_diagnostics`]
 //! turns the result into rustc-style text. The library never touches the disk (imports go
 //! through a [`SourceLoader`]) and never prints.
 

@@ -192,8 +192,10 @@ fn found_token(text: &str, pos: usize) -> (String, usize) {
 fn previous_word(text: &str, pos: usize) -> &str {
     let before = text.get(..pos).unwrap_or("").trim_end();
     let start = before
-        .rfind(|c: char| !(c.is_alphanumeric() || c == '_'))
-        .map_or(0, |i| i + 1);
+        .char_indices()
+        .rev()
+        .find(|(_, c)| !(c.is_alphanumeric() || *c == '_'))
+        .map_or(0, |(i, c)| i + c.len_utf8());
     &before[start..]
 }
 
@@ -339,4 +341,26 @@ fn hints(expected: &Expected, text: &str, pos: usize, found: &str) -> Vec<String
         );
     }
     hints
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn previous_word_copes_with_wide_characters() {
+        assert_eq!(previous_word("sphere →radius ", 17), "radius");
+        assert_eq!(previous_word("é", 2), "é");
+        assert_eq!(previous_word("→", 3), "");
+    }
+
+    #[test]
+    fn found_tokens_are_whole_words_numbers_or_operators() {
+        assert_eq!(found_token("radius 1", 0), ("`radius`".to_string(), 6));
+        assert_eq!(found_token("0..10", 0), ("the number `0`".to_string(), 1));
+        assert_eq!(found_token("2.5e3", 0).1, 3);
+        assert_eq!(found_token("== 1", 0), ("`==`".to_string(), 2));
+        assert_eq!(found_token("", 0), ("the end of the file".to_string(), 0));
+        assert_eq!(found_token("日本", 0).1, "日本".len());
+    }
 }

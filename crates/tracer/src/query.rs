@@ -13,7 +13,7 @@ use whitted_ir::{Handle, Material};
 use crate::bvh::Step;
 use crate::csg::CsgScratch;
 use crate::ray::Ray;
-use crate::scene::{Item, ItemKind, Leaf, PreparedScene};
+use crate::scene::{Item, Leaf, PreparedScene};
 use crate::shapes::{sphere_first_hit, Geometry, Part};
 
 /// Below this many bounded items a plain loop beats walking the BVH.
@@ -75,17 +75,17 @@ fn item_hit(
     tmax: f32,
     scratch: &mut CsgScratch,
 ) -> Option<(f32, u32, Part, bool)> {
-    match &item.kind {
+    match item {
         // Spheres first and inline: they are most of the objects in big scenes.
-        ItemKind::Shape(Leaf {
+        Item::Shape(Leaf {
             geometry: Geometry::Sphere { center, radius },
             ..
         }) => sphere_first_hit(ray, *center, *radius, tmin, tmax).map(|t| (t, 0, 0, false)),
-        ItemKind::Shape(leaf) => leaf
+        Item::Shape(leaf) => leaf
             .geometry
             .first_hit(ray, tmin, tmax)
             .map(|(t, part)| (t, 0, part, false)),
-        ItemKind::Csg(tree) => tree
+        Item::Csg { tree, .. } => tree
             .first_hit(ray, tmin, tmax, scratch)
             .map(|b| (b.t, b.leaf, b.part, b.flip)),
     }

@@ -122,6 +122,20 @@ pub struct WorldQuadric {
 }
 
 #[derive(Clone, Debug, PartialEq)]
+pub struct WorldDisk {
+    pub center: Vec3A,
+    pub normal: Vec3A,
+    pub radius: f32,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldTriangle {
+    pub a: Vec3A,
+    pub edge1: Vec3A,
+    pub edge2: Vec3A,
+}
+
+#[derive(Clone, Debug, PartialEq)]
 pub enum Geometry {
     Sphere {
         center: Vec3A,
@@ -132,16 +146,9 @@ pub enum Geometry {
         normal: Vec3A,
         offset: f32,
     },
-    Disk {
-        center: Vec3A,
-        normal: Vec3A,
-        radius: f32,
-    },
-    Triangle {
-        a: Vec3A,
-        edge1: Vec3A,
-        edge2: Vec3A,
-    },
+    /// Boxed, like the rarer shapes, so that the common ones keep leaves small.
+    Disk(Box<WorldDisk>),
+    Triangle(Box<WorldTriangle>),
     Quadric(Box<WorldQuadric>),
     Local(Box<LocalGeometry>),
 }
@@ -252,11 +259,11 @@ impl Geometry {
                         let r = radius * scale;
                         // The disk's extent along each axis is r·√(1 − nᵢ²).
                         let extent = (DVec3::ONE - n * n).max(DVec3::ZERO).map(f64::sqrt) * r;
-                        let geometry = Geometry::Disk {
+                        let geometry = Geometry::Disk(Box::new(WorldDisk {
                             center: c.as_vec3a(),
                             normal: n.as_vec3a(),
                             radius: r as f32,
-                        };
+                        }));
                         (geometry, Bound::from_f64(c - extent, c + extent))
                     }
                     None => {
@@ -281,11 +288,11 @@ impl Geometry {
                     m.transform_point3(*b),
                     m.transform_point3(*c),
                 );
-                let geometry = Geometry::Triangle {
+                let geometry = Geometry::Triangle(Box::new(WorldTriangle {
                     a: a.as_vec3a(),
                     edge1: (b - a).as_vec3a(),
                     edge2: (c - a).as_vec3a(),
-                };
+                }));
                 (geometry, Bound::from_f64(a.min(b).min(c), a.max(b).max(c)))
             }
             Shape::Quadric { quadric, .. } => {
@@ -314,7 +321,7 @@ impl Geometry {
     /// Whether the shape encloses a volume (CSG and refraction need an inside).
     pub fn is_solid(&self) -> bool {
         match self {
-            Geometry::Disk { .. } | Geometry::Triangle { .. } => false,
+            Geometry::Disk(_) | Geometry::Triangle(_) => false,
             Geometry::Local(local) => match local.shape {
                 Canonical::Disk => false,
                 Canonical::Cylinder { capped } | Canonical::Cone { capped, .. } => capped,
@@ -335,20 +342,16 @@ impl Geometry {
                 let t = (offset - normal.dot(ray.origin)) / normal.dot(ray.direction);
                 (t > tmin && t < tmax).then_some((t, WALL))
             }
-            Geometry::Disk {
-                center,
-                normal,
-                radius,
-            } => {
-                let t = (*center - ray.origin).dot(*normal) / ray.direction.dot(*normal);
+            Geometry::Disk(disk) => {
+                let t = (disk.center - ray.origin).dot(disk.normal) / ray.direction.dot(disk.normal);
                 if !(t > tmin && t < tmax) {
                     return None;
                 }
-                let from_center = ray.at(t) - *center;
-                (from_center.length_squared() <= radius * radius).then_some((t, WALL))
+                let from_center = ray.at(t) - disk.center;
+                (from_center.length_squared() <= disk.radius * disk.radius).then_some((t, WALL))
             }
-            Geometry::Triangle { a, edge1, edge2 } => {
-                let t = triangle_hit(ray, *a, *edge1, *edge2)?;
+            Geometry::Triangle(triangle) => {
+                let t = triangle_hit(ray, triangle.a, triangle.edge1, triangle.edge2)?;
                 (t > tmin && t < tmax).then_some((t, WALL))
             }
             Geometry::Quadric(_) => self.spans(ray).first_boundary(tmin, tmax),
@@ -416,7 +419,7 @@ impl Geometry {
                 let d = local.canonical_from_world.transform_vector3a(ray.direction);
                 canonical_spans(local.shape, o, d)
             }
-            Geometry::Disk { .. } | Geometry::Triangle { .. } => ShapeSpans::NONE,
+            Geometry::Disk(_) | Geometry::Triangle(_) => ShapeSpans::NONE,
         }
     }
 
@@ -424,8 +427,9 @@ impl Geometry {
     pub fn normal(&self, ray: &Ray, t: f32, part: Part) -> Vec3A {
         let n = match self {
             Geometry::Sphere { center, .. } => ray.at(t) - *center,
-            Geometry::Plane { normal, .. } | Geometry::Disk { normal, .. } => *normal,
-            Geometry::Triangle { edge1, edge2, .. } => edge1.cross(*edge2),
+            Geometry::Plane { normal, .. } => *normal,
+            Geometry::Disk(disk) => disk.normal,
+            Geometry::Triangle(triangle) => triangle.edge1.cross(triangle.edge2),
             Geometry::Quadric(quadric) => quadric.gradient(ray, t),
             Geometry::Local(local) => {
                 let o = local.canonical_from_world.transform_point3a(ray.origin);

@@ -151,7 +151,7 @@ impl<'a> Tracer<'a> {
             geometric_normal: surface.geometric_normal,
             shading_normal: n,
             front_face,
-            object: surface.item.object,
+            object: surface.item.object(),
             leaf: surface.leaf.object,
             material: surface.leaf.material,
             resolved_material: material_handle,
@@ -202,7 +202,7 @@ impl<'a> Tracer<'a> {
                 Shadow::Blocked(blocker) => {
                     let item = scene.item(blocker.item);
                     let result = ShadowResult::Blocked {
-                        object: item.object,
+                        object: item.object(),
                         leaf: item.leaf(blocker.leaf).object,
                         t: blocker.t,
                     };

@@ -243,22 +243,28 @@ fn check_scene(
 ) -> SceneReport {
     let actual_path = out_dir.join(format!("{}.actual.png", scene.name));
     let mut report = match render(exe, root, scene, &actual_path) {
-        Ok(actual) => match image::open(refs_dir.join(format!("{}.png", scene.name))) {
-            Ok(expected) => evaluate_image(
-                &scene.name,
-                &expected.into_rgb8(),
-                &actual,
-                &scene.thresholds,
-                out_dir,
-            ),
-            Err(e) => problem(
-                scene,
-                format!(
-                    "no usable reference ({e}); create it with `cargo xtask golden --bless {}`",
-                    scene.name
+        Ok(actual) => {
+            let reference = refs_dir.join(format!("{}.png", scene.name));
+            match image::open(&reference) {
+                Ok(expected) => evaluate_image(
+                    &scene.name,
+                    &expected.into_rgb8(),
+                    &actual,
+                    &scene.thresholds,
+                    out_dir,
                 ),
-            ),
-        },
+                Err(_) if !reference.exists() => problem(
+                    scene,
+                    format!(
+                        "there is no reference {} yet: look at {}, then `cargo xtask golden --bless {}`",
+                        reference.display(),
+                        actual_path.display(),
+                        scene.name
+                    ),
+                ),
+                Err(e) => problem(scene, format!("cannot read the reference {}: {e}", reference.display())),
+            }
+        }
         Err(e) => problem(scene, format!("{e:#}")),
     };
     for &pixel in &scene.pixels {

@@ -130,6 +130,15 @@ const TOKENS: &[&str] = &[
     "ior",
     "vertices",
     "coefficients",
+    "→",
+    "é",
+    "日本",
+    "\u{0}",
+    "\t",
+    "\\",
+    "#",
+    "@",
+    "'",
 ];
 
 /// Small limits, so that a mutation that makes a huge loop ends quickly.

@@ -27,7 +27,7 @@ fn first_hit(scene: &PreparedScene, origin: Vec3A, direction: Vec3A) -> Option<H
         t: hit.t,
         point: surface.point,
         normal: surface.geometric_normal,
-        object: surface.item.object,
+        object: surface.item.object(),
         leaf: surface.leaf.object,
     })
 }

@@ -1,0 +1,291 @@
+//! The ray tree as plain data: what `whitted trace` prints, what its JSON holds and what the
+//! debugger shows. Built by the tree recorder; no behaviour here beyond small helpers.
+//!
+//! Vectors and colours are `[f32; 3]` (linear RGB for colours), exactly the f32 values the
+//! tracer computed, so a serialised tree round-trips bit for bit. Fields marked
+//! `#[serde(skip)]` are for in-process users (the debugger's source pane) only.
+
+use serde::Serialize;
+use whitted_ir::Span;
+
+use crate::recorder::{RayKind, Termination};
+
+/// The version of the JSON document (`docs/ray-tree.md`); bumped on any incompatible change.
+pub const RAY_TREE_JSON_VERSION: u32 = 1;
+
+/// Every recorded ray of one pixel.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RayTree {
+    /// `[x, y]`, x from the left, y from the top.
+    pub pixel: [u32; 2],
+    /// `[width, height]` of the image the pixel belongs to.
+    pub image_size: [u32; 2],
+    /// The pixel's linear RGB exactly as `render` produced it (the mean of all its samples).
+    pub color: [f32; 3],
+    pub samples_per_pixel: u32,
+    /// The limits the tree was traced with.
+    pub max_depth: u32,
+    pub min_weight: f32,
+    /// Every sample recorded: all of the pixel's samples, or just the one asked for.
+    pub samples: Vec<SampleTree>,
+}
+
+/// The tree of one sample (one camera ray) of a pixel.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SampleTree {
+    /// The sample's index, `0..samples_per_pixel`.
+    pub index: u32,
+    /// What this sample contributed before averaging (equals `root.color`).
+    pub color: [f32; 3],
+    /// The camera ray.
+    pub root: RayNode,
+}
+
+/// One ray: the camera ray, a reflected or transmitted ray, or a shadow ray.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RayNode {
+    pub kind: RayKind,
+    /// 0 for the camera ray; a reflected or transmitted ray is one deeper than its parent.
+    /// A shadow ray has its parent's depth: it belongs to that hit's local illumination and
+    /// the depth limit does not apply to it.
+    pub depth: u32,
+    pub origin: [f32; 3],
+    /// A unit vector.
+    pub direction: [f32; 3],
+    /// The path weight: the product of every coefficient (and absorption factor) from the eye
+    /// up to and including this ray's own coefficient: how much its colour counts in the pixel.
+    /// A shadow ray carries the weight of the ray whose hit cast it.
+    pub weight: [f32; 3],
+    /// This ray's own coefficient: `kr` or `kt` after Fresnel and total internal reflection;
+    /// `[1, 1, 1]` for camera and shadow rays.
+    pub coefficient: [f32; 3],
+    /// The optics of the surface this ray leaves from (reflected and transmitted rays only).
+    pub interface: Option<InterfaceInfo>,
+    /// What the ray hit; `None` on a miss (and always on shadow rays, see `shadow`).
+    pub hit: Option<HitInfo>,
+    /// The local illumination at the hit (`None` on a miss and on shadow rays).
+    pub local: Option<LocalIllumination>,
+    /// Only on shadow rays: which light, and what the ray found on its way there.
+    pub shadow: Option<ShadowInfo>,
+    /// The colour this ray returned to its parent (or to the pixel). For a shadow ray, the
+    /// fraction of the light that got through: 1 unblocked, 0 blocked, the filter colour
+    /// otherwise.
+    pub color: [f32; 3],
+    /// Why recursion stopped here. Shadow rays never recurse: `miss` when they reach the
+    /// light (clear or filtered), `absorbed` when a blocker stops them.
+    pub termination: Termination,
+    /// Reflected or transmitted rays the material asked for but that were not traced.
+    pub skipped: Vec<SkippedInfo>,
+    /// Shadow rays first (in light order), then the reflected ray, then the transmitted one.
+    pub children: Vec<RayNode>,
+}
+
+impl RayNode {
+    /// The number of rays in this subtree, this one included.
+    pub fn ray_count(&self) -> usize {
+        1 + self.children.iter().map(RayNode::ray_count).sum::<usize>()
+    }
+
+    /// The deepest `depth` in this subtree.
+    pub fn deepest(&self) -> u32 {
+        self.children
+            .iter()
+            .map(RayNode::deepest)
+            .fold(self.depth, u32::max)
+    }
+
+    /// The first child of `kind`, if any.
+    pub fn child(&self, kind: RayKind) -> Option<&RayNode> {
+        self.children.iter().find(|c| c.kind == kind)
+    }
+}
+
+/// The surface a reflected or transmitted ray leaves from.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct InterfaceInfo {
+    /// The angle between the incoming ray and the shading normal, in degrees (0 = head on).
+    pub incidence_degrees: f32,
+    pub cos_incidence: f32,
+    /// `[from, to]` refractive indices when the material transmits (air is 1).
+    pub ior: Option<[f32; 2]>,
+    /// Whether the incoming ray was entering the solid (it hit the outside).
+    pub entering: bool,
+    /// Schlick's `R` when the material uses Fresnel.
+    pub fresnel_reflectance: Option<f32>,
+    /// `1 − R` when the material uses Fresnel.
+    pub fresnel_transmittance: Option<f32>,
+    pub total_internal_reflection: bool,
+}
+
+/// Where a ray hit and what it hit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HitInfo {
+    /// Distance along the (unit) direction.
+    pub t: f32,
+    pub point: [f32; 3],
+    /// The solid's outward normal (reversed on subtracted CSG surfaces).
+    pub geometric_normal: [f32; 3],
+    /// The normal used for shading: the geometric normal turned to face the ray.
+    pub shading_normal: [f32; 3],
+    /// Whether the ray hit the outside of the surface.
+    pub front_face: bool,
+    /// The top-level object (a shape or a CSG root; groups are flattened away).
+    pub object: ObjectRef,
+    /// The shape whose surface was hit: the CSG leaf, or the object itself.
+    pub leaf: ObjectRef,
+    /// The CSG operations from `object` down to `leaf` (empty for a plain shape).
+    pub csg_path: Vec<ObjectRef>,
+    /// The leaf's material as the scene gives it.
+    pub material: MaterialRef,
+    /// The material in effect at the point once patterns are resolved.
+    pub resolved_material: MaterialRef,
+    /// Beer-Lambert transmittance over this ray's path inside an absorbing solid (1 in air);
+    /// the returned colour includes it.
+    pub absorption: [f32; 3],
+}
+
+/// An IR object, named for people and located in the source.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ObjectRef {
+    /// Its index in the IR's object arena.
+    pub handle: u32,
+    pub name: Option<String>,
+    /// The name, or the kind and handle (`sphere #3`).
+    pub label: String,
+    /// `sphere`, `box`, `difference`, ...
+    pub kind: String,
+    /// `file:line:column` of its definition, or `<built-in>`.
+    pub location: String,
+    #[serde(skip)]
+    pub span: Span,
+}
+
+/// An IR material, named for people and located in the source.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MaterialRef {
+    pub handle: u32,
+    pub name: Option<String>,
+    pub label: String,
+    pub location: String,
+    #[serde(skip)]
+    pub span: Span,
+}
+
+/// An IR light, named for people and located in the source.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LightRef {
+    pub handle: u32,
+    pub name: Option<String>,
+    /// The name, or `light #N`.
+    pub label: String,
+    /// `point`, `directional` or `spot`.
+    pub kind: String,
+    pub location: String,
+    #[serde(skip)]
+    pub span: Span,
+}
+
+/// The local part of a hit's colour: ambient plus each light's share.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LocalIllumination {
+    /// `ka·Ia·kd`.
+    pub ambient: [f32; 3],
+    /// One entry per light, in scene order.
+    pub lights: Vec<LightContribution>,
+    /// `ambient + Σ (diffuse + specular)`: the local colour before absorption.
+    pub total: [f32; 3],
+}
+
+/// One light's share of the local illumination at a hit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LightContribution {
+    pub light: LightRef,
+    /// Unit vector from the (offset) hit point towards the light.
+    pub to_light: [f32; 3],
+    /// Distance to the light; `None` for directional lights (infinitely far).
+    pub distance: Option<f32>,
+    /// `N·L` with the shading normal; the light counts only when it is positive.
+    pub n_dot_l: f32,
+    /// `fatt` (1 for directional lights).
+    pub attenuation: f32,
+    /// The spot cone factor (1 for other lights).
+    pub spot: f32,
+    /// `fatt·spot·Ii·shadow·kd·(N·L)`.
+    pub diffuse: [f32; 3],
+    /// `fatt·spot·Ii·shadow·ks·(R·V)^n`.
+    pub specular: [f32; 3],
+    /// Whether and why the light reaches the point.
+    pub visibility: Visibility,
+    /// The index in the node's `children` of this light's shadow ray (`None` when no shadow
+    /// ray was cast).
+    pub shadow_child: Option<usize>,
+}
+
+/// Whether a light reaches a hit point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Visibility {
+    /// The shadow ray reached the light.
+    Lit,
+    /// The shadow ray passed through transmissive objects only (filtered shadows).
+    Filtered,
+    /// The shadow ray was stopped by an opaque object.
+    Blocked,
+    /// No shadow ray was cast: the light is behind the surface (`N·L <= 0`), outside its
+    /// cone, too far to count, or black.
+    NotFacing,
+}
+
+/// What a shadow ray was cast for and what it found.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ShadowInfo {
+    pub light: LightRef,
+    /// The distance to the light, where the ray stops; `None` for directional lights.
+    pub max_t: Option<f32>,
+    pub result: ShadowOutcome,
+    /// The blocker found, on `blocked` results (the first found, not necessarily the nearest).
+    pub blocker: Option<Blocker>,
+    /// The product of the transmissive colours passed through, on `filtered` results.
+    pub transmittance: Option<[f32; 3]>,
+    /// How many transmissive objects it passed through, on `filtered` results.
+    pub filters: Option<u32>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShadowOutcome {
+    Unblocked,
+    Blocked,
+    Filtered,
+}
+
+/// The object that stopped a shadow ray.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Blocker {
+    pub object: ObjectRef,
+    /// The shape actually hit (the CSG leaf, or the object itself).
+    pub leaf: ObjectRef,
+    pub t: f32,
+}
+
+/// A reflected or transmitted ray the material asked for but that was not traced.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SkippedInfo {
+    pub kind: RayKind,
+    pub depth: u32,
+    /// The path weight it would have had (zero for a transmission lost to total internal
+    /// reflection, whose weight went to the reflected ray).
+    pub weight: [f32; 3],
+    pub coefficient: [f32; 3],
+    /// `max_depth`, `weight_cutoff` or `total_internal_reflection`.
+    pub reason: Termination,
+}
+
+/// Which samples of a pixel to record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SampleChoice {
+    /// Every sample, `0..samples_per_pixel`.
+    All,
+    /// Only this one (the others are still traced, unrecorded, for the pixel's colour).
+    One(u32),
+}

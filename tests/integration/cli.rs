@@ -1,0 +1,220 @@
+//! The command line as a user meets it: exit codes, diagnostics, output files, `-D`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn whitted() -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_whitted"));
+    command.current_dir(workspace());
+    command.env("NO_COLOR", "1");
+    command
+}
+
+fn workspace() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn run(args: &[&str]) -> Output {
+    whitted().args(args).output().expect("the whitted binary runs")
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+fn stdout(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+fn write_scene(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).expect("write a scene");
+    path
+}
+
+#[test]
+fn check_accepts_every_example_scene() {
+    let mut scenes: Vec<PathBuf> = std::fs::read_dir(workspace().join("scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "scene"))
+        .collect();
+    scenes.sort();
+    assert!(scenes.len() >= 15, "expected the feature scenes, found {}", scenes.len());
+    for scene in scenes {
+        let output = run(&["check", scene.to_str().unwrap()]);
+        assert!(output.status.success(), "{}: {}", scene.display(), stderr(&output));
+        assert!(stdout(&output).contains(": ok ("), "{}", stdout(&output));
+    }
+}
+
+#[test]
+fn a_scene_with_errors_exits_1_with_located_diagnostics() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write_scene(
+        dir.path(),
+        "bad.scene",
+        "sphere { centre <0, 0, 0> radius 1 }\nsphere { radius foo }\n",
+    );
+    let output = run(&["check", scene.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(1));
+    let text = stderr(&output);
+    assert!(text.contains("bad.scene:1:10"), "{text}");
+    assert!(text.contains("center"), "the hint names the right property: {text}");
+    assert!(text.contains("bad.scene:2:17"), "every error is reported, not just the first: {text}");
+    assert!(text.contains("has 2 errors"), "{text}");
+}
+
+#[test]
+fn a_missing_file_is_one_clear_line_and_exit_1() {
+    let output = run(&["render", "no/such/file.scene", "-o", "/tmp/never.png"]);
+    assert_eq!(output.status.code(), Some(1));
+    let text = stderr(&output);
+    assert!(text.starts_with("error: cannot read no/such/file.scene"), "{text}");
+    assert_eq!(text.lines().count(), 1, "{text}");
+}
+
+#[test]
+fn bad_usage_exits_2() {
+    for args in [
+        vec!["render", "scenes/whitted.scene", "-o", "out.jpg"],
+        vec!["render", "scenes/whitted.scene", "--width", "0"],
+        vec!["check", "scenes/whitted.scene", "-D", "N"],
+        vec!["frobnicate"],
+    ] {
+        let output = run(&args);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {}", stderr(&output));
+    }
+}
+
+#[test]
+fn render_writes_the_requested_size_and_format() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["small.png", "small.exr", "small.hdr", "small.ppm"] {
+        let out = dir.path().join(name);
+        let output = run(&[
+            "render",
+            "scenes/whitted.scene",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--quiet",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(output.status.success(), "{name}: {}", stderr(&output));
+        assert!(stdout(&output).is_empty() && stderr(&output).is_empty(), "--quiet prints nothing");
+        let bytes = std::fs::read(&out).unwrap();
+        if name.ends_with(".ppm") {
+            assert!(bytes.starts_with(b"P6\n40 30\n255\n"));
+        } else {
+            let image = image::load_from_memory(&bytes).unwrap();
+            assert_eq!((image.width(), image.height()), (40, 30), "{name}");
+        }
+    }
+}
+
+#[test]
+fn a_failed_render_leaves_the_old_image_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("keep.png");
+    std::fs::write(&out, b"the old image").unwrap();
+    let scene = write_scene(dir.path(), "broken.scene", "sphere { radius -1 ");
+    let output = run(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(std::fs::read(&out).unwrap(), b"the old image");
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .filter(|n| n.to_string_lossy().ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[test]
+fn the_image_is_byte_identical_for_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut images = Vec::new();
+    for threads in ["1", "2", "3"] {
+        let out = dir.path().join(format!("t{threads}.png"));
+        let output = run(&[
+            "render",
+            "scenes/whitted.scene",
+            "--width",
+            "96",
+            "--height",
+            "72",
+            "--spp",
+            "4",
+            "--threads",
+            threads,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(output.status.success(), "{}", stderr(&output));
+        images.push(std::fs::read(&out).unwrap());
+    }
+    assert_eq!(images[0], images[1], "1 and 2 threads differ");
+    assert_eq!(images[0], images[2], "1 and 3 threads differ");
+}
+
+#[test]
+fn defines_override_constants_and_unknown_ones_are_errors() {
+    let output = run(&["check", "scenes/bench/grid.scene", "-D", "N=3"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let objects_3 = stdout(&output);
+    let output = run(&["check", "scenes/bench/grid.scene", "-D", "N=4"]);
+    let objects_4 = stdout(&output);
+    assert_ne!(objects_3, objects_4, "-D N changes the scene");
+
+    let output = run(&["check", "scenes/bench/grid.scene", "-D", "NOPE=3"]);
+    assert_eq!(output.status.code(), Some(1));
+    assert!(stderr(&output).contains("NOPE"), "{}", stderr(&output));
+}
+
+#[test]
+fn ir_prints_text_and_versioned_json() {
+    let output = run(&["ir", "scenes/whitted.scene"]);
+    assert!(output.status.success());
+    let text = stdout(&output);
+    assert!(text.contains("\"glass sphere\" sphere"), "{text}");
+    assert!(text.contains("scenes/whitted.scene:"), "objects carry their source location: {text}");
+
+    let output = run(&["ir", "scenes/whitted.scene", "--json"]);
+    assert!(output.status.success());
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(json["version"], 1);
+    assert_eq!(json["objects"].as_array().unwrap().len(), 3);
+    assert_eq!(json["lights"][0]["name"], "sun");
+}
+
+#[test]
+fn stats_report_ray_counts_as_text_and_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("s.png");
+    let output = run(&[
+        "render",
+        "scenes/whitted.scene",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--stats=json",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let stats: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(stats["camera_rays"], 32 * 24);
+    let total = stats["total_rays"].as_u64().unwrap();
+    let parts: u64 = ["camera_rays", "shadow_rays", "reflected_rays", "transmitted_rays"]
+        .iter()
+        .map(|k| stats[k].as_u64().unwrap())
+        .sum();
+    assert_eq!(total, parts);
+    assert!(stats["transmitted_rays"].as_u64().unwrap() > 0, "the glass sphere refracts");
+
+    let output = run(&["render", "scenes/whitted.scene", "--width", "32", "--height", "24", "--stats", "-o", out.to_str().unwrap()]);
+    assert!(stdout(&output).contains("camera rays      768"), "{}", stdout(&output));
+}
