@@ -23,6 +23,8 @@ pub enum Command {
     Check(SceneArgs),
     /// Print the compiled IR of a scene, as text or JSON.
     Ir(IrArgs),
+    /// Record every ray behind one pixel and print its ray tree, as text or JSON.
+    Trace(TraceArgs),
 }
 
 /// The scene file and the `-D` overrides every scene-reading command takes.
@@ -58,6 +60,27 @@ pub struct RenderArgs {
     /// (linear float), .ppm (8-bit sRGB). Default: the scene's name with .png, here.
     #[arg(short = 'o', long = "output", value_name = "OUT", value_parser = parse_output)]
     pub output: Option<PathBuf>,
+    #[command(flatten)]
+    pub overrides: RenderOverrides,
+    /// Worker threads (default: one per core). The image is identical for any count.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Print ray counts, timings and rays per second (text, or --stats=json).
+    #[arg(long, value_name = "FORMAT", num_args = 0..=1, default_missing_value = "text")]
+    pub stats: Option<StatsFormat>,
+    /// Also write per-pixel statistics as a heat-map image: rays per pixel, deepest level
+    /// and cut-off terminations, side by side (see docs/ray-tree.md).
+    #[arg(long, value_name = "OUT", value_parser = parse_output)]
+    pub stats_image: Option<PathBuf>,
+    /// Print nothing but errors (no progress bar, no warnings).
+    #[arg(long, short = 'q')]
+    pub quiet: bool,
+}
+
+/// The scene settings that `render` and `trace` may override, so that a trace can follow a
+/// render made at another size.
+#[derive(Args, Clone, Debug, Default)]
+pub struct RenderOverrides {
     /// Image width in pixels (overrides the scene's settings).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub width: Option<u32>,
@@ -70,15 +93,32 @@ pub struct RenderArgs {
     /// Maximum recursion depth; the camera ray is depth 0 (overrides the scene's settings).
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=64))]
     pub max_depth: Option<u32>,
-    /// Worker threads (default: one per core). The image is identical for any count.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
-    pub threads: Option<u32>,
-    /// Print ray counts, timings and rays per second (text, or --stats=json).
-    #[arg(long, value_name = "FORMAT", num_args = 0..=1, default_missing_value = "text")]
-    pub stats: Option<StatsFormat>,
-    /// Print nothing but errors (no progress bar, no warnings).
-    #[arg(long, short = 'q')]
-    pub quiet: bool,
+}
+
+#[derive(Args)]
+pub struct TraceArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// The pixel to trace: X,Y counted from the top-left corner (0,0).
+    // Hyphen values reach the parser so that `-1,3` gets its message, not "unexpected argument".
+    #[arg(long, value_name = "X,Y", value_parser = parse_pixel, allow_hyphen_values = true)]
+    pub pixel: [u32; 2],
+    /// Record only this sample of the pixel (default: every sample).
+    #[arg(long, value_name = "K")]
+    pub sample: Option<u32>,
+    /// Print the versioned JSON document (docs/ray-tree.md) instead of text.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub overrides: RenderOverrides,
+}
+
+fn parse_pixel(text: &str) -> Result<[u32; 2], String> {
+    let usage = || format!("`{text}` is not a pixel: write X,Y (for example --pixel 400,270)");
+    let (x, y) = text.split_once(',').ok_or_else(usage)?;
+    let x = x.trim().parse::<u32>().map_err(|_| usage())?;
+    let y = y.trim().parse::<u32>().map_err(|_| usage())?;
+    Ok([x, y])
 }
 
 fn parse_define(text: &str) -> Result<(String, String), String> {
@@ -146,6 +186,16 @@ mod tests {
         assert!(parse_define("N").is_err());
         assert!(parse_define("1N=3").is_err());
         assert!(parse_define("N=").is_err());
+    }
+
+    #[test]
+    fn pixels_are_two_unsigned_numbers() {
+        assert_eq!(parse_pixel("400,270"), Ok([400, 270]));
+        assert_eq!(parse_pixel(" 3 , 4 "), Ok([3, 4]));
+        assert!(parse_pixel("400").is_err());
+        assert!(parse_pixel("-1,2").is_err());
+        assert!(parse_pixel("1,2,3").is_err());
+        assert!(parse_pixel("x,y").is_err());
     }
 
     #[test]

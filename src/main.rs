@@ -7,6 +7,8 @@ mod cli;
 mod image_output;
 mod render_cmd;
 mod scene_input;
+mod stats_image;
+mod trace_cmd;
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -37,6 +39,7 @@ fn main() -> ExitCode {
         Command::Check(args) => scene_input::check(&args),
         Command::Ir(args) => scene_input::ir(&args),
         Command::Render(args) => render_cmd::render(&args),
+        Command::Trace(args) => trace_cmd::trace(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

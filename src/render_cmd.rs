@@ -5,11 +5,13 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
+use whitted_ir::Settings;
 use whitted_tracer::{PreparedScene, RenderObserver, RenderOptions, RenderStats, TileResult};
 
-use crate::cli::{ImageFormat, RenderArgs, StatsFormat};
+use crate::cli::{ImageFormat, RenderArgs, RenderOverrides, StatsFormat};
 use crate::image_output::write_image;
 use crate::scene_input::{load_scene, write_stdout};
+use crate::stats_image::StatsImage;
 use crate::Failure;
 
 /// Advances a progress bar by the pixels of each finished tile.
@@ -23,6 +25,17 @@ impl RenderObserver for ProgressObserver {
             bar.inc(u64::from(tile.width) * u64::from(tile.height));
         }
     }
+}
+
+/// The scene's render settings with the command line's overrides applied: shared by
+/// `render` and `trace`, so that a trace at a given size follows the render at that size.
+pub fn render_options(settings: &Settings, overrides: &RenderOverrides) -> RenderOptions {
+    let mut options = RenderOptions::from_settings(settings);
+    options.width = overrides.width.unwrap_or(options.width);
+    options.height = overrides.height.unwrap_or(options.height);
+    options.samples_per_pixel = overrides.spp.unwrap_or(options.samples_per_pixel);
+    options.max_depth = overrides.max_depth.unwrap_or(options.max_depth);
+    options
 }
 
 /// `scenes/whitted.scene` renders to `whitted.png` in the current directory by default.
@@ -42,13 +55,15 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         .unwrap_or_else(|| default_output(&args.scene.scene));
     let format = ImageFormat::from_path(&output).unwrap_or(ImageFormat::Png);
     // Fail before a long render, not after it, when the output cannot be written there.
-    if let Some(dir) = output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
-            return Err(Failure::Message(format!(
-                "cannot write {}: the directory {} does not exist",
-                output.display(),
-                dir.display()
-            )));
+    for path in std::iter::once(&output).chain(&args.stats_image) {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            if !dir.is_dir() {
+                return Err(Failure::Message(format!(
+                    "cannot write {}: the directory {} does not exist",
+                    path.display(),
+                    dir.display()
+                )));
+            }
         }
     }
 
@@ -56,11 +71,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     let compile_seconds = started.elapsed().as_secs_f64();
     let prepared = PreparedScene::new(&loaded.scene);
 
-    let mut options = RenderOptions::from_settings(&loaded.scene.settings);
-    options.width = args.width.unwrap_or(options.width);
-    options.height = args.height.unwrap_or(options.height);
-    options.samples_per_pixel = args.spp.unwrap_or(options.samples_per_pixel);
-    options.max_depth = args.max_depth.unwrap_or(options.max_depth);
+    let options = render_options(&loaded.scene.settings, &args.overrides);
 
     let threads = match args.threads {
         Some(n) => n as usize,
@@ -83,11 +94,17 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         bar
     });
     let observer = ProgressObserver { bar };
-    let rendered = pool.install(|| whitted_tracer::render(&prepared, &options, &observer));
+    // Per-pixel statistics are gathered only when asked for: the plain render records nothing.
+    let rendered = pool.install(|| match &args.stats_image {
+        Some(_) => whitted_tracer::render_with_pixel_stats(&prepared, &options, &observer)
+            .map(|(image, stats, pixel_stats)| (image, stats, Some(pixel_stats))),
+        None => whitted_tracer::render(&prepared, &options, &observer)
+            .map(|(image, stats)| (image, stats, None)),
+    });
     if let Some(bar) = &observer.bar {
         bar.finish_and_clear();
     }
-    let Some((image, stats)) = rendered else {
+    let Some((image, stats, pixel_stats)) = rendered else {
         return Err(Failure::Message(
             "the render was cancelled; nothing was written".into(),
         ));
@@ -95,6 +112,18 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
 
     write_image(&output, format, image.width, image.height, &image.pixels)
         .map_err(Failure::Message)?;
+    if let (Some(path), Some(pixel_stats)) = (&args.stats_image, &pixel_stats) {
+        let heat_maps = StatsImage::new(image.width, image.height, pixel_stats, &options);
+        let format = ImageFormat::from_path(path).unwrap_or(ImageFormat::Png);
+        write_image(
+            path,
+            format,
+            heat_maps.width,
+            heat_maps.height,
+            &heat_maps.pixels,
+        )
+        .map_err(Failure::Message)?;
+    }
 
     let summary = Summary {
         scene: &args.scene.scene,

@@ -15,7 +15,10 @@ fn workspace() -> PathBuf {
 }
 
 fn run(args: &[&str]) -> Output {
-    whitted().args(args).output().expect("the whitted binary runs")
+    whitted()
+        .args(args)
+        .output()
+        .expect("the whitted binary runs")
 }
 
 fn stderr(output: &Output) -> String {
@@ -40,10 +43,19 @@ fn check_accepts_every_example_scene() {
         .filter(|p| p.extension().is_some_and(|e| e == "scene"))
         .collect();
     scenes.sort();
-    assert!(scenes.len() >= 15, "expected the feature scenes, found {}", scenes.len());
+    assert!(
+        scenes.len() >= 15,
+        "expected the feature scenes, found {}",
+        scenes.len()
+    );
     for scene in scenes {
         let output = run(&["check", scene.to_str().unwrap()]);
-        assert!(output.status.success(), "{}: {}", scene.display(), stderr(&output));
+        assert!(
+            output.status.success(),
+            "{}: {}",
+            scene.display(),
+            stderr(&output)
+        );
         assert!(stdout(&output).contains(": ok ("), "{}", stdout(&output));
     }
 }
@@ -60,8 +72,14 @@ fn a_scene_with_errors_exits_1_with_located_diagnostics() {
     assert_eq!(output.status.code(), Some(1));
     let text = stderr(&output);
     assert!(text.contains("bad.scene:1:10"), "{text}");
-    assert!(text.contains("center"), "the hint names the right property: {text}");
-    assert!(text.contains("bad.scene:2:17"), "every error is reported, not just the first: {text}");
+    assert!(
+        text.contains("center"),
+        "the hint names the right property: {text}"
+    );
+    assert!(
+        text.contains("bad.scene:2:17"),
+        "every error is reported, not just the first: {text}"
+    );
     assert!(text.contains("has 2 errors"), "{text}");
 }
 
@@ -70,7 +88,10 @@ fn a_missing_file_is_one_clear_line_and_exit_1() {
     let output = run(&["render", "no/such/file.scene", "-o", "/tmp/never.png"]);
     assert_eq!(output.status.code(), Some(1));
     let text = stderr(&output);
-    assert!(text.starts_with("error: cannot read no/such/file.scene"), "{text}");
+    assert!(
+        text.starts_with("error: cannot read no/such/file.scene"),
+        "{text}"
+    );
     assert_eq!(text.lines().count(), 1, "{text}");
 }
 
@@ -83,7 +104,12 @@ fn bad_usage_exits_2() {
         vec!["frobnicate"],
     ] {
         let output = run(&args);
-        assert_eq!(output.status.code(), Some(2), "{args:?}: {}", stderr(&output));
+        assert_eq!(
+            output.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            stderr(&output)
+        );
     }
 }
 
@@ -104,7 +130,10 @@ fn render_writes_the_requested_size_and_format() {
             out.to_str().unwrap(),
         ]);
         assert!(output.status.success(), "{name}: {}", stderr(&output));
-        assert!(stdout(&output).is_empty() && stderr(&output).is_empty(), "--quiet prints nothing");
+        assert!(
+            stdout(&output).is_empty() && stderr(&output).is_empty(),
+            "--quiet prints nothing"
+        );
         let bytes = std::fs::read(&out).unwrap();
         if name.ends_with(".ppm") {
             assert!(bytes.starts_with(b"P6\n40 30\n255\n"));
@@ -121,7 +150,12 @@ fn a_failed_render_leaves_the_old_image_alone() {
     let out = dir.path().join("keep.png");
     std::fs::write(&out, b"the old image").unwrap();
     let scene = write_scene(dir.path(), "broken.scene", "sphere { radius -1 ");
-    let output = run(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let output = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert_eq!(output.status.code(), Some(1));
     assert_eq!(std::fs::read(&out).unwrap(), b"the old image");
     let leftovers: Vec<_> = std::fs::read_dir(dir.path())
@@ -179,7 +213,10 @@ fn ir_prints_text_and_versioned_json() {
     assert!(output.status.success());
     let text = stdout(&output);
     assert!(text.contains("\"glass sphere\" sphere"), "{text}");
-    assert!(text.contains("scenes/whitted.scene:"), "objects carry their source location: {text}");
+    assert!(
+        text.contains("scenes/whitted.scene:"),
+        "objects carry their source location: {text}"
+    );
 
     let output = run(&["ir", "scenes/whitted.scene", "--json"]);
     assert!(output.status.success());
@@ -208,13 +245,35 @@ fn stats_report_ray_counts_as_text_and_json() {
     let stats: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
     assert_eq!(stats["camera_rays"], 32 * 24);
     let total = stats["total_rays"].as_u64().unwrap();
-    let parts: u64 = ["camera_rays", "shadow_rays", "reflected_rays", "transmitted_rays"]
-        .iter()
-        .map(|k| stats[k].as_u64().unwrap())
-        .sum();
+    let parts: u64 = [
+        "camera_rays",
+        "shadow_rays",
+        "reflected_rays",
+        "transmitted_rays",
+    ]
+    .iter()
+    .map(|k| stats[k].as_u64().unwrap())
+    .sum();
     assert_eq!(total, parts);
-    assert!(stats["transmitted_rays"].as_u64().unwrap() > 0, "the glass sphere refracts");
+    assert!(
+        stats["transmitted_rays"].as_u64().unwrap() > 0,
+        "the glass sphere refracts"
+    );
 
-    let output = run(&["render", "scenes/whitted.scene", "--width", "32", "--height", "24", "--stats", "-o", out.to_str().unwrap()]);
-    assert!(stdout(&output).contains("camera rays      768"), "{}", stdout(&output));
+    let output = run(&[
+        "render",
+        "scenes/whitted.scene",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--stats",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        stdout(&output).contains("camera rays      768"),
+        "{}",
+        stdout(&output)
+    );
 }

@@ -2,3 +2,6 @@
 //! together, the way a user does.
 
 mod cli;
+mod json_schema;
+mod ray_trees;
+mod trace_cli;

@@ -1,3 +1,33 @@
-//! whitted-debugger: the terminal ray-tree debugger (ratatui).
+//! whitted-debugger: the terminal ray-tree debugger (`whitted debug`), built on ratatui.
+//!
+//! The shape is ratatui's demo2 / gitui: the state ([`app::App`]), a pure map from keys to
+//! [`action::Action`]s, [`update::update`] applying them, and drawing (`impl Widget for &App`
+//! in `ui`) kept apart. [`run`] owns the terminal and the one event loop over
+//! [`event::Event`]; rendering, recompiling and file watching happen on other threads and
+//! report back as events. The binary hands over a compiled scene and a way to recompile it
+//! ([`Session`]): this crate never parses.
 
+pub mod action;
+pub mod app;
+pub mod event;
+pub mod framebuffer;
+pub mod heat_map;
+pub mod hit_point;
 pub mod image_view;
+pub mod layout;
+pub mod projection;
+mod reload;
+mod render_job;
+mod run;
+mod session;
+mod terminal;
+pub mod tree_view;
+pub mod ui;
+pub mod update;
+mod watch;
+
+#[cfg(test)]
+mod test_scene;
+
+pub use run::{run, DebugError};
+pub use session::{Compiled, Recompile, Session};

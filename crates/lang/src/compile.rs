@@ -22,6 +22,10 @@ use crate::{Compilation, CompileOptions, Limits, SourceLoader};
 /// systems that refuse to reserve that much address space (strict overcommit).
 const COMPILE_STACK_BYTES: [usize; 2] = [512 * 1024 * 1024, 64 * 1024 * 1024];
 
+/// Stack one level of evaluation may use, generously: a debug build measures about 5 KiB.
+/// The evaluator's depth bound is the stack divided by this.
+const STACK_BYTES_PER_EVALUATION_LEVEL: usize = 16 * 1024;
+
 /// Expressions and blocks may nest this many times deeper than brackets (an operator adds a
 /// level without a bracket).
 const EXPRESSION_DEPTH_PER_NESTING: usize = 16;
@@ -33,10 +37,10 @@ pub fn compile_file(
     options: &CompileOptions,
 ) -> Compilation {
     let path = normalize(path);
-    on_big_stack(loader, move |loader| {
+    on_big_stack(loader, move |loader, max_depth| {
         let display = path.to_string_lossy().into_owned();
         match loader.load(&path) {
-            Ok(text) => compile_root(&path, display, text, loader, options),
+            Ok(text) => compile_root(&path, display, text, loader, options, max_depth),
             Err(error) => Compilation {
                 sources: SourceMap::new(),
                 scene: None,
@@ -59,8 +63,8 @@ pub fn compile_source(
 ) -> Compilation {
     let path = normalize(Path::new(name));
     let text = text.to_string();
-    on_big_stack(loader, move |loader| {
-        compile_root(&path, name.to_string(), text, loader, options)
+    on_big_stack(loader, move |loader, max_depth| {
+        compile_root(&path, name.to_string(), text, loader, options, max_depth)
     })
 }
 
@@ -78,9 +82,11 @@ impl SourceLoader for ChannelLoader {
     }
 }
 
+/// Runs `work` on a thread with a large stack, passing it the evaluation depth that stack
+/// allows.
 fn on_big_stack<F>(loader: &mut dyn SourceLoader, work: F) -> Compilation
 where
-    F: FnOnce(&mut dyn SourceLoader) -> Compilation + Send,
+    F: FnOnce(&mut dyn SourceLoader, usize) -> Compilation + Send,
 {
     let (request_tx, request_rx) = mpsc::channel::<PathBuf>();
     let (reply_tx, reply_rx) = mpsc::channel();
@@ -98,7 +104,9 @@ where
                     let taken = parcel.lock().ok().and_then(|mut p| p.take());
                     let (work, requests, replies) = taken?;
                     let mut channel = ChannelLoader { requests, replies };
-                    Some(work(&mut channel))
+                    let max_depth = (stack / STACK_BYTES_PER_EVALUATION_LEVEL)
+                        .min(crate::eval::MAX_EVALUATION_DEPTH);
+                    Some(work(&mut channel, max_depth))
                 });
             if spawned.is_ok() {
                 break;
@@ -175,6 +183,9 @@ struct Loading<'a> {
     /// The chain of files being loaded, for cycle detection.
     stack: Vec<PathBuf>,
     total_bytes: usize,
+    /// Bracket nesting and syntax-tree depth allowed, within what the stack can take.
+    max_nesting: usize,
+    max_tree_depth: usize,
 }
 
 impl Loading<'_> {
@@ -191,17 +202,13 @@ impl Loading<'_> {
             Some(source) => source.text.clone(),
             None => return index,
         };
-        let max_depth = self
-            .limits
-            .max_nesting
-            .saturating_mul(EXPRESSION_DEPTH_PER_NESTING);
         let mut cx = ParseContext::new(
             file,
             &mut self.interner,
             &mut self.program.functions,
-            max_depth,
+            self.max_tree_depth,
         );
-        let parsed = parser::parse_file(&text, &mut cx, self.limits.max_nesting);
+        let parsed = parser::parse_file(&text, &mut cx, self.max_nesting);
         let build_errors = std::mem::take(&mut cx.errors);
         self.diagnostics.extend(build_errors);
         let mut items = match parsed {
@@ -297,6 +304,7 @@ fn compile_root(
     text: String,
     loader: &mut dyn SourceLoader,
     options: &CompileOptions,
+    max_evaluation_depth: usize,
 ) -> Compilation {
     // Expected-token detail makes syntax errors name punctuation (`,`, `;`); it costs only
     // on the failing path.
@@ -312,6 +320,13 @@ fn compile_root(
         loaded: HashMap::new(),
         stack: Vec::new(),
         total_bytes: 0,
+        // Limits raised far past their defaults stay within what this thread's stack can
+        // take: every recursive pass is bounded by the tree depth.
+        max_tree_depth: limits
+            .max_nesting
+            .saturating_mul(EXPRESSION_DEPTH_PER_NESTING)
+            .min(max_evaluation_depth),
+        max_nesting: limits.max_nesting.min(max_evaluation_depth / 2),
     };
     if text.len() > limits.max_source_bytes {
         let size = text.len();
@@ -368,6 +383,7 @@ fn compile_root(
         &resolution,
         &defines,
         sources.clone(),
+        max_evaluation_depth,
     );
     let (scene, eval_diagnostics, failed) = evaluator.run();
     diagnostics.extend(eval_diagnostics);
@@ -412,18 +428,14 @@ fn parse_defines(loading: &mut Loading<'_>, defines: &[(String, String)]) -> Opt
             ok = false;
             continue;
         }
-        let max_depth = loading
-            .limits
-            .max_nesting
-            .saturating_mul(EXPRESSION_DEPTH_PER_NESTING);
         let mut cx = ParseContext::new(
             file,
             &mut loading.interner,
             &mut loading.program.functions,
-            max_depth,
+            loading.max_tree_depth,
         );
         let result =
-            parser::parse_define_value(&text, name.len() + 1, &mut cx, loading.limits.max_nesting);
+            parser::parse_define_value(&text, name.len() + 1, &mut cx, loading.max_nesting);
         let build_errors = std::mem::take(&mut cx.errors);
         let sym = loading.interner.intern(name);
         loading.diagnostics.extend(build_errors);

@@ -74,6 +74,7 @@ pub struct CompileOptions {
     pub limits: Limits,
 }
 
+#[derive(Debug)]
 pub struct Compilation {
     /// Every file read (root first, then imports), plus a pseudo-file for each -D value so that
     /// its diagnostics can point into it.

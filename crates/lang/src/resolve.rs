@@ -434,6 +434,7 @@ impl<'a> Resolver<'a> {
             other => other,
         };
         let item_span = item.span;
+        let header = header_span(&item.kind, item.span);
         match &mut item.kind {
             ItemKind::Import { path, .. } => {
                 // A top-level import was handled by `resolve_file`; here it is misplaced, or its
@@ -542,7 +543,7 @@ impl<'a> Resolver<'a> {
                 if !top_level {
                     self.misplaced(
                         "`settings`",
-                        item_span,
+                        header,
                         cx,
                         "put `settings` at the top level of a file",
                     );
@@ -553,7 +554,7 @@ impl<'a> Resolver<'a> {
                 if !top_level {
                     self.misplaced(
                         "a camera",
-                        item_span,
+                        header,
                         cx,
                         "put the camera at the top level of a file",
                     );
@@ -577,7 +578,7 @@ impl<'a> Resolver<'a> {
                 if !cx.is_statements() {
                     self.misplaced(
                         "a light",
-                        item_span,
+                        header,
                         cx,
                         "lights are not objects: put them at the top level or in a function",
                     );
@@ -601,7 +602,7 @@ impl<'a> Resolver<'a> {
                         "to derive a material inline, write `material : {} {{ ... }}`",
                         self.name(name.sym)
                     );
-                    self.misplaced("a material definition", item_span, cx, &inline);
+                    self.misplaced("a material definition", header, cx, &inline);
                     // Most likely an attempt to derive from `name`: count it as a use
                     // rather than defining it, so no "never used" follows.
                     if let Some(def) = self.lookup(name.sym) {
@@ -626,7 +627,7 @@ impl<'a> Resolver<'a> {
                         Context::Object(_) => "only `union`, `intersection`, `difference` and `group` hold other objects",
                         _ => "objects go at the top level, in functions, or inside `union`, `intersection`, `difference` and `group`",
                     };
-                    self.misplaced("an object", item_span, cx, hint);
+                    self.misplaced("an object", header, cx, hint);
                 }
                 *tag = self.object_tag(*kind);
                 let body_cx = tag.map_or(Context::Unknown, Context::Object);
@@ -673,10 +674,7 @@ impl<'a> Resolver<'a> {
     }
 
     fn misplaced(&mut self, what: &str, span: Span, cx: Context, hint: &str) {
-        let message = match cx {
-            Context::Statements { .. } => format!("{what} cannot go inside this block"),
-            other => format!("{what} cannot go inside {}", other.describe()),
-        };
+        let message = format!("{what} cannot go inside {}", cx.describe());
         self.error(
             Diagnostic::error(message, span)
                 .with_label("not allowed here")
@@ -1160,6 +1158,24 @@ impl<'a> Resolver<'a> {
             }
             self.error(diagnostic);
         }
+    }
+}
+
+/// The first line's worth of an item, for messages about the item as a whole: `light point
+/// "key"`, `sphere "ball"`, `material glass`, not the whole block.
+fn header_span(kind: &ItemKind, span: Span) -> Span {
+    let until = |end: u32| Span::new(span.file, span.start as usize, end as usize);
+    match kind {
+        ItemKind::Light { kind, name, .. } => {
+            until(name.as_ref().map_or(kind.span.end, |n| n.span.end))
+        }
+        ItemKind::Object { kind, name, .. } => {
+            kind.span.to(name.as_ref().map_or(kind.span, |n| n.span))
+        }
+        ItemKind::Camera { kind, .. } => until(kind.span.end),
+        ItemKind::Material { body, .. } => body.header,
+        ItemKind::Settings(_) => until(span.start + "settings".len() as u32),
+        _ => span,
     }
 }
 

@@ -432,7 +432,10 @@ impl Context {
             Context::Statements {
                 in_function: true, ..
             } => "a function body".to_string(),
-            Context::Statements { .. } => "the top level".to_string(),
+            Context::Statements {
+                top_level: true, ..
+            } => "the top level".to_string(),
+            Context::Statements { .. } => "a block".to_string(),
             Context::Object(tag) => article(tag.name()),
             Context::Modifiers => "the block after a call".to_string(),
             Context::Settings => "the settings".to_string(),

@@ -114,7 +114,7 @@ impl Expected {
         }
         let mut words = Vec::new();
         if self.statement {
-            words.push("a statement, object or property".to_string());
+            words.push("a property, object or statement".to_string());
         }
         if self.value {
             words.push("a value such as `1`, `<0, 1, 0>` or a name".to_string());
@@ -139,12 +139,16 @@ impl Expected {
     }
 }
 
-/// "a, b or c".
+/// "a, b or c"; "a, b or c, or d" when a phrase has its own "or".
 fn join_or(words: &[String]) -> String {
     match words {
         [] => "something else".to_string(),
         [one] => one.clone(),
-        [rest @ .., last] => format!("{} or {last}", rest.join(", ")),
+        [rest @ .., last] => {
+            let nested = rest.iter().any(|w| w.contains(" or "));
+            let or = if nested { ", or" } else { " or" };
+            format!("{}{or} {last}", rest.join(", "))
+        }
     }
 }
 

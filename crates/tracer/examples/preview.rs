@@ -28,7 +28,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let builder = match name {
         "whitted" => whitted_classic(),
-        "spheres" => reflective_spheres(1000),
+        "spheres" => reflective_spheres(),
         "grid" => sphere_grid(100),
         other => return Err(format!("unknown scene {other}").into()),
     };

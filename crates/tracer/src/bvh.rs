@@ -53,9 +53,7 @@ impl Bvh {
             obvhs::BvhBuildParams::medium_build(),
             &mut std::time::Duration::default(),
         );
-        let t = std::time::Instant::now();
         let planes = cwbvh.nodes.iter().map(dequantise).collect();
-        eprintln!("    dequantise {:.3} ({} nodes)", t.elapsed().as_secs_f64(), cwbvh.nodes.len());
         let bvh = Bvh {
             nodes: cwbvh.nodes,
             planes,

@@ -15,6 +15,7 @@ mod material;
 pub mod optics;
 mod query;
 mod ray;
+pub mod ray_tree;
 mod recorder;
 mod render;
 mod sampling;

@@ -128,7 +128,8 @@ pub struct Interface {
     /// solid is taken to be air (1.0), and thin surfaces (disks, triangles, open cylinders
     /// and cones) have (1.0, 1.0) on both sides.
     pub ior: Option<(f32, f32)>,
-    /// Whether the incoming ray was entering a solid (it hit the outside of the surface).
+    /// Whether the incoming ray was entering a solid (it hit the outside of a solid's
+    /// surface; always false on thin surfaces).
     pub entering: bool,
     /// Schlick's reflectance `R` when the material asks for Fresnel (transmission is `1 − R`).
     pub fresnel_reflectance: Option<f32>,

@@ -100,7 +100,6 @@ impl PreparedScene {
             .map(|(handle, light)| PreparedLight::new(handle, light))
             .collect();
         let roots = flatten_groups(scene);
-        eprintln!("flatten {:.3}", started.elapsed().as_secs_f64());
         // Memory traffic dominates scenes of a million objects, so items are made once and
         // moved once, into BVH order.
         let (mut items, bounds): (Vec<Option<Item>>, Vec<Bound>) = roots
@@ -110,7 +109,6 @@ impl PreparedScene {
                 (Some(item), bound)
             })
             .unzip();
-        eprintln!("prepare items {:.3}", started.elapsed().as_secs_f64());
         let mut bounded_slots = Vec::new();
         let mut aabbs = Vec::new();
         let mut unbounded = Vec::new();
@@ -124,9 +122,7 @@ impl PreparedScene {
                 }
             }
         }
-        eprintln!("partition {:.3}", started.elapsed().as_secs_f64());
         let (bounded, bvh) = build_bvh(&mut items, &bounded_slots, &aabbs);
-        eprintln!("bvh {:.3}", started.elapsed().as_secs_f64());
         let settings = scene.settings.clone();
         PreparedScene {
             camera: PreparedCamera::new(&scene.camera),
@@ -329,24 +325,22 @@ fn build_bvh(
     if bounded_slots.is_empty() || bounded_slots.len() > crate::bvh::MAX_PRIMITIVES {
         return (take_all(items), None);
     }
-    let t = Instant::now();
     let (bvh, primitive_indices) = Bvh::build(aabbs);
-    eprintln!("  obvhs+dequantise {:.3}", t.elapsed().as_secs_f64());
+    // A parallel gather (random reads of a large array are the cost here); items are
+    // copied, and the originals dropped with `items`.
     let ordered: Vec<Item> = primitive_indices
-        .iter()
+        .par_iter()
         .filter_map(|&index| {
             let slot = *bounded_slots.get(index as usize)?;
-            items.get_mut(slot)?.take()
+            items.get(slot)?.clone()
         })
         .collect();
     if ordered.len() == bounded_slots.len() && primitive_indices.len() == ordered.len() {
         (ordered, Some(bvh))
     } else {
         // Not a permutation (obvhs never does this without spatial splits): keep every item
-        // and test them all, which is slow but right.
-        let mut all = ordered;
-        all.extend(take_all(items));
-        (all, None)
+        // once and test them all, which is slow but right.
+        (take_all(items), None)
     }
 }
 
@@ -357,7 +351,11 @@ mod tests {
     /// A million of these must stay cheap to build and to walk.
     #[test]
     fn items_stay_small() {
-        assert!(std::mem::size_of::<Item>() <= 48, "{}", std::mem::size_of::<Item>());
+        assert!(
+            std::mem::size_of::<Item>() <= 48,
+            "{}",
+            std::mem::size_of::<Item>()
+        );
         assert_eq!(
             std::mem::size_of::<Option<Item>>(),
             std::mem::size_of::<Item>()

@@ -343,7 +343,8 @@ impl Geometry {
                 (t > tmin && t < tmax).then_some((t, WALL))
             }
             Geometry::Disk(disk) => {
-                let t = (disk.center - ray.origin).dot(disk.normal) / ray.direction.dot(disk.normal);
+                let t =
+                    (disk.center - ray.origin).dot(disk.normal) / ray.direction.dot(disk.normal);
                 if !(t > tmin && t < tmax) {
                     return None;
                 }

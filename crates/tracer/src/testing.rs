@@ -208,87 +208,116 @@ pub fn glass() -> Material {
     }
 }
 
-/// Whitted's 1980 picture: a glass sphere and a mirror sphere over a red and yellow
-/// checkerboard, under a blue sky.
-pub fn whitted_classic() -> SceneBuilder {
-    let mut b = SceneBuilder::new();
-    b.settings().background = Color::new(0.35, 0.55, 0.95);
-    b.settings().ambient = Color::gray(1.0);
-    b.camera(DVec3::new(0.0, 1.6, 6.0), DVec3::new(0.0, 0.9, 0.0), 45.0);
-    b.point_light(DVec3::new(-4.0, 8.0, 6.0), 0.9);
-    let red = b.material(matte(0.9, 0.15, 0.1));
-    let yellow = b.material(matte(0.95, 0.9, 0.2));
-    let checker = b.material(Material {
+fn checker(b: &mut SceneBuilder, a: Material, other: Material, scale: f64) -> Handle<Material> {
+    let a = b.material(a);
+    let other = b.material(other);
+    b.material(Material {
         pattern: Some(Pattern {
             kind: PatternKind::Checker,
-            a: red,
-            b: yellow,
-            scale: 1.0,
+            a,
+            b: other,
+            scale,
             pattern_from_object: DMat4::IDENTITY,
         }),
         ..Material::default()
+    })
+}
+
+/// Whitted's 1980 picture, as `scenes/whitted.scene` (and `scenes/bench/classic.scene`)
+/// writes it: a glass sphere and a mirror sphere over a red and yellow checkerboard, under
+/// a blue sky.
+pub fn whitted_classic() -> SceneBuilder {
+    let mut b = SceneBuilder::new();
+    b.settings().max_depth = 5;
+    b.settings().background = Color::new(0.10, 0.30, 0.75);
+    b.camera(DVec3::new(0.0, 1.6, -6.5), DVec3::new(0.0, 1.0, 0.0), 45.0);
+    b.point_light(DVec3::new(-6.0, 10.0, -8.0), 1.0);
+    let tiles = checker(&mut b, matte(0.9, 0.1, 0.1), matte(0.95, 0.9, 0.2), 1.0);
+    let glass = b.material(Material {
+        ambient: Color::BLACK,
+        diffuse: Color::gray(0.05),
+        specular: Color::gray(0.8),
+        shininess: 200.0,
+        reflective: Color::gray(0.1),
+        transmissive: Color::gray(0.9),
+        ior: 1.5,
+        ..Material::default()
     });
-    let glass = b.material(glass());
-    let mirror = b.material(mirror());
-    b.add(plane_y(0.0), DMat4::IDENTITY, checker);
-    b.add(sphere(0.6, 1.25, 1.0, 0.8), DMat4::IDENTITY, glass);
-    b.add(sphere(-0.9, 0.9, -0.8, 0.9), DMat4::IDENTITY, mirror);
+    let mirror = b.material(Material {
+        ambient: Color::gray(0.05),
+        diffuse: Color::gray(0.1),
+        specular: Color::gray(0.8),
+        shininess: 120.0,
+        reflective: Color::gray(0.8),
+        ..Material::default()
+    });
+    b.add(plane_y(0.0), DMat4::IDENTITY, tiles);
+    b.add(sphere(-0.75, 1.1, -1.2, 1.0), DMat4::IDENTITY, glass);
+    b.add(sphere(1.2, 1.0, 1.4, 1.0), DMat4::IDENTITY, mirror);
     b
 }
 
-/// `count` reflective spheres in a loose cube of side 20, lit by two point lights, over a
-/// matte floor. Positions come from a fixed hash, so the scene is the same every time.
-pub fn reflective_spheres(count: u32) -> SceneBuilder {
+/// A 10 × 10 × 10 lattice of reflective spheres over a plane, one light, shadows: as
+/// `scenes/bench/spheres1000.scene` writes it.
+pub fn reflective_spheres() -> SceneBuilder {
     let mut b = SceneBuilder::new();
-    b.settings().background = Color::new(0.1, 0.1, 0.15);
-    b.camera(DVec3::new(0.0, 12.0, 34.0), DVec3::new(0.0, 8.0, 0.0), 50.0);
-    b.point_light(DVec3::new(-20.0, 40.0, 30.0), 0.7);
-    b.point_light(DVec3::new(25.0, 30.0, 10.0), 0.5);
-    let floor = b.material(matte(0.6, 0.6, 0.6));
-    b.add(plane_y(-1.0), DMat4::IDENTITY, floor);
-    let shiny = b.material(Material {
-        ambient: Color::gray(0.05),
-        diffuse: Color::new(0.5, 0.3, 0.2),
-        specular: Color::gray(0.6),
-        shininess: 60.0,
-        reflective: Color::gray(0.5),
+    b.settings().max_depth = 5;
+    b.settings().background = Color::new(0.05, 0.05, 0.1);
+    b.camera(
+        DVec3::new(14.0, 12.0, -16.0),
+        DVec3::new(4.5, 3.5, 4.5),
+        45.0,
+    );
+    b.point_light(DVec3::new(20.0, 30.0, -10.0), 1.0);
+    let floor = b.material(Material {
+        ambient: Color::gray(0.1),
+        diffuse: Color::gray(0.6),
         ..Material::default()
     });
-    let unit = |i: u32, salt: u32| {
-        let mut h = i.wrapping_mul(0x9E37_79B9) ^ salt.wrapping_mul(0x85EB_CA6B);
-        h ^= h >> 16;
-        h = h.wrapping_mul(0x7FEB_352D);
-        h ^= h >> 15;
-        h = h.wrapping_mul(0x846C_A68B);
-        h ^= h >> 16;
-        f64::from(h) / f64::from(u32::MAX)
-    };
-    for i in 0..count {
-        let x = unit(i, 1) * 20.0 - 10.0;
-        let y = unit(i, 2) * 20.0;
-        let z = unit(i, 3) * 20.0 - 10.0;
-        let r = 0.3 + unit(i, 4) * 0.5;
-        b.add(sphere(x, y, z, r), DMat4::IDENTITY, shiny);
+    b.add(plane_y(-0.5), DMat4::IDENTITY, floor);
+    for i in 0..10 {
+        for j in 0..10 {
+            for k in 0..10 {
+                let tint = |n: i32| (0.2 + f64::from(n) / 12.0) * 0.7;
+                let material = b.material(Material {
+                    ambient: Color::gray(0.1),
+                    diffuse: Color::new(tint(i), tint(j), tint(k)),
+                    specular: Color::gray(0.5),
+                    shininess: 60.0,
+                    reflective: Color::gray(0.3),
+                    ..Material::default()
+                });
+                b.add(
+                    sphere(f64::from(i), f64::from(j), f64::from(k), 0.35),
+                    DMat4::IDENTITY,
+                    material,
+                );
+            }
+        }
     }
     b
 }
 
-/// An `n × n` grid of matte spheres on the floor, seen from above at an angle.
+/// An `n × n` grid of spheres on a checkered floor, as `scenes/bench/grid.scene` writes it
+/// (each sphere at its place through its transform, as the language lowers it).
 pub fn sphere_grid(n: u32) -> SceneBuilder {
     let mut b = SceneBuilder::new();
     let n_f = f64::from(n.max(1));
-    b.camera(
-        DVec3::new(0.0, n_f * 0.8, n_f * 1.1),
-        DVec3::new(0.0, 0.0, 0.0),
-        50.0,
-    );
-    b.point_light(DVec3::new(n_f, n_f * 2.0, n_f), 1.0);
-    let floor = b.material(matte(0.5, 0.5, 0.5));
-    b.add(plane_y(-0.5), DMat4::IDENTITY, floor);
+    b.camera(DVec3::new(0.0, n_f * 0.8, -n_f * 0.9), DVec3::ZERO, 50.0);
+    b.point_light(DVec3::new(n_f, 2.0 * n_f, -n_f), 1.0);
+    b.light(Light {
+        name: None,
+        color: Color::gray(0.3),
+        kind: LightKind::Directional {
+            direction: DVec3::new(1.0, -1.0, 1.0),
+        },
+    });
+    let tiles = checker(&mut b, matte(1.0, 1.0, 1.0), matte(0.25, 0.25, 0.25), 2.0);
+    b.add(plane_y(-0.5), DMat4::IDENTITY, tiles);
     let ball = b.material(Material {
         specular: Color::gray(0.3),
-        shininess: 20.0,
-        ..matte(0.8, 0.3, 0.3)
+        shininess: 40.0,
+        ..matte(0.8, 0.3, 0.2)
     });
     let half = (n_f - 1.0) / 2.0;
     for i in 0..n {

@@ -113,7 +113,8 @@ impl<'a> Tracer<'a> {
             RayKind::Camera => self.counters.camera += 1,
             RayKind::Reflected => self.counters.reflected += 1,
             RayKind::Transmitted => self.counters.transmitted += 1,
-            RayKind::Shadow => self.counters.shadow += 1,
+            // Shadow rays are queries, not traced paths; they are counted where they are cast.
+            RayKind::Shadow => {}
         }
         self.counters.deepest = self.counters.deepest.max(path.depth);
         let scene = self.scene;
@@ -242,14 +243,14 @@ impl<'a> Tracer<'a> {
         let mut reflect_coefficient = m.reflective;
         let mut transmit_coefficient = Vec3A::ZERO;
         let mut refracted = None;
+        let solid = surface.leaf.geometry.is_solid();
         let mut interface = Interface {
             cos_incidence,
             ior: None,
-            entering: front_face,
+            entering: solid && front_face,
             fresnel_reflectance: None,
             total_internal_reflection: false,
         };
-        let solid = surface.leaf.geometry.is_solid();
         if m.transmissive != Vec3A::ZERO {
             let (from, to) = match (solid, front_face) {
                 (false, _) => (1.0, 1.0),
@@ -260,6 +261,9 @@ impl<'a> Tracer<'a> {
             match refract(d, n, from, to) {
                 None => {
                     interface.total_internal_reflection = true;
+                    if m.schlick {
+                        interface.fresnel_reflectance = Some(1.0);
+                    }
                     reflect_coefficient = m.reflective + m.transmissive;
                 }
                 Some(direction) => {

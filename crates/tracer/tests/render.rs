@@ -71,6 +71,16 @@ fn busy_scene() -> SceneBuilder {
         DMat4::from_translation(DVec3::new(2.0, 0.3, 1.5)),
         tinted,
     );
+    // A ring of small balls, so that the BVH (not the few-object loop) does the work.
+    for i in 0..40 {
+        let angle = f64::from(i) * std::f64::consts::TAU / 40.0;
+        let material = if i % 3 == 0 { shiny } else { blue };
+        b.add(
+            sphere(3.0 * angle.cos(), 0.15, 3.0 * angle.sin() - 1.0, 0.15),
+            DMat4::IDENTITY,
+            material,
+        );
+    }
     b
 }
 

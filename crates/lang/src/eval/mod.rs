@@ -64,8 +64,9 @@ fn inherit() -> Handle<Material> {
 /// Unique errors beyond this many stop evaluation (the rest would be noise).
 const MAX_ERRORS: usize = 100;
 
-/// How deep blocks, expressions and calls may nest while running. Parsing bounds each file's
-/// tree; this bounds what recursion through calls adds on top, so the stack always suffices.
+/// How deep blocks, expressions and calls may nest while running, at most. Parsing bounds
+/// each file's tree; this bounds what recursion through calls adds on top, so the stack
+/// always suffices (the driver lowers it for a smaller stack).
 pub(crate) const MAX_EVALUATION_DEPTH: usize = 20_000;
 
 pub(crate) struct Evaluator<'a> {
@@ -101,6 +102,7 @@ pub(crate) struct Evaluator<'a> {
 
     call_depth: usize,
     depth: usize,
+    max_depth: usize,
     iterations: u64,
     files_run: Vec<bool>,
     camera_span: Option<Span>,
@@ -115,6 +117,7 @@ impl<'a> Evaluator<'a> {
         resolution: &'a Resolution,
         defines: &'a [Define],
         sources: whitted_ir::SourceMap,
+        max_depth: usize,
     ) -> Self {
         let scene = Scene {
             sources,
@@ -143,6 +146,7 @@ impl<'a> Evaluator<'a> {
             scratch: Vec::new(),
             call_depth: 0,
             depth: 0,
+            max_depth,
             iterations: 0,
             files_run: vec![false; program.files.len()],
             camera_span: None,
@@ -201,12 +205,13 @@ impl<'a> Evaluator<'a> {
 
     fn enter(&mut self, span: Span) -> Eval<()> {
         self.depth += 1;
-        if self.depth > MAX_EVALUATION_DEPTH {
+        if self.depth > self.max_depth {
             self.depth -= 1;
+            let limit = self.max_depth;
             return self.fatal(
                 Diagnostic::error(
                     format!(
-                        "the scene nests too deeply while running: more than {MAX_EVALUATION_DEPTH} levels of calls, blocks and expressions"
+                        "the scene nests too deeply while running: more than {limit} levels of calls, blocks and expressions"
                     ),
                     span,
                 )

@@ -745,74 +745,94 @@ impl<'a> Evaluator<'a> {
     // ---- per-block properties --------------------------------------------------------------
 
     fn shape_property(&mut self, prop: Prop, values: &Values, span: Span) -> Eval<()> {
+        /// A converted value, held while `self` reports errors, then stored in place (the
+        /// builder is large; copying it per property showed in profiles).
+        enum Set {
+            Vector(DVec3),
+            Number(f64),
+            Vertices([DVec3; 3]),
+            Coefficients([f64; 10]),
+            Open,
+        }
         let tag = match self.targets.last() {
             Some(Target::Object(b)) => b.tag,
             _ => return Ok(()),
         };
         let (value, value_span) = one(values, span);
-        let shape = crate::schema::article(tag.name());
-        let mut fields = match self.targets.last() {
-            Some(Target::Object(b)) => b.fields,
-            _ => return Ok(()),
-        };
-        match prop {
-            Prop::Center => fields.center = self.as_vector(value, value_span, prop)?,
+        let shape = || crate::schema::article(tag.name());
+        let set = match prop {
+            Prop::Center | Prop::Min | Prop::Max | Prop::Base | Prop::Apex => {
+                Set::Vector(self.as_vector(value, value_span, prop)?)
+            }
+            Prop::Normal => Set::Vector(self.nonzero_vector(value, value_span, prop)?),
+            Prop::Offset => Set::Number(self.as_number(value, value_span, prop)?),
             Prop::Radius => {
                 let x = self.as_number(value, value_span, prop)?;
                 if x <= 0.0 {
                     return self.fail(
                         Diagnostic::error(
-                            format!("{shape}'s radius must be greater than 0, not {x}"),
+                            format!("{}'s radius must be greater than 0, not {x}", shape()),
                             value_span,
                         )
                         .with_label("too small"),
                     );
                 }
-                fields.radius = x;
+                Set::Number(x)
             }
-            Prop::Normal => fields.normal = self.nonzero_vector(value, value_span, prop)?,
-            Prop::Offset => fields.offset = self.as_number(value, value_span, prop)?,
-            Prop::Min => fields.min = self.as_vector(value, value_span, prop)?,
-            Prop::Max => fields.max = self.as_vector(value, value_span, prop)?,
-            Prop::Base => fields.base = self.as_vector(value, value_span, prop)?,
-            Prop::Apex => fields.apex = self.as_vector(value, value_span, prop)?,
             Prop::BaseRadius | Prop::ApexRadius => {
-                let x = self.in_range(value, value_span, prop, 0.0, false, f64::INFINITY)?;
-                if prop == Prop::BaseRadius {
-                    fields.base_radius = x;
-                } else {
-                    fields.apex_radius = x;
-                }
+                Set::Number(self.in_range(value, value_span, prop, 0.0, false, f64::INFINITY)?)
             }
             Prop::Radii => {
                 let v = self.as_vector(value, value_span, prop)?;
                 if v.cmple(DVec3::ZERO).any() {
                     return self.fail(
                         Diagnostic::error(
-                            format!("{shape}'s radii must all be greater than 0"),
+                            format!("{}'s radii must all be greater than 0", shape()),
                             value_span,
                         )
                         .with_label(format!("this is <{}, {}, {}>", v.x, v.y, v.z)),
                     );
                 }
-                fields.radii = v;
+                Set::Vector(v)
             }
             Prop::Vertices => {
+                let mut vertices = [DVec3::ZERO; 3];
                 if let Values::List(list) = values {
-                    for (slot, (value, value_span)) in fields.vertices.iter_mut().zip(list) {
+                    for (slot, (value, value_span)) in vertices.iter_mut().zip(list) {
                         *slot = self.as_vector(*value, *value_span, prop)?;
                     }
                 }
+                Set::Vertices(vertices)
             }
             Prop::Coefficients => {
                 let numbers = self.numbers(values, span, prop, 10)?;
-                fields.coefficients.copy_from_slice(&numbers);
+                let mut coefficients = [0.0; 10];
+                coefficients.copy_from_slice(&numbers);
+                Set::Coefficients(coefficients)
             }
-            Prop::Open => fields.open = true,
+            Prop::Open => Set::Open,
+            _ => return Ok(()),
+        };
+        let Some(Target::Object(b)) = self.targets.last_mut() else {
+            return Ok(());
+        };
+        let f = &mut b.fields;
+        match (prop, set) {
+            (Prop::Center, Set::Vector(v)) => f.center = v,
+            (Prop::Min, Set::Vector(v)) => f.min = v,
+            (Prop::Max, Set::Vector(v)) => f.max = v,
+            (Prop::Base, Set::Vector(v)) => f.base = v,
+            (Prop::Apex, Set::Vector(v)) => f.apex = v,
+            (Prop::Normal, Set::Vector(v)) => f.normal = v,
+            (Prop::Radii, Set::Vector(v)) => f.radii = v,
+            (Prop::Offset, Set::Number(x)) => f.offset = x,
+            (Prop::Radius, Set::Number(x)) => f.radius = x,
+            (Prop::BaseRadius, Set::Number(x)) => f.base_radius = x,
+            (Prop::ApexRadius, Set::Number(x)) => f.apex_radius = x,
+            (_, Set::Vertices(v)) => f.vertices = v,
+            (_, Set::Coefficients(c)) => f.coefficients = c,
+            (_, Set::Open) => f.open = true,
             _ => {}
-        }
-        if let Some(Target::Object(b)) = self.targets.last_mut() {
-            b.fields = fields;
         }
         Ok(())
     }

@@ -147,3 +147,28 @@ fn nan_and_infinity_never_reach_the_ir() {
         );
     }
 }
+
+#[test]
+fn limits_raised_far_past_the_defaults_still_cannot_overflow_the_stack() {
+    let options = CompileOptions {
+        limits: Limits {
+            max_nesting: 10_000_000,
+            max_call_depth: 10_000_000,
+            ..Limits::default()
+        },
+        ..CompileOptions::default()
+    };
+    for input in [
+        format!("let x = {}1{};", "(".repeat(100_000), ")".repeat(100_000)),
+        format!("{}{}", "group {".repeat(100_000), "}".repeat(100_000)),
+        "fn f(n) { f(n + 1) }\nf(0)".to_string(),
+    ] {
+        let compilation = compile_with(&input, &mut MapLoader::default(), &options);
+        let error = compilation.diagnostics.iter().find(|d| d.is_error());
+        assert!(
+            error.is_some_and(|e| e.span.is_some()),
+            "{:?}",
+            compilation.diagnostics
+        );
+    }
+}

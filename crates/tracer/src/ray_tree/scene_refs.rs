@@ -1,12 +1,36 @@
 //! Turning IR handles into the named, located references a ray tree shows: labels and
 //! `file:line:col` come from the `whitted_ir::Scene` that the prepared scene was made from.
 
-use whitted_ir::{Handle, Light, LightKind, Material, Object, ObjectKind, Scene};
+use whitted_ir::{Handle, Light, LightKind, Material, Object, ObjectKind, Scene, Span};
 
 use super::model::{LightRef, MaterialRef, ObjectRef};
 
+/// A reference for a handle the scene does not have: only reachable when the caller passes
+/// a different scene from the one that was prepared. Labelled, not a panic.
+fn unknown(what: &str, handle: u32) -> (u32, Option<String>, String, String, Span) {
+    let label = format!("{what} #{handle} (not in this scene)");
+    (
+        handle,
+        None,
+        label,
+        "<unknown>".to_string(),
+        Span::detached(),
+    )
+}
+
 pub(crate) fn object_ref(scene: &Scene, handle: Handle<Object>) -> ObjectRef {
-    let object = &scene.objects[handle];
+    let Some(object) = scene.objects.get(handle) else {
+        let (handle, name, label, location, span) = unknown("object", handle.index() as u32);
+        let kind = "unknown".to_string();
+        return ObjectRef {
+            handle,
+            name,
+            label,
+            kind,
+            location,
+            span,
+        };
+    };
     let span = scene.objects.span(handle);
     let kind = match &object.kind {
         ObjectKind::Shape { shape } => shape.kind_name(),
@@ -24,6 +48,16 @@ pub(crate) fn object_ref(scene: &Scene, handle: Handle<Object>) -> ObjectRef {
 }
 
 pub(crate) fn material_ref(scene: &Scene, handle: Handle<Material>) -> MaterialRef {
+    if !scene.materials.contains(handle) {
+        let (handle, name, label, location, span) = unknown("material", handle.index() as u32);
+        return MaterialRef {
+            handle,
+            name,
+            label,
+            location,
+            span,
+        };
+    }
     let span = scene.materials.span(handle);
     MaterialRef {
         handle: handle.index() as u32,
@@ -35,7 +69,18 @@ pub(crate) fn material_ref(scene: &Scene, handle: Handle<Material>) -> MaterialR
 }
 
 pub(crate) fn light_ref(scene: &Scene, handle: Handle<Light>) -> LightRef {
-    let light = &scene.lights[handle];
+    let Some(light) = scene.lights.get(handle) else {
+        let (handle, name, label, location, span) = unknown("light", handle.index() as u32);
+        let kind = "unknown".to_string();
+        return LightRef {
+            handle,
+            name,
+            label,
+            kind,
+            location,
+            span,
+        };
+    };
     let span = scene.lights.span(handle);
     let kind = match light.kind {
         LightKind::Point { .. } => "point",
@@ -58,7 +103,11 @@ pub(crate) fn light_ref(scene: &Scene, handle: Handle<Light>) -> LightRef {
 /// The CSG operations from `object` down to (not including) `leaf`: empty when the object
 /// is the leaf. Searched depth first in child order with an explicit stack, so deeply
 /// nested CSG cannot overflow the call stack.
-pub(crate) fn csg_path(scene: &Scene, object: Handle<Object>, leaf: Handle<Object>) -> Vec<ObjectRef> {
+pub(crate) fn csg_path(
+    scene: &Scene,
+    object: Handle<Object>,
+    leaf: Handle<Object>,
+) -> Vec<ObjectRef> {
     if object == leaf {
         return Vec::new();
     }

@@ -425,3 +425,37 @@ fn phong_highlight_matches_the_formula() {
     let total = root.ambient + sample.diffuse + sample.specular;
     assert!(root.color.abs_diff_eq(total, 1e-6));
 }
+
+#[test]
+fn thin_transparent_surfaces_do_not_bend_or_absorb() {
+    let mut b = SceneBuilder::new();
+    let film = b.material(Material {
+        absorption: Color::gray(3.0),
+        ..clear_glass(Fresnel::Off)
+    });
+    b.add(
+        Shape::Disk {
+            center: DVec3::ZERO,
+            normal: DVec3::new(0.3, 0.2, 1.0),
+            radius: 2.0,
+        },
+        DMat4::IDENTITY,
+        film,
+    );
+    let root = shoot(b, DVec3::new(0.5, 0.4, 5.0), DVec3::new(-0.2, 0.1, 0.0), 3);
+    let through = child(&root, RayKind::Transmitted);
+    let interface = through
+        .start
+        .interface
+        .unwrap_or_else(|| panic!("no interface"));
+    assert_eq!(interface.ior, Some((1.0, 1.0)));
+    assert!(!interface.entering);
+    assert!(through
+        .start
+        .direction
+        .abs_diff_eq(root.start.direction, 1e-6));
+    // It travels on in air: the background comes back unabsorbed.
+    assert_eq!(through.termination, Termination::Miss);
+    assert_eq!(through.color, Vec3A::ZERO);
+    assert_eq!(root.color, Vec3A::ZERO);
+}

@@ -1,0 +1,44 @@
+//! Everything the event loop reacts to, from every source: the terminal (keys, mouse,
+//! resize), the render worker (tiles, the end), the reload worker, the file watcher, and the
+//! loop's own timer. A closed enum, so that handling is one exhaustive match.
+
+use std::path::PathBuf;
+
+use ratatui::crossterm::event::{KeyEvent, MouseEvent};
+use whitted_tracer::{PixelStats, RenderStats, TileResult};
+
+use crate::app::{LoadedScene, SceneErrors};
+
+pub enum Event {
+    Key(KeyEvent),
+    Mouse(MouseEvent),
+    Resize(u16, u16),
+    /// The terminal could not be read any more.
+    InputFailed(String),
+    RenderTile {
+        generation: u64,
+        tile: TileResult,
+    },
+    /// The render ended: its statistics, or `None` when it was cancelled.
+    RenderDone {
+        generation: u64,
+        result: Option<(RenderStats, Vec<PixelStats>)>,
+    },
+    /// The renderer crashed (a bug): the panic's message.
+    RenderFailed {
+        generation: u64,
+        message: String,
+    },
+    Reloaded(Reloaded),
+    /// A watched scene file changed on disk.
+    FileChanged,
+    /// The loop's timer: nothing arrived before the next deadline.
+    Tick,
+}
+
+/// The reload worker's answer: the new scene and its warning count, or its errors; and the
+/// files it was made from, to watch from now on.
+pub struct Reloaded {
+    pub result: Result<(LoadedScene, usize), SceneErrors>,
+    pub watch: Vec<PathBuf>,
+}

@@ -1,0 +1,336 @@
+//! The inspector pane: every field of the selected ray (docs/ray-tree.md), colours with
+//! swatches beside their numbers, so the pixel's colour can be read off term by term.
+
+use ratatui::buffer::Buffer;
+use ratatui::layout::Rect;
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Paragraph, Widget, Wrap};
+use whitted_tracer::ray_tree::{
+    HitInfo, InterfaceInfo, LocalIllumination, RayNode, ShadowInfo, ShadowOutcome, Visibility,
+};
+use whitted_tracer::{RayKind, Termination};
+
+use crate::action::Focus;
+use crate::app::App;
+use crate::hit_point::hit_point_view;
+use crate::image_view::ColorDepth;
+use crate::tree_view::{NodeId, TreeView};
+
+use super::format::{self, number, swatch, vector};
+use super::pane_block;
+use super::tree_pane::contribution;
+
+const LABEL_WIDTH: usize = 12;
+
+pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
+    let focused = app.focus == Focus::Inspector;
+    let Some(picked) = &app.picked else {
+        let block = pane_block(Line::from(" Inspector "), focused);
+        Paragraph::new(vec![
+            Line::from("The selected ray's numbers show here."),
+            Line::from(""),
+            Line::from("Press ? for every key."),
+        ])
+        .style(Style::new().fg(Color::Gray))
+        .wrap(Wrap { trim: true })
+        .block(block)
+        .render(pane, buf);
+        return;
+    };
+    let tree = &picked.tree;
+    let id = tree.selected();
+    let Some(node) = tree.node(id) else {
+        return;
+    };
+    let title = format!(" Inspector · {} ray, depth {} ", node.kind.name(), node.depth);
+    let block = pane_block(Line::from(title), focused);
+    let lines = Lines::new(app.color_depth).node(app, tree, id, node);
+    let inner_height = usize::from(block.inner(pane).height);
+    let longest_scroll = lines.len().saturating_sub(inner_height);
+    let scroll = usize::from(app.inspector_scroll).min(longest_scroll);
+    let mut paragraph = Paragraph::new(lines).block(block);
+    if longest_scroll > 0 {
+        paragraph = paragraph.scroll((u16::try_from(scroll).unwrap_or(u16::MAX), 0));
+    }
+    paragraph.render(pane, buf);
+}
+
+/// Builds the inspector's lines: a label column, then values.
+struct Lines {
+    depth: ColorDepth,
+    out: Vec<Line<'static>>,
+}
+
+fn label_style() -> Style {
+    Style::new().fg(Color::Gray)
+}
+
+fn section_style() -> Style {
+    Style::new().add_modifier(Modifier::BOLD)
+}
+
+impl Lines {
+    fn new(depth: ColorDepth) -> Lines {
+        Lines {
+            depth,
+            out: Vec::new(),
+        }
+    }
+
+    fn text(&mut self, label: &str, value: impl Into<String>) {
+        self.out.push(Line::from(vec![
+            Span::styled(format!("{label:<LABEL_WIDTH$} "), label_style()),
+            Span::raw(value.into()),
+        ]));
+    }
+
+    fn color(&mut self, label: &str, c: [f32; 3], note: &str) {
+        let mut spans = vec![
+            Span::styled(format!("{label:<LABEL_WIDTH$} "), label_style()),
+            swatch(c, self.depth),
+            Span::raw(format!(" {}", format::rgb(c))),
+        ];
+        if !note.is_empty() {
+            spans.push(Span::styled(format!("  {note}"), label_style()));
+        }
+        self.out.push(Line::from(spans));
+    }
+
+    fn section(&mut self, title: &str) {
+        self.out
+            .push(Line::from(Span::styled(title.to_string(), section_style())));
+    }
+
+    fn node(mut self, app: &App, tree: &TreeView, id: NodeId, node: &RayNode) -> Vec<Line<'static>> {
+        let whole = tree.tree();
+        let [x, y] = whole.pixel;
+        self.color(&format!("pixel {x},{y}"), whole.color, "its rendered colour");
+        if let Some(sample) = tree.sample(id) {
+            if whole.samples_per_pixel > 1 {
+                self.color(
+                    &format!("sample {}", sample.index),
+                    sample.color,
+                    &format!("of {}", whole.samples_per_pixel),
+                );
+            }
+        }
+        self.section(&format!("{} ray, depth {}", node.kind.name(), node.depth));
+        self.text("origin", vector(node.origin));
+        self.text("direction", vector(node.direction));
+        self.color("path weight", node.weight, "share of the pixel");
+        if matches!(node.kind, RayKind::Reflected | RayKind::Transmitted) {
+            let name = if node.kind == RayKind::Reflected {
+                "kr"
+            } else {
+                "kt"
+            };
+            self.color("coefficient", node.coefficient, name);
+        }
+        if let Some(interface) = &node.interface {
+            self.interface(interface);
+        }
+        if let Some(shadow) = &node.shadow {
+            self.shadow(shadow);
+            if let Some(light) = tree.light_of_shadow(id) {
+                self.color(
+                    "light share",
+                    format::add(light.diffuse, light.specular),
+                    "diffuse + specular at the hit",
+                );
+            }
+            self.color("returned", node.color, "light let through");
+        } else {
+            match &node.hit {
+                Some(hit) => self.hit(hit),
+                None => self.text("hit", "nothing: the ray left the scene"),
+            }
+            if node.hit.is_some() || node.shadow.is_some() {
+                if let Some(view) = hit_point_view(app) {
+                    self.text("on screen", view.describe());
+                }
+            }
+            if let Some(local) = &node.local {
+                self.local(local);
+            }
+            self.color("returned", node.color, "colour sent back up");
+        }
+        self.color(
+            "contributes",
+            contribution(tree, id, node),
+            "to the pixel",
+        );
+        self.text("ended", termination(node));
+        for skipped in &node.skipped {
+            self.text(
+                "not traced",
+                format!(
+                    "{} ray (depth {}): {}",
+                    skipped.kind.name(),
+                    skipped.depth,
+                    reason(skipped.reason)
+                ),
+            );
+            self.color("  weight", skipped.weight, "it would have had");
+        }
+        self.out
+    }
+
+    fn interface(&mut self, interface: &InterfaceInfo) {
+        let side = if interface.entering {
+            "entering the solid"
+        } else {
+            "leaving the solid"
+        };
+        self.text(
+            "leaves from",
+            format!(
+                "incidence {:.1}°, {side}",
+                interface.incidence_degrees
+            ),
+        );
+        if let Some([from, to]) = interface.ior {
+            self.text("ior", format!("{} → {}", number(from), number(to)));
+        }
+        if let (Some(r), Some(t)) = (
+            interface.fresnel_reflectance,
+            interface.fresnel_transmittance,
+        ) {
+            self.text("Fresnel", format!("R {}  T {}", number(r), number(t)));
+        }
+        if interface.total_internal_reflection {
+            self.text("", "total internal reflection");
+        }
+    }
+
+    fn hit(&mut self, hit: &HitInfo) {
+        self.section("hit");
+        self.text(
+            "t, point",
+            format!("{}  {}", number(hit.t), vector(hit.point)),
+        );
+        self.text(
+            "object",
+            format!("{} ({})  {}", hit.object.label, hit.object.kind, hit.object.location),
+        );
+        if hit.leaf.handle != hit.object.handle {
+            self.text(
+                "leaf",
+                format!("{} ({})  {}", hit.leaf.label, hit.leaf.kind, hit.leaf.location),
+            );
+        }
+        if !hit.csg_path.is_empty() {
+            let path: Vec<String> = hit
+                .csg_path
+                .iter()
+                .map(|o| format!("{} {}", o.kind, o.label))
+                .collect();
+            self.text("csg", path.join(" › "));
+        }
+        self.text(
+            "face",
+            if hit.front_face {
+                "front (outside)"
+            } else {
+                "back (from inside)"
+            },
+        );
+        self.text("normal", format!("geometric {}", vector(hit.geometric_normal)));
+        self.text("", format!("shading   {}", vector(hit.shading_normal)));
+        self.text(
+            "material",
+            format!("{}  {}", hit.material.label, hit.material.location),
+        );
+        if hit.resolved_material.handle != hit.material.handle {
+            self.text("pattern →", hit.resolved_material.label.clone());
+        }
+        if hit.absorption != [1.0; 3] {
+            self.color("absorption", hit.absorption, "Beer-Lambert on the way here");
+        }
+    }
+
+    fn local(&mut self, local: &LocalIllumination) {
+        self.section("local illumination");
+        self.color("ambient", local.ambient, "ka·Ia·kd");
+        for light in &local.lights {
+            let mut facts = vec![
+                match light.visibility {
+                    Visibility::Lit => "lit".to_string(),
+                    Visibility::Filtered => "filtered".to_string(),
+                    Visibility::Blocked => "in shadow".to_string(),
+                    Visibility::NotFacing => "faces away (no shadow ray)".to_string(),
+                },
+                format!("N·L {}", number(light.n_dot_l)),
+            ];
+            if light.attenuation != 1.0 {
+                facts.push(format!("fatt {}", number(light.attenuation)));
+            }
+            if light.spot != 1.0 {
+                facts.push(format!("spot {}", number(light.spot)));
+            }
+            self.text(&format!("light {}", light.light.label), facts.join(" · "));
+            self.color("  diffuse", light.diffuse, "kd·(N·L)");
+            self.color("  specular", light.specular, "ks·(R·V)^n");
+        }
+        self.color("local total", local.total, "");
+    }
+
+    fn shadow(&mut self, shadow: &ShadowInfo) {
+        self.text(
+            "towards",
+            format!(
+                "{} ({})  {}",
+                shadow.light.label, shadow.light.kind, shadow.light.location
+            ),
+        );
+        self.text(
+            "max t",
+            match shadow.max_t {
+                Some(t) => number(t),
+                None => "none (directional light)".to_string(),
+            },
+        );
+        let result = match shadow.result {
+            ShadowOutcome::Unblocked => "reached the light".to_string(),
+            ShadowOutcome::Blocked => match &shadow.blocker {
+                Some(blocker) => format!(
+                    "blocked by {} at t {}  {}",
+                    blocker.object.label,
+                    number(blocker.t),
+                    blocker.object.location
+                ),
+                None => "blocked".to_string(),
+            },
+            ShadowOutcome::Filtered => format!(
+                "filtered through {} object(s)",
+                shadow.filters.unwrap_or(0)
+            ),
+        };
+        self.text("result", result);
+        if let Some(transmittance) = shadow.transmittance {
+            self.color("transmittance", transmittance, "");
+        }
+    }
+}
+
+fn termination(node: &RayNode) -> String {
+    let shadow = node.kind == RayKind::Shadow;
+    match node.termination {
+        Termination::NotEnded => "not ended: it spawned secondary rays".to_string(),
+        Termination::Miss if shadow => "reached the light".to_string(),
+        Termination::Miss => "miss: the background colour returns".to_string(),
+        Termination::Absorbed if shadow => "stopped by a blocker".to_string(),
+        other => reason(other).to_string(),
+    }
+}
+
+fn reason(termination: Termination) -> &'static str {
+    match termination {
+        Termination::NotEnded => "not ended",
+        Termination::Miss => "miss",
+        Termination::MaxDepth => "max depth: a deeper ray would pass the depth limit",
+        Termination::WeightCutoff => "weight cut-off: it would weigh less than min_weight",
+        Termination::TotalInternalReflection => "total internal reflection",
+        Termination::Absorbed => "absorbed: the surface neither reflects nor transmits",
+    }
+}

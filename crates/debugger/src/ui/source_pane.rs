@@ -1,0 +1,172 @@
+//! The source pane: the scene text around the definition of the selected ray's object (or,
+//! with `m`, its material), the definition highlighted, titled with its file:line.
+
+use ratatui::buffer::Buffer;
+use ratatui::layout::Rect;
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Paragraph, Widget, Wrap};
+use whitted_ir::{SourceMap, Span as SourceSpan};
+use whitted_tracer::ray_tree::ShadowOutcome;
+
+use crate::app::{App, SourceTarget};
+
+use super::pane_block;
+
+/// What the pane shows: a definition's span and what to call it.
+struct Target {
+    span: SourceSpan,
+    what: String,
+}
+
+pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
+    let (target, note) = target(app);
+    let Some(target) = target else {
+        let block = pane_block(Line::from(" Source "), false);
+        Paragraph::new(Line::from(note))
+            .style(Style::new().fg(Color::Gray))
+            .wrap(Wrap { trim: true })
+            .block(block)
+            .render(pane, buf);
+        return;
+    };
+    let sources = &app.loaded.scene.sources;
+    let location = sources.location(target.span);
+    let title = format!(" Source · {location} · {} ", target.what);
+    let block = pane_block(Line::from(title), false);
+    let area = block.inner(pane);
+    block.render(pane, buf);
+    let lines = excerpt(sources, target.span, area.height);
+    match lines {
+        Some(lines) => Paragraph::new(lines).render(area, buf),
+        None => Paragraph::new(format!("{} was not written in a scene file.", target.what))
+            .style(Style::new().fg(Color::Gray))
+            .wrap(Wrap { trim: true })
+            .render(area, buf),
+    }
+}
+
+/// The definition to show for the selected ray, or a note saying why there is none.
+fn target(app: &App) -> (Option<Target>, String) {
+    let Some(picked) = &app.picked else {
+        return (None, "The definition of what the selected ray hit shows here.".into());
+    };
+    let Some(node) = picked.tree.selected_node() else {
+        return (None, String::new());
+    };
+    if let Some(shadow) = &node.shadow {
+        let blocker = shadow
+            .blocker
+            .as_ref()
+            .filter(|_| shadow.result == ShadowOutcome::Blocked);
+        let target = match blocker {
+            Some(blocker) => Target {
+                span: blocker.leaf.span,
+                what: format!("blocker {}", blocker.leaf.label),
+            },
+            None => Target {
+                span: shadow.light.span,
+                what: format!("light {}", shadow.light.label),
+            },
+        };
+        return (Some(target), String::new());
+    }
+    let Some(hit) = &node.hit else {
+        return (
+            None,
+            "The ray hit nothing: it returns the scene's background colour.".into(),
+        );
+    };
+    let target = match app.source_target {
+        SourceTarget::Object => Target {
+            span: hit.leaf.span,
+            what: hit.leaf.label.clone(),
+        },
+        SourceTarget::Material => Target {
+            span: hit.material.span,
+            what: format!("material {}", hit.material.label),
+        },
+    };
+    (Some(target), String::new())
+}
+
+/// Up to `height` numbered lines around `span`, its text highlighted; `None` when the span
+/// points into no file (a built-in default).
+fn excerpt(sources: &SourceMap, span: SourceSpan, height: u16) -> Option<Vec<Line<'static>>> {
+    let file = sources.get(span.file)?;
+    let start = file.line_col(span.start);
+    let end = file.line_col(span.end);
+    let height = u32::from(height.max(1));
+    // The definition's first line a third of the way down, when the file allows.
+    let first = start
+        .line
+        .saturating_sub(height / 3)
+        .max(1)
+        .min(file.line_count().saturating_sub(height - 1).max(1));
+    let last = (first + height - 1).min(file.line_count());
+    let gutter = last.to_string().len();
+    let highlight = Style::new()
+        .fg(Color::Yellow)
+        .add_modifier(Modifier::BOLD);
+    let mut lines = Vec::new();
+    for number in first..=last {
+        let text = file.line_text(number).replace('\t', "    ");
+        let mut spans = vec![Span::styled(
+            format!("{number:>gutter$} │ "),
+            Style::new().fg(Color::DarkGray),
+        )];
+        let in_span = number >= start.line && number <= end.line;
+        if in_span {
+            // Columns are 1-based characters; the end column is exclusive.
+            let from = if number == start.line {
+                start.column as usize - 1
+            } else {
+                0
+            };
+            let to = if number == end.line {
+                end.column as usize - 1
+            } else {
+                usize::MAX
+            };
+            let chars: Vec<char> = text.chars().collect();
+            let from = from.min(chars.len());
+            let to = to.min(chars.len()).max(from);
+            spans.push(Span::raw(chars[..from].iter().collect::<String>()));
+            spans.push(Span::styled(
+                chars[from..to].iter().collect::<String>(),
+                highlight,
+            ));
+            spans.push(Span::raw(chars[to..].iter().collect::<String>()));
+        } else {
+            spans.push(Span::raw(text));
+        }
+        lines.push(Line::from(spans));
+    }
+    Some(lines)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use whitted_ir::SourceFile;
+
+    #[test]
+    fn the_excerpt_highlights_exactly_the_span() {
+        let mut sources = SourceMap::new();
+        let text = "a\nb\nsphere \"s\" {\n  radius 1\n}\nc\n";
+        let file = sources.add(SourceFile::new("x.scene", text));
+        let start = text.find("sphere").unwrap();
+        let end = text.find("}").unwrap() + 1;
+        let lines = excerpt(&sources, whitted_ir::Span::new(file, start, end), 4).unwrap();
+        let rendered: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+        assert_eq!(
+            rendered,
+            ["2 │ b", "3 │ sphere \"s\" {", "4 │   radius 1", "5 │ }"]
+        );
+        // Line 3: gutter, nothing before, the highlighted definition, nothing after.
+        assert_eq!(lines[1].spans[2].content, "sphere \"s\" {");
+        assert_eq!(lines[1].spans[2].style.fg, Some(Color::Yellow));
+        assert_eq!(lines[0].spans.len(), 2, "line 2 is outside the span");
+        assert!(excerpt(&sources, whitted_ir::Span::detached(), 4).is_none());
+    }
+}

@@ -1,0 +1,154 @@
+//! The ray-tree pane: one row per ray — kind, depth, what it hit (or why it ended) and its
+//! contribution to the pixel, with a swatch — indented under the ray that spawned it.
+
+use ratatui::buffer::Buffer;
+use ratatui::layout::Rect;
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Paragraph, Widget, Wrap};
+use whitted_tracer::ray_tree::{RayNode, ShadowOutcome};
+use whitted_tracer::{RayKind, Termination};
+
+use crate::action::Focus;
+use crate::app::App;
+use crate::tree_view::{NodeId, TreeView};
+
+use super::format::{self, swatch};
+use super::pane_block;
+
+pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
+    let focused = app.focus == Focus::Tree;
+    let Some(picked) = &app.picked else {
+        let block = pane_block(Line::from(" Ray tree "), focused);
+        let text = vec![
+            Line::from("No pixel picked yet."),
+            Line::from("Move the cursor (arrows, hjkl) and press Enter, or click the image."),
+        ];
+        Paragraph::new(text)
+            .style(Style::new().fg(Color::Gray))
+            .wrap(Wrap { trim: true })
+            .block(block)
+            .render(pane, buf);
+        return;
+    };
+    let tree = &picked.tree;
+    let [x, y] = tree.tree().pixel;
+    let title = format!(
+        " Ray tree of ({x}, {y}) · {} rays ",
+        tree.len()
+    );
+    let block = pane_block(Line::from(title), focused);
+    let area = block.inner(pane);
+    block.render(pane, buf);
+
+    let visible = tree.visible();
+    let rows = visible
+        .iter()
+        .skip(tree.scroll())
+        .take(usize::from(area.height));
+    for (row, &id) in rows.enumerate() {
+        let line = row_line(app, tree, id, usize::from(area.width));
+        let selected = id == tree.selected();
+        let style = match (selected, focused) {
+            (true, true) => Style::new().add_modifier(Modifier::REVERSED),
+            (true, false) => Style::new().bg(Color::DarkGray),
+            _ => Style::new(),
+        };
+        let row_area = Rect::new(area.x, area.y + row as u16, area.width, 1);
+        buf.set_style(row_area, style);
+        line.render(row_area, buf);
+    }
+}
+
+/// One ray's row, fitted to `width` columns: the label is cut first, the numbers last.
+fn row_line(app: &App, tree: &TreeView, id: NodeId, width: usize) -> Line<'static> {
+    let Some(node) = tree.node(id) else {
+        return Line::default();
+    };
+    let indent = "  ".repeat(tree.level(id));
+    let marker = match (tree.has_children(id), tree.is_open(id)) {
+        (false, _) => "  ",
+        (true, true) => "▼ ",
+        (true, false) => "▶ ",
+    };
+    let head = format!("{indent}{marker}{:<11} d{} ", node.kind.name(), node.depth);
+    let contribution = contribution(tree, id, node);
+    let numbers = format!(" {}", format::rgb(contribution));
+    // Columns: head, label, swatch (2), numbers; drop the numbers when the pane is narrow.
+    let show_numbers = width >= head.chars().count() + 12 + 2 + numbers.len();
+    let tail = 2 + if show_numbers { numbers.len() } else { 0 };
+    let label_width = width.saturating_sub(head.chars().count() + tail + 1);
+    let label = format!(
+        "{:<label_width$}",
+        format::truncate(&describe(node), label_width)
+    );
+    let kind_style = Style::new().fg(match node.kind {
+        RayKind::Camera => Color::LightBlue,
+        RayKind::Reflected => Color::LightCyan,
+        RayKind::Transmitted => Color::LightGreen,
+        RayKind::Shadow => Color::Gray,
+    });
+    let mut spans = vec![
+        Span::styled(head, kind_style),
+        Span::raw(label),
+        Span::raw(" "),
+        swatch(contribution, app.color_depth),
+    ];
+    if show_numbers {
+        spans.push(Span::raw(numbers));
+    }
+    Line::from(spans)
+}
+
+/// What the ray met: the object it hit, a miss, or for a shadow ray its light and blocker;
+/// plus why recursion stopped when that is worth a glance.
+fn describe(node: &RayNode) -> String {
+    if let Some(shadow) = &node.shadow {
+        let light = &shadow.light.label;
+        return match shadow.result {
+            ShadowOutcome::Unblocked => format!("→ {light}: lit"),
+            ShadowOutcome::Filtered => format!("→ {light}: filtered"),
+            ShadowOutcome::Blocked => match &shadow.blocker {
+                Some(blocker) => format!("→ {light}: blocked by {}", blocker.object.label),
+                None => format!("→ {light}: blocked"),
+            },
+        };
+    }
+    let mut text = match &node.hit {
+        Some(hit) if hit.leaf.handle != hit.object.handle => {
+            format!("{} ({})", hit.object.label, hit.leaf.label)
+        }
+        Some(hit) => hit.object.label.clone(),
+        None => "miss (background)".to_string(),
+    };
+    if node.hit.as_ref().is_some_and(|h| !h.front_face) {
+        text.push_str(" from inside");
+    }
+    let ended = match node.termination {
+        Termination::MaxDepth => Some("max depth"),
+        Termination::WeightCutoff => Some("weight cut-off"),
+        Termination::TotalInternalReflection => Some("total internal reflection"),
+        Termination::Absorbed => Some("absorbed"),
+        Termination::NotEnded | Termination::Miss => None,
+    };
+    if let Some(ended) = ended {
+        text.push_str(&format!(" · {ended}"));
+    }
+    text
+}
+
+/// How much of the pixel this ray accounts for: its path weight times the colour it
+/// returned, over the sample count. A shadow ray accounts for its light's diffuse and
+/// specular terms at the hit that cast it.
+pub fn contribution(tree: &TreeView, id: NodeId, node: &RayNode) -> [f32; 3] {
+    let samples = tree.tree().samples_per_pixel.max(1) as f32;
+    let share = if node.kind == RayKind::Shadow {
+        match tree.light_of_shadow(id) {
+            Some(light) => format::mul(node.weight, format::add(light.diffuse, light.specular)),
+            None => [0.0; 3],
+        }
+    } else {
+        format::mul(node.weight, node.color)
+    };
+    format::scale(share, 1.0 / samples)
+}

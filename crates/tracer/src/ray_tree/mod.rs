@@ -1,0 +1,23 @@
+//! Ray trees: every ray behind one pixel, with its numbers, recorded from the renderer's own
+//! code path. [`trace_pixel`] records a pixel; [`format_text`] prints it for people and
+//! [`RayTree::document`] is its versioned JSON form (`docs/ray-tree.md`).
+
+mod json;
+mod model;
+mod pixel;
+mod scene_refs;
+mod text;
+mod tree_recorder;
+
+#[cfg(test)]
+mod tests;
+
+pub use json::RayTreeDocument;
+pub use model::{
+    Blocker, HitInfo, InterfaceInfo, LightContribution, LightRef, LocalIllumination, MaterialRef,
+    ObjectRef, RayNode, RayTree, SampleChoice, SampleTree, ShadowInfo, ShadowOutcome, SkippedInfo,
+    Visibility, RAY_TREE_JSON_VERSION,
+};
+pub use pixel::{check_request, trace_pixel, TraceError};
+pub use text::{format_text, TextOptions};
+pub use tree_recorder::TreeRecorder;

@@ -1,0 +1,138 @@
+//! `trace_pixel`: one pixel's ray tree, recorded from the same code path `render` runs, with
+//! the pixel's colour averaged exactly as `render` averages it.
+
+use std::fmt;
+
+use whitted_ir::Scene;
+
+use super::model::{RayTree, SampleChoice, SampleTree};
+use super::tree_recorder::TreeRecorder;
+use crate::recorder::NoRecord;
+use crate::render::{trace_pixel_with, PixelAccumulator, RenderOptions};
+use crate::scene::PreparedScene;
+
+/// Why a pixel's tree could not be recorded.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum TraceError {
+    PixelOutOfRange {
+        x: u32,
+        y: u32,
+        width: u32,
+        height: u32,
+    },
+    SampleOutOfRange {
+        sample: u32,
+        samples_per_pixel: u32,
+    },
+}
+
+impl fmt::Display for TraceError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            TraceError::PixelOutOfRange {
+                x,
+                y,
+                width,
+                height,
+            } => write!(
+                f,
+                "pixel ({x}, {y}) is outside the {width}x{height} image \
+                 (x must be 0 to {}, y 0 to {})",
+                width.saturating_sub(1),
+                height.saturating_sub(1)
+            ),
+            TraceError::SampleOutOfRange {
+                sample,
+                samples_per_pixel: 1,
+            } => write!(
+                f,
+                "there is no sample {sample}: the image has 1 sample per pixel (sample 0)"
+            ),
+            TraceError::SampleOutOfRange {
+                sample,
+                samples_per_pixel,
+            } => write!(
+                f,
+                "there is no sample {sample}: the image has {samples_per_pixel} samples per \
+                 pixel (0 to {})",
+                samples_per_pixel - 1
+            ),
+        }
+    }
+}
+
+impl std::error::Error for TraceError {}
+
+/// Checks that pixel `(x, y)` and the chosen sample exist at these options, as
+/// [`trace_pixel`] does: callers can fail fast before preparing a big scene.
+pub fn check_request(
+    options: &RenderOptions,
+    x: u32,
+    y: u32,
+    which: SampleChoice,
+) -> Result<(), TraceError> {
+    if x >= options.width || y >= options.height {
+        return Err(TraceError::PixelOutOfRange {
+            x,
+            y,
+            width: options.width,
+            height: options.height,
+        });
+    }
+    let samples_per_pixel = options.samples();
+    match which {
+        SampleChoice::One(sample) if sample >= samples_per_pixel => {
+            Err(TraceError::SampleOutOfRange {
+                sample,
+                samples_per_pixel,
+            })
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Records the ray tree of pixel `(x, y)`: every sample, or only `which`. Samples that are
+/// not recorded are still traced (without a recorder) so that `RayTree::color` is the pixel
+/// exactly as `render` computes it, bit for bit.
+///
+/// `scene` must be the scene `prepared` was made from: it supplies names and locations.
+pub fn trace_pixel(
+    prepared: &PreparedScene,
+    scene: &Scene,
+    options: &RenderOptions,
+    x: u32,
+    y: u32,
+    which: SampleChoice,
+) -> Result<RayTree, TraceError> {
+    check_request(options, x, y, which)?;
+    let samples_per_pixel = options.samples();
+    let mut recorder = TreeRecorder::new(scene);
+    let mut accumulator = PixelAccumulator::new();
+    let mut samples = Vec::new();
+    for index in 0..samples_per_pixel {
+        let recorded = match which {
+            SampleChoice::All => true,
+            SampleChoice::One(k) => k == index,
+        };
+        let color = if recorded {
+            let color = trace_pixel_with(prepared, options, x, y, index, &mut recorder);
+            // The tracer always finishes the camera ray it started, so a root exists.
+            if let Some(root) = recorder.take_root() {
+                samples.push(SampleTree { index, color, root });
+            }
+            color
+        } else {
+            trace_pixel_with(prepared, options, x, y, index, &mut NoRecord)
+        };
+        accumulator.add(color);
+    }
+    Ok(RayTree {
+        pixel: [x, y],
+        image_size: [options.width, options.height],
+        color: accumulator.mean(),
+        samples_per_pixel,
+        max_depth: options.depth_limit(),
+        min_weight: options.min_weight,
+        samples,
+    })
+}

@@ -1,0 +1,390 @@
+//! The readable form of a ray tree (`whitted trace` without `--json`): an indented tree, one
+//! header line per ray and a few detail lines under it, numbers rounded for reading.
+
+use std::fmt::Write;
+
+use super::model::{
+    HitInfo, InterfaceInfo, LightContribution, LightRef, ObjectRef, RayNode, RayTree, ShadowInfo,
+    ShadowOutcome, Visibility,
+};
+use crate::recorder::{RayKind, Termination};
+
+/// How to print a tree.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TextOptions {
+    /// Put a coloured swatch (ANSI truecolor background) before every colour. Only for
+    /// terminals that asked for colour.
+    pub swatches: bool,
+}
+
+/// The whole tree as text, ending with a newline.
+pub fn format_text(tree: &RayTree, options: TextOptions) -> String {
+    let printer = Printer { options };
+    let mut out = String::new();
+    let [x, y] = tree.pixel;
+    let [width, height] = tree.image_size;
+    let _ = writeln!(
+        out,
+        "pixel ({x}, {y}) of {width}x{height}: {}",
+        printer.color(tree.color)
+    );
+    let _ = writeln!(
+        out,
+        "{} per pixel, max depth {}, min weight {}",
+        plural(tree.samples_per_pixel, "sample"),
+        tree.max_depth,
+        num(tree.min_weight)
+    );
+    for sample in &tree.samples {
+        out.push('\n');
+        let _ = writeln!(
+            out,
+            "sample {} of {}: {}",
+            sample.index,
+            tree.samples_per_pixel,
+            printer.color(sample.color)
+        );
+        printer.node(&mut out, &sample.root, "", None);
+    }
+    out
+}
+
+struct Printer {
+    options: TextOptions,
+}
+
+impl Printer {
+    /// Prints `node` and its subtree. `prefix` is the indentation of the node's own line;
+    /// `last` is `None` for the root, otherwise whether it is its parent's last child.
+    fn node(&self, out: &mut String, node: &RayNode, prefix: &str, last: Option<bool>) {
+        let (connector, below) = match last {
+            None => ("", prefix.to_string()),
+            Some(false) => ("├─ ", format!("{prefix}│  ")),
+            Some(true) => ("└─ ", format!("{prefix}   ")),
+        };
+        let _ = writeln!(out, "{prefix}{connector}{}", self.header(node));
+        let detail_prefix = if node.children.is_empty() {
+            format!("{below}  ")
+        } else {
+            format!("{below}│ ")
+        };
+        for line in self.details(node) {
+            let _ = writeln!(out, "{detail_prefix}{line}");
+        }
+        let count = node.children.len();
+        for (i, child) in node.children.iter().enumerate() {
+            self.node(out, child, &below, Some(i + 1 == count));
+        }
+    }
+
+    fn header(&self, node: &RayNode) -> String {
+        let kind = node.kind.name();
+        if let Some(shadow) = &node.shadow {
+            return format!(
+                "{kind} to {}: {}",
+                shadow.light.label,
+                self.shadow_outcome(shadow)
+            );
+        }
+        let target = match &node.hit {
+            Some(hit) => format!("hit {} at t {}", hit.object.label, num(hit.t)),
+            None => "miss".to_string(),
+        };
+        format!(
+            "{kind} depth {}: {target} -> {} ({})",
+            node.depth,
+            self.color(node.color),
+            termination_text(node.termination)
+        )
+    }
+
+    fn details(&self, node: &RayNode) -> Vec<String> {
+        let mut lines = vec![format!(
+            "ray        origin {} direction {}",
+            vector(node.origin),
+            vector(node.direction)
+        )];
+        if node.kind == RayKind::Shadow {
+            if let Some(shadow) = &node.shadow {
+                lines.extend(shadow_details(shadow));
+            }
+            return lines;
+        }
+        if node.kind != RayKind::Camera {
+            lines.push(format!(
+                "weight     {} (coefficient {})",
+                self.color(node.weight),
+                self.color(node.coefficient)
+            ));
+        }
+        if let Some(interface) = &node.interface {
+            lines.push(format!("interface  {}", interface_text(interface)));
+        }
+        if let Some(hit) = &node.hit {
+            lines.extend(self.hit_details(hit));
+        }
+        if let Some(local) = &node.local {
+            lines.push(format!("ambient    {}", self.color(local.ambient)));
+            for light in &local.lights {
+                lines.push(self.light_line(light));
+            }
+            lines.push(format!("local      {}", self.color(local.total)));
+        }
+        for skipped in &node.skipped {
+            // A transmission lost to total internal reflection has no weight of its own: it
+            // went to the reflected ray.
+            let weight = match skipped.reason {
+                Termination::TotalInternalReflection => String::new(),
+                _ => format!(" (weight {})", self.color(skipped.weight)),
+            };
+            lines.push(format!(
+                "skipped    {} ray at depth {}: {}{weight}",
+                skipped.kind.name(),
+                skipped.depth,
+                termination_text(skipped.reason),
+            ));
+        }
+        lines
+    }
+
+    fn hit_details(&self, hit: &HitInfo) -> Vec<String> {
+        let mut lines = vec![
+            format!(
+                "point      {} ({} face)",
+                vector(hit.point),
+                if hit.front_face { "front" } else { "back" }
+            ),
+            format!(
+                "normal     {} (shading {})",
+                vector(hit.geometric_normal),
+                vector(hit.shading_normal)
+            ),
+            format!("object     {}", object_text(&hit.object)),
+        ];
+        if hit.leaf.handle != hit.object.handle {
+            let path: Vec<&str> = hit.csg_path.iter().map(|o| o.label.as_str()).collect();
+            lines.push(format!(
+                "leaf       {} via {}",
+                object_text(&hit.leaf),
+                path.join(" > ")
+            ));
+        }
+        let material = &hit.material;
+        if hit.resolved_material.handle == material.handle {
+            lines.push(format!(
+                "material   {} ({})",
+                material.label, material.location
+            ));
+        } else {
+            lines.push(format!(
+                "material   {} ({}), here {} ({})",
+                material.label,
+                material.location,
+                hit.resolved_material.label,
+                hit.resolved_material.location
+            ));
+        }
+        if hit.absorption != [1.0; 3] {
+            lines.push(format!("absorption {}", self.color(hit.absorption)));
+        }
+        lines
+    }
+
+    fn light_line(&self, light: &LightContribution) -> String {
+        let shadow = match (light.visibility, light.shadow_child) {
+            (Visibility::NotFacing, _) => "no shadow ray".to_string(),
+            (visibility, Some(index)) => {
+                format!("shadow ray {index}: {}", visibility_text(visibility))
+            }
+            (visibility, None) => visibility_text(visibility).to_string(),
+        };
+        format!(
+            "{}: N.L {} fatt {} spot {} diffuse {} specular {}, {shadow}",
+            light_text(&light.light),
+            num(light.n_dot_l),
+            num(light.attenuation),
+            num(light.spot),
+            self.color(light.diffuse),
+            self.color(light.specular),
+        )
+    }
+
+    fn shadow_outcome(&self, shadow: &ShadowInfo) -> String {
+        match (shadow.result, &shadow.blocker) {
+            (ShadowOutcome::Blocked, Some(blocker)) => {
+                format!(
+                    "blocked by {} at t {}",
+                    blocker.object.label,
+                    num(blocker.t)
+                )
+            }
+            (ShadowOutcome::Blocked, None) => "blocked".to_string(),
+            (ShadowOutcome::Unblocked, _) => "unblocked".to_string(),
+            (ShadowOutcome::Filtered, _) => {
+                let through = shadow.filters.map_or(String::new(), |n| {
+                    format!(" through {}", plural(n, "transmissive object"))
+                });
+                let transmittance = shadow.transmittance.map_or(String::new(), |t| {
+                    format!(", transmittance {}", self.color(t))
+                });
+                format!("filtered{through}{transmittance}")
+            }
+        }
+    }
+
+    fn color(&self, c: [f32; 3]) -> String {
+        let numbers = format!("rgb({}, {}, {})", num(c[0]), num(c[1]), num(c[2]));
+        if self.options.swatches {
+            let [r, g, b] = c.map(srgb8);
+            format!("\x1b[48;2;{r};{g};{b}m  \x1b[0m {numbers}")
+        } else {
+            numbers
+        }
+    }
+}
+
+fn shadow_details(shadow: &ShadowInfo) -> Vec<String> {
+    let mut lines = vec![match shadow.max_t {
+        Some(t) => format!("light      {} at distance {}", shadow.light.label, num(t)),
+        None => format!("light      {} (directional)", shadow.light.label),
+    }];
+    if let Some(blocker) = &shadow.blocker {
+        lines.push(format!("blocker    {}", object_text(&blocker.object)));
+        if blocker.leaf.handle != blocker.object.handle {
+            lines.push(format!("leaf       {}", object_text(&blocker.leaf)));
+        }
+    }
+    lines
+}
+
+fn interface_text(interface: &InterfaceInfo) -> String {
+    // Which side was hit shows on the parent's hit (front or back face), and the ior pair
+    // says which way light crosses; `entering` is in the JSON.
+    let mut text = format!("incidence {}°", num(interface.incidence_degrees));
+    if let Some([from, to]) = interface.ior {
+        let _ = write!(text, ", ior {} -> {}", num(from), num(to));
+    }
+    if let (Some(r), Some(t)) = (
+        interface.fresnel_reflectance,
+        interface.fresnel_transmittance,
+    ) {
+        let _ = write!(text, ", Fresnel R {} T {}", num(r), num(t));
+    }
+    if interface.total_internal_reflection {
+        text.push_str(", total internal reflection");
+    }
+    text
+}
+
+fn object_text(object: &ObjectRef) -> String {
+    match &object.name {
+        Some(name) => format!(
+            "{name} ({} #{}, {})",
+            object.kind, object.handle, object.location
+        ),
+        None => format!("{} ({})", object.label, object.location),
+    }
+}
+
+/// `light sun`, or `light #0` for an unnamed light.
+fn light_text(light: &LightRef) -> String {
+    match &light.name {
+        Some(name) => format!("light {name}"),
+        None => light.label.clone(),
+    }
+}
+
+fn visibility_text(visibility: Visibility) -> &'static str {
+    match visibility {
+        Visibility::Lit => "lit",
+        Visibility::Filtered => "filtered",
+        Visibility::Blocked => "blocked",
+        Visibility::NotFacing => "not facing",
+    }
+}
+
+fn termination_text(termination: Termination) -> &'static str {
+    match termination {
+        Termination::NotEnded => "not ended",
+        Termination::Miss => "miss",
+        Termination::MaxDepth => "max depth",
+        Termination::WeightCutoff => "weight cut-off",
+        Termination::TotalInternalReflection => "total internal reflection",
+        Termination::Absorbed => "absorbed",
+    }
+}
+
+fn plural(n: u32, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
+/// At most four decimals, trailing zeros dropped, and no `-0`.
+fn num(value: f32) -> String {
+    if !value.is_finite() {
+        return value.to_string();
+    }
+    let text = format!("{value:.4}");
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &text
+    };
+    if text == "-0" {
+        "0".to_string()
+    } else {
+        text.to_string()
+    }
+}
+
+fn vector(v: [f32; 3]) -> String {
+    format!("({}, {}, {})", num(v[0]), num(v[1]), num(v[2]))
+}
+
+/// The 8-bit sRGB value of a linear channel, clamped, for swatches.
+fn srgb8(linear: f32) -> u8 {
+    let v = if linear.is_nan() {
+        0.0
+    } else {
+        linear.clamp(0.0, 1.0)
+    };
+    let encoded = if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    };
+    (encoded * 255.0 + 0.5) as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_short_and_never_negative_zero() {
+        assert_eq!(num(1.0), "1");
+        assert_eq!(num(0.5), "0.5");
+        assert_eq!(num(-0.00001), "0");
+        assert_eq!(num(2.123_456), "2.1235");
+        assert_eq!(num(-3.25), "-3.25");
+        assert_eq!(num(f32::INFINITY), "inf");
+    }
+
+    #[test]
+    fn swatches_are_ansi_truecolor_backgrounds() {
+        let printer = Printer {
+            options: TextOptions { swatches: true },
+        };
+        assert_eq!(
+            printer.color([1.0, 0.0, 0.5]),
+            "\x1b[48;2;255;0;188m  \x1b[0m rgb(1, 0, 0.5)"
+        );
+        let plain = Printer {
+            options: TextOptions::default(),
+        };
+        assert_eq!(plain.color([0.5, 0.25, 0.0]), "rgb(0.5, 0.25, 0)");
+    }
+}

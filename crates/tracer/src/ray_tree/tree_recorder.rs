@@ -1,0 +1,242 @@
+//! The recorder that builds a ray tree: it listens to the one tracing code path (see
+//! `recorder.rs` for the order of hooks) and turns each ray's hooks into a [`RayNode`].
+//!
+//! Rays nest: a stack holds the rays started but not yet finished; a finished ray becomes
+//! the last child of the ray below it, or the tree's root when the stack is empty.
+
+use glam::Vec3A;
+use whitted_ir::Scene;
+
+use super::model::{
+    Blocker, HitInfo, InterfaceInfo, LightContribution, LocalIllumination, RayNode, ShadowInfo,
+    ShadowOutcome, SkippedInfo, Visibility,
+};
+use super::scene_refs::{csg_path, light_ref, material_ref, object_ref};
+use crate::recorder::{
+    Interface, LightSample, RayKind, RayStart, Recorder, ShadowResult, SkippedRay, SurfaceHit,
+    Termination,
+};
+
+/// Records every ray of one camera ray's tree. Names and source locations come from
+/// `scene`, which must be the scene the traced `PreparedScene` was made from.
+pub struct TreeRecorder<'s> {
+    scene: &'s Scene,
+    open: Vec<RayNode>,
+    /// The local colour summed so far for each open ray, in the tracer's order (so that
+    /// `LocalIllumination::total` is bit-identical to what the tracer added).
+    local_sums: Vec<Vec3A>,
+    root: Option<RayNode>,
+}
+
+impl<'s> TreeRecorder<'s> {
+    pub fn new(scene: &'s Scene) -> TreeRecorder<'s> {
+        TreeRecorder {
+            scene,
+            open: Vec::new(),
+            local_sums: Vec::new(),
+            root: None,
+        }
+    }
+
+    /// The finished camera ray's tree, once the tracer has returned; the recorder is then
+    /// ready for another camera ray.
+    pub fn take_root(&mut self) -> Option<RayNode> {
+        self.root.take()
+    }
+}
+
+impl Recorder for TreeRecorder<'_> {
+    fn ray_started(&mut self, ray: &RayStart) {
+        self.open.push(RayNode {
+            kind: ray.kind,
+            depth: ray.depth,
+            origin: ray.origin.to_array(),
+            direction: ray.direction.to_array(),
+            weight: ray.weight.to_array(),
+            coefficient: ray.coefficient.to_array(),
+            interface: ray.interface.as_ref().map(interface_info),
+            hit: None,
+            local: None,
+            shadow: None,
+            color: [0.0; 3],
+            termination: Termination::NotEnded,
+            skipped: Vec::new(),
+            children: Vec::new(),
+        });
+        self.local_sums.push(Vec3A::ZERO);
+    }
+
+    fn surface_hit(&mut self, hit: &SurfaceHit) {
+        let scene = self.scene;
+        let Some(node) = self.open.last_mut() else {
+            return;
+        };
+        node.hit = Some(HitInfo {
+            t: hit.t,
+            point: hit.point.to_array(),
+            geometric_normal: hit.geometric_normal.to_array(),
+            shading_normal: hit.shading_normal.to_array(),
+            front_face: hit.front_face,
+            object: object_ref(scene, hit.object),
+            leaf: object_ref(scene, hit.leaf),
+            csg_path: csg_path(scene, hit.object, hit.leaf),
+            material: material_ref(scene, hit.material),
+            resolved_material: material_ref(scene, hit.resolved_material),
+            absorption: hit.absorption.to_array(),
+        });
+    }
+
+    fn ambient(&mut self, ambient: Vec3A) {
+        let (Some(node), Some(sum)) = (self.open.last_mut(), self.local_sums.last_mut()) else {
+            return;
+        };
+        *sum = ambient;
+        node.local = Some(LocalIllumination {
+            ambient: ambient.to_array(),
+            lights: Vec::new(),
+            total: ambient.to_array(),
+        });
+    }
+
+    fn light_sampled(&mut self, sample: &LightSample) {
+        let scene = self.scene;
+        let (Some(node), Some(sum)) = (self.open.last_mut(), self.local_sums.last_mut()) else {
+            return;
+        };
+        let light = light_ref(scene, sample.light);
+        let mut shadow_child = None;
+        let visibility = match &sample.shadow_ray {
+            None => Visibility::NotFacing,
+            Some(shadow_ray) => {
+                let (result, blocker, transmittance, filters, passed, termination) =
+                    match shadow_ray.result {
+                        ShadowResult::Unblocked => (
+                            ShadowOutcome::Unblocked,
+                            None,
+                            None,
+                            None,
+                            Vec3A::ONE,
+                            Termination::Miss,
+                        ),
+                        ShadowResult::Blocked { object, leaf, t } => (
+                            ShadowOutcome::Blocked,
+                            Some(Blocker {
+                                object: object_ref(scene, object),
+                                leaf: object_ref(scene, leaf),
+                                t,
+                            }),
+                            None,
+                            None,
+                            Vec3A::ZERO,
+                            Termination::Absorbed,
+                        ),
+                        ShadowResult::Filtered {
+                            transmittance,
+                            blockers,
+                        } => (
+                            ShadowOutcome::Filtered,
+                            None,
+                            Some(transmittance.to_array()),
+                            Some(blockers),
+                            transmittance,
+                            Termination::Miss,
+                        ),
+                    };
+                shadow_child = Some(node.children.len());
+                node.children.push(RayNode {
+                    kind: RayKind::Shadow,
+                    depth: node.depth,
+                    origin: shadow_ray.origin.to_array(),
+                    direction: shadow_ray.direction.to_array(),
+                    weight: node.weight,
+                    coefficient: [1.0; 3],
+                    interface: None,
+                    hit: None,
+                    local: None,
+                    shadow: Some(ShadowInfo {
+                        light: light.clone(),
+                        max_t: finite(shadow_ray.max_t),
+                        result,
+                        blocker,
+                        transmittance,
+                        filters,
+                    }),
+                    color: passed.to_array(),
+                    termination,
+                    skipped: Vec::new(),
+                    children: Vec::new(),
+                });
+                match result {
+                    ShadowOutcome::Unblocked => Visibility::Lit,
+                    ShadowOutcome::Blocked => Visibility::Blocked,
+                    ShadowOutcome::Filtered => Visibility::Filtered,
+                }
+            }
+        };
+        // The tracer adds a light's terms only when some light passed; adding zeros
+        // instead would still be exact, but following it keeps the sums obviously equal.
+        if sample.diffuse != Vec3A::ZERO || sample.specular != Vec3A::ZERO {
+            *sum += sample.diffuse + sample.specular;
+        }
+        let local = node.local.get_or_insert_with(|| LocalIllumination {
+            ambient: [0.0; 3],
+            lights: Vec::new(),
+            total: [0.0; 3],
+        });
+        local.total = sum.to_array();
+        local.lights.push(LightContribution {
+            light,
+            to_light: sample.to_light.to_array(),
+            distance: finite(sample.distance),
+            n_dot_l: sample.n_dot_l,
+            attenuation: sample.attenuation,
+            spot: sample.spot,
+            diffuse: sample.diffuse.to_array(),
+            specular: sample.specular.to_array(),
+            visibility,
+            shadow_child,
+        });
+    }
+
+    fn secondary_skipped(&mut self, skipped: &SkippedRay) {
+        if let Some(node) = self.open.last_mut() {
+            node.skipped.push(SkippedInfo {
+                kind: skipped.kind,
+                depth: skipped.depth,
+                weight: skipped.weight.to_array(),
+                coefficient: skipped.coefficient.to_array(),
+                reason: skipped.reason,
+            });
+        }
+    }
+
+    fn ray_finished(&mut self, color: Vec3A, termination: Termination) {
+        let Some(mut node) = self.open.pop() else {
+            return;
+        };
+        self.local_sums.pop();
+        node.color = color.to_array();
+        node.termination = termination;
+        match self.open.last_mut() {
+            Some(parent) => parent.children.push(node),
+            None => self.root = Some(node),
+        }
+    }
+}
+
+fn interface_info(interface: &Interface) -> InterfaceInfo {
+    InterfaceInfo {
+        incidence_degrees: interface.incidence_degrees(),
+        cos_incidence: interface.cos_incidence,
+        ior: interface.ior.map(|(from, to)| [from, to]),
+        entering: interface.entering,
+        fresnel_reflectance: interface.fresnel_reflectance,
+        fresnel_transmittance: interface.fresnel_reflectance.map(|r| 1.0 - r),
+        total_internal_reflection: interface.total_internal_reflection,
+    }
+}
+
+/// Infinite distances (directional lights) become `None`: JSON has no infinity.
+fn finite(value: f32) -> Option<f32> {
+    value.is_finite().then_some(value)
+}

@@ -1,0 +1,37 @@
+//! `whitted trace`: compile a scene, record one pixel's ray tree, print it as text or JSON.
+
+use std::io::IsTerminal;
+
+use whitted_tracer::ray_tree::{
+    check_request, format_text, trace_pixel, SampleChoice, TextOptions,
+};
+use whitted_tracer::PreparedScene;
+
+use crate::cli::TraceArgs;
+use crate::render_cmd::render_options;
+use crate::scene_input::{load_scene, write_stdout};
+use crate::Failure;
+
+pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
+    let loaded = load_scene(&args.scene, false)?;
+    let options = render_options(&loaded.scene.settings, &args.overrides);
+    let [x, y] = args.pixel;
+    let which = match args.sample {
+        Some(sample) => SampleChoice::One(sample),
+        None => SampleChoice::All,
+    };
+    // Check the request before the BVH build, which is the slow part on big scenes.
+    check_request(&options, x, y, which).map_err(|error| Failure::Message(error.to_string()))?;
+    let prepared = PreparedScene::new(&loaded.scene);
+    let tree = trace_pixel(&prepared, &loaded.scene, &options, x, y, which)
+        .map_err(|error| Failure::Message(error.to_string()))?;
+    let text = if args.json {
+        serde_json::to_string_pretty(&tree.document())
+            .map_err(|e| Failure::Message(format!("cannot write the tree as JSON: {e}")))?
+            + "\n"
+    } else {
+        let swatches = std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none();
+        format_text(&tree, TextOptions { swatches })
+    };
+    write_stdout(&text)
+}

@@ -1,0 +1,285 @@
+//! Ray trees recorded in-process from the real scenes: the tree's colour is the rendered
+//! pixel bit for bit on every feature scene, the glass sphere's refraction shows in the
+//! tree, and the text form is pinned by snapshots.
+
+use std::path::{Path, PathBuf};
+
+use whitted_ir::ValidScene;
+use whitted_lang::{compile_file, CompileOptions, SourceLoader};
+use whitted_tracer::ray_tree::{
+    format_text, trace_pixel, RayNode, RayTree, SampleChoice, ShadowOutcome, TextOptions,
+    Visibility,
+};
+use whitted_tracer::{render, NoObserver, PreparedScene, RayKind, RenderOptions, Termination};
+
+struct FileLoader;
+
+impl SourceLoader for FileLoader {
+    fn load(&mut self, path: &Path) -> std::io::Result<String> {
+        std::fs::read_to_string(path)
+    }
+}
+
+/// A compiled and prepared scene; paths are relative to the workspace, as users type them.
+pub struct Loaded {
+    pub scene: ValidScene,
+    pub prepared: PreparedScene,
+}
+
+pub fn load(path: &str) -> Loaded {
+    let compilation = compile_file(Path::new(path), &mut FileLoader, &CompileOptions::default());
+    let Some(scene) = compilation.scene else {
+        panic!("{path} does not compile: {:?}", compilation.diagnostics);
+    };
+    let prepared = PreparedScene::new(&scene);
+    Loaded { scene, prepared }
+}
+
+/// The feature scenes (scenes/*.scene, not the benchmarks), sorted.
+fn feature_scenes() -> Vec<PathBuf> {
+    let mut scenes: Vec<PathBuf> = std::fs::read_dir("scenes")
+        .expect("the scenes directory")
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.extension().is_some_and(|e| e == "scene"))
+        .collect();
+    scenes.sort();
+    scenes
+}
+
+fn options_at(loaded: &Loaded, width: u32, height: u32) -> RenderOptions {
+    RenderOptions {
+        width,
+        height,
+        ..RenderOptions::from_settings(&loaded.scene.settings)
+    }
+}
+
+fn tree(loaded: &Loaded, options: &RenderOptions, x: u32, y: u32, which: SampleChoice) -> RayTree {
+    trace_pixel(&loaded.prepared, &loaded.scene, options, x, y, which)
+        .unwrap_or_else(|error| panic!("{error}"))
+}
+
+fn bits(color: [f32; 3]) -> [u32; 3] {
+    color.map(f32::to_bits)
+}
+
+fn walk(node: &RayNode) -> Vec<&RayNode> {
+    let mut nodes = vec![node];
+    let mut i = 0;
+    while i < nodes.len() {
+        let next = nodes[i];
+        nodes.extend(next.children.iter());
+        i += 1;
+    }
+    nodes
+}
+
+#[test]
+fn on_every_scene_the_tree_colour_is_the_rendered_pixel_bit_for_bit() {
+    let scenes = feature_scenes();
+    assert!(
+        scenes.len() >= 15,
+        "expected the feature scenes, found {}",
+        scenes.len()
+    );
+    let (width, height) = (64, 48);
+    for path in scenes {
+        let name = path.display().to_string();
+        let loaded = load(&name);
+        let options = options_at(&loaded, width, height);
+        let Some((image, _)) = render(&loaded.prepared, &options, &NoObserver) else {
+            panic!("{name}: the render was cancelled");
+        };
+        let xs = (0..width).step_by(5).chain([width - 1]);
+        let mut checked = 0;
+        for x in xs {
+            for y in (0..height).step_by(5).chain([height - 1]) {
+                let tree = tree(&loaded, &options, x, y, SampleChoice::All);
+                let rendered = image.pixel(x, y).unwrap_or([f32::NAN; 3]);
+                assert_eq!(bits(tree.color), bits(rendered), "{name} pixel ({x}, {y})");
+                assert_eq!(
+                    tree.samples.len(),
+                    options.samples_per_pixel.max(1) as usize
+                );
+                for sample in &tree.samples {
+                    assert_eq!(bits(sample.color), bits(sample.root.color), "{name}");
+                }
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 14 * 11, "{name}");
+    }
+}
+
+#[test]
+fn the_glass_sphere_refracts_in_and_out_and_shadow_rays_name_their_blocker() {
+    let loaded = load("scenes/whitted.scene");
+    let options = RenderOptions::from_settings(&loaded.scene.settings);
+    assert_eq!((options.width, options.height), (640, 480));
+    let tree = tree(&loaded, &options, 400, 270, SampleChoice::All);
+    let root = &tree.samples[0].root;
+    let hit = root.hit.as_ref().expect("the camera ray hits");
+    assert_eq!(hit.object.label, "glass sphere");
+    assert_eq!(hit.object.location, "scenes/whitted.scene:20:1");
+    assert_eq!(hit.material.label, "glass");
+
+    let into = root
+        .child(RayKind::Transmitted)
+        .expect("refraction into the glass");
+    let interface = into.interface.as_ref().expect("an interface");
+    assert!(interface.entering);
+    assert_eq!(interface.ior, Some([1.0, 1.5]));
+    let inside = into.hit.as_ref().expect("the ray meets the far side");
+    assert_eq!(inside.object.label, "glass sphere");
+    assert!(!inside.front_face);
+
+    // Leaving the glass again (or totally reflected inside it).
+    let out = into.child(RayKind::Transmitted);
+    let tir = into.interface.as_ref().is_some_and(|_| {
+        into.skipped
+            .iter()
+            .any(|s| s.reason == Termination::TotalInternalReflection)
+    });
+    match out {
+        Some(out) => {
+            let interface = out.interface.as_ref().expect("an interface");
+            assert!(!interface.entering);
+            assert_eq!(interface.ior, Some([1.5, 1.0]));
+            assert_eq!(out.depth, 2);
+        }
+        None => assert!(
+            tir,
+            "neither an exit nor total internal reflection: {into:#?}"
+        ),
+    }
+
+    // Every shadow ray says what it found, and a blocked one names the blocker.
+    let shadows: Vec<&RayNode> = walk(root)
+        .into_iter()
+        .filter(|n| n.kind == RayKind::Shadow)
+        .collect();
+    assert!(!shadows.is_empty());
+    let mut blocked = 0;
+    for shadow in shadows {
+        let info = shadow.shadow.as_ref().expect("shadow info");
+        assert_eq!(info.light.label, "sun");
+        if info.result == ShadowOutcome::Blocked {
+            let blocker = info.blocker.as_ref().expect("a blocker");
+            assert!(blocker.t > 0.0);
+            assert!(!blocker.object.label.is_empty());
+            blocked += 1;
+        }
+    }
+    assert!(
+        blocked > 0,
+        "the light inside the glass is blocked by the sphere itself"
+    );
+    let lights = &into.local.as_ref().expect("local illumination").lights;
+    assert_eq!(lights[0].visibility, Visibility::Blocked);
+}
+
+#[test]
+fn total_internal_reflection_inside_the_glass_cube_is_recorded() {
+    let loaded = load("scenes/tir.scene");
+    let options = options_at(&loaded, 48, 36);
+    let tree = tree(&loaded, &options, 21, 24, SampleChoice::All);
+    let nodes = walk(&tree.samples[0].root);
+    let trapped = nodes
+        .iter()
+        .find(|n| {
+            n.skipped.iter().any(|s| {
+                s.kind == RayKind::Transmitted && s.reason == Termination::TotalInternalReflection
+            })
+        })
+        .expect("a ray that could not leave the glass");
+    // Its reflected child carries the whole transmitted weight, marked as TIR.
+    let reflected = trapped
+        .child(RayKind::Reflected)
+        .expect("the reflected ray");
+    let interface = reflected.interface.as_ref().expect("an interface");
+    assert!(interface.total_internal_reflection);
+    assert!(!interface.entering);
+    assert_eq!(interface.ior, Some([1.5, 1.0]));
+}
+
+fn snapshot(name: &str, text: String) {
+    insta::with_settings!({ prepend_module_to_snapshot => false }, {
+        insta::assert_snapshot!(name, text);
+    });
+}
+
+fn text_of(path: &str, size: Option<(u32, u32)>, x: u32, y: u32, which: SampleChoice) -> String {
+    let loaded = load(path);
+    let options = match size {
+        Some((width, height)) => options_at(&loaded, width, height),
+        None => RenderOptions::from_settings(&loaded.scene.settings),
+    };
+    format_text(
+        &tree(&loaded, &options, x, y, which),
+        TextOptions::default(),
+    )
+}
+
+#[test]
+fn text_of_the_glass_sphere_pixel() {
+    snapshot(
+        "trace_whitted_glass",
+        text_of("scenes/whitted.scene", None, 400, 270, SampleChoice::All),
+    );
+}
+
+#[test]
+fn text_of_a_csg_cut_with_its_leaf_and_operations() {
+    snapshot(
+        "trace_csg_difference",
+        text_of(
+            "scenes/csg-difference.scene",
+            Some((48, 36)),
+            22,
+            16,
+            SampleChoice::All,
+        ),
+    );
+}
+
+#[test]
+fn text_of_total_internal_reflection() {
+    snapshot(
+        "trace_tir",
+        text_of(
+            "scenes/tir.scene",
+            Some((48, 36)),
+            21,
+            24,
+            SampleChoice::All,
+        ),
+    );
+}
+
+#[test]
+fn text_of_a_filtered_shadow() {
+    snapshot(
+        "trace_filtered_shadow",
+        text_of(
+            "scenes/transparent-shadows.scene",
+            Some((48, 32)),
+            27,
+            18,
+            SampleChoice::All,
+        ),
+    );
+}
+
+#[test]
+fn text_of_one_sample_of_many() {
+    snapshot(
+        "trace_one_sample",
+        text_of(
+            "scenes/antialiasing.scene",
+            Some((48, 32)),
+            24,
+            12,
+            SampleChoice::One(5),
+        ),
+    );
+}
