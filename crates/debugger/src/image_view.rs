@@ -199,7 +199,7 @@ mod tests {
             (self.width, self.height)
         }
         fn srgb(&self, x: u32, y: u32) -> Option<[u8; 3]> {
-            Some(if (x + y) % 2 == 0 {
+            Some(if (x + y).is_multiple_of(2) {
                 [255, 255, 255]
             } else {
                 [0, 0, 0]

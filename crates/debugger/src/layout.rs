@@ -79,8 +79,8 @@ mod tests {
 
     fn covers_without_overlap(area: Rect, p: &Panes) {
         let all = [p.image, p.tree, p.inspector, p.source, p.status];
-        let cells: u32 = all.iter().map(|r| u32::from(r.area())).sum();
-        assert_eq!(cells, u32::from(area.area()), "{p:?}");
+        let cells: u32 = all.iter().map(|r| r.area()).sum();
+        assert_eq!(cells, area.area(), "{p:?}");
         for (i, a) in all.iter().enumerate() {
             assert!(area.contains(a.as_position()), "{a:?}");
             for b in &all[i + 1..] {

@@ -28,7 +28,7 @@ pub fn project(camera: &Camera, width: u32, height: u32, point: DVec3) -> Projec
     let aspect = w / h;
     let offset = point - camera.eye;
     let depth = offset.dot(forward);
-    if !(depth > 0.0) {
+    if depth.is_nan() || depth <= 0.0 {
         return Projected::Behind;
     }
     let (u, v) = match camera.projection {

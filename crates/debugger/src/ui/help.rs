@@ -10,7 +10,7 @@ use ratatui::widgets::{Block, Clear, Paragraph, Widget};
 use crate::action::KEY_HELP;
 
 const SECTION_WIDTH: usize = 10;
-const KEY_WIDTH: usize = 19;
+const KEY_WIDTH: usize = 18;
 
 pub fn draw(area: Rect, buf: &mut Buffer) {
     let lines = help_lines();

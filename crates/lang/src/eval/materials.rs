@@ -83,6 +83,7 @@ impl<'a> Evaluator<'a> {
         }
         let mut material = builder.material;
         material.name = name;
+        self.warn_if_material_gains_energy(&material, body.header);
         self.materials.push(MaterialDef {
             material,
             pattern: builder.pattern,
@@ -90,6 +91,28 @@ impl<'a> Evaluator<'a> {
             lowered: None,
         });
         Ok((self.materials.len() - 1) as MaterialId)
+    }
+
+    /// Warns when `reflective + transmissive` exceeds 1 on a channel: every bounce would then
+    /// return more light than arrives, and deep recursion washes the object out to white.
+    fn warn_if_material_gains_energy(&mut self, material: &Material, span: Span) {
+        let (kr, kt) = (material.reflective, material.transmissive);
+        let sums = [kr.r + kt.r, kr.g + kt.g, kr.b + kt.b];
+        let largest = sums.iter().copied().fold(0.0, f64::max);
+        if largest > 1.0 + 1e-9 && self.warned_materials.insert(span) {
+            let hint = match material.fresnel {
+                whitted_ir::Fresnel::Schlick => "with `fresnel schlick`, `transmissive` is already split between reflection and refraction: set `reflective 0` for plain glass",
+                whitted_ir::Fresnel::Off => "keep `reflective + transmissive` at most 1 on every channel",
+            };
+            self.diagnostics.push(
+                Diagnostic::warning(
+                    format!("this material reflects and transmits more light than it receives (reflective + transmissive = {largest})"),
+                    span,
+                )
+                .with_label("returns more light than arrives")
+                .with_hint(hint),
+            );
+        }
     }
 
     /// The IR handle of a material, appending it (and its pattern's parts) on first use.

@@ -86,6 +86,8 @@ pub(crate) struct Evaluator<'a> {
     /// Where errors were already reported, so that a loop repeats none of them (the values
     /// in the message may differ from one iteration to the next; the place does not).
     reported: HashSet<Span>,
+    /// Material definitions already warned about (a definition in a loop warns once).
+    warned_materials: HashSet<Span>,
     unique_errors: usize,
     /// Every error reported or repeated: an object whose body adds to this is not built.
     error_events: usize,
@@ -135,6 +137,7 @@ impl<'a> Evaluator<'a> {
             scene,
             diagnostics: Vec::new(),
             reported: HashSet::new(),
+            warned_materials: HashSet::new(),
             unique_errors: 0,
             error_events: 0,
             materials: Vec::new(),

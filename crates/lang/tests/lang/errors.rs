@@ -92,6 +92,10 @@ fn name_errors() {
                 "unused material and function",
                 "material unused { }\nfn helper() { }\nmaterial _kept { }\nsphere { }\n",
             ),
+            (
+                "a material that returns more light than it receives",
+                "material glass { reflective 1 transmissive 1 fresnel schlick }\nfor i in 0..3 { material shiny { reflective 0.6 transmissive <0.2, 0.5, 0.2> } sphere { material shiny } }\nsphere { material glass }\n",
+            ),
         ],
     );
 }
