@@ -17,6 +17,8 @@ struct Case {
     label: &'static str,
     scene: &'static str,
     defines: &'static [&'static str],
+    /// The equivalent POV-Ray scene, for a side-by-side figure when `povray` is installed.
+    pov: Option<&'static str>,
 }
 
 const RENDERS: &[Case] = &[
@@ -24,16 +26,19 @@ const RENDERS: &[Case] = &[
         label: "classic (Whitted 1980)",
         scene: "scenes/bench/classic.scene",
         defines: &[],
+        pov: Some("scenes/bench/pov/classic.pov"),
     },
     Case {
         label: "1,000 spheres",
         scene: "scenes/bench/spheres1000.scene",
         defines: &[],
+        pov: Some("scenes/bench/pov/spheres1000.pov"),
     },
     Case {
         label: "grid 1,000,000 spheres",
         scene: "scenes/bench/grid.scene",
         defines: &["N=1000"],
+        pov: Some("scenes/bench/pov/grid.pov"),
     },
 ];
 
@@ -42,11 +47,13 @@ const COMPILES: &[Case] = &[
         label: "grid N=316 (99,856 spheres)",
         scene: "scenes/bench/grid.scene",
         defines: &["N=316"],
+        pov: None,
     },
     Case {
         label: "grid N=1000 (1,000,000 spheres)",
         scene: "scenes/bench/grid.scene",
         defines: &["N=1000"],
+        pov: None,
     },
 ];
 
@@ -149,6 +156,36 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         }
     }
 
+    if Path::new(POVRAY).exists() {
+        println!("\nPOV-Ray 3.7 on the equivalent scenes ({width}x{height}, max_trace_level 5, no anti-aliasing)");
+        println!(
+            "{:<26} {:>7} {:>8} {:>8} {:>8} {:>10} {:>9}",
+            "scene", "threads", "parse", "trace", "wall", "rays", "Mrays/s/core"
+        );
+        for case in RENDERS {
+            let Some(pov) = case.pov else { continue };
+            for threads in [1, cores] {
+                let figures = run_povray(&root.join(pov), &out_dir, width, height, threads)?;
+                let per_core =
+                    figures.rays as f64 / figures.trace_seconds.max(1e-9) / threads as f64 / 1e6;
+                println!(
+                    "{:<26} {:>7} {:>7.3}s {:>7.3}s {:>7.3}s {:>10} {:>9.2}",
+                    case.label,
+                    threads,
+                    figures.parse_seconds,
+                    figures.trace_seconds,
+                    figures.wall_seconds,
+                    figures.rays,
+                    per_core
+                );
+            }
+        }
+    } else {
+        println!(
+            "\n(POV-Ray not installed: `apt-get install povray` adds a side-by-side comparison)"
+        );
+    }
+
     println!("\ncompile only (`whitted check`, one core; wall includes process start)");
     println!("{:<34} {:>8} {:>12}", "scene", "wall", "peak memory");
     for case in COMPILES {
@@ -190,4 +227,65 @@ fn time_check(exe: &Path, scene: &Path, defines: &[&str]) -> anyhow::Result<(f64
         .last()
         .and_then(|line| line.trim().parse::<u64>().ok());
     Ok((wall, peak))
+}
+
+const POVRAY: &str = "/usr/bin/povray";
+
+/// What POV-Ray reports about one render.
+struct PovFigures {
+    parse_seconds: f64,
+    trace_seconds: f64,
+    wall_seconds: f64,
+    /// Camera, reflected and refracted rays plus shadow-ray tests: the same rays whitted counts.
+    rays: u64,
+}
+
+fn run_povray(
+    scene: &Path,
+    out_dir: &Path,
+    width: u32,
+    height: u32,
+    threads: usize,
+) -> anyhow::Result<PovFigures> {
+    let started = Instant::now();
+    let output = Command::new(POVRAY)
+        .arg(format!("+I{}", scene.display()))
+        .arg(format!("+O{}", out_dir.join("povray.png").display()))
+        .args([
+            format!("+W{width}"),
+            format!("+H{height}"),
+            format!("+WT{threads}"),
+        ])
+        .args(["-A", "+FN", "-D", "-P", "+V"])
+        .output()
+        .context("cannot run povray")?;
+    let wall_seconds = started.elapsed().as_secs_f64();
+    let log = String::from_utf8_lossy(&output.stderr).into_owned();
+    if !output.status.success() {
+        bail!("povray failed on {}:\n{log}", scene.display());
+    }
+    // "Parse Time:  0 hours  0 minutes  5 seconds (5.123 seconds)" and likewise "Trace Time:".
+    let seconds_after = |label: &str| -> f64 {
+        log.lines()
+            .find(|l| l.trim_start().starts_with(label))
+            .and_then(|l| l.rsplit('(').next())
+            .and_then(|l| l.split_whitespace().next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or(0.0)
+    };
+    // "Rays:  643263  Saved: ..." and "Shadow Ray Tests:  452395  Succeeded: ...".
+    let count_after = |label: &str| -> u64 {
+        log.lines()
+            .find(|l| l.trim_start().starts_with(label))
+            .and_then(|l| l.split(':').nth(1))
+            .and_then(|l| l.split_whitespace().next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or(0)
+    };
+    Ok(PovFigures {
+        parse_seconds: seconds_after("Parse Time:"),
+        trace_seconds: seconds_after("Trace Time:"),
+        wall_seconds,
+        rays: count_after("Rays:") + count_after("Shadow Ray Tests:"),
+    })
 }
