@@ -25,6 +25,8 @@ pub enum Command {
     Ir(IrArgs),
     /// Record every ray behind one pixel and print its ray tree, as text or JSON.
     Trace(TraceArgs),
+    /// Explore a scene in the terminal: pick a pixel, walk its ray tree, see the source.
+    Debug(DebugArgs),
 }
 
 /// The scene file and the `-D` overrides every scene-reading command takes.
@@ -111,6 +113,15 @@ pub struct TraceArgs {
     pub json: bool,
     #[command(flatten)]
     pub overrides: RenderOverrides,
+}
+
+#[derive(Args)]
+pub struct DebugArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// A pixel to trace at start: X,Y counted from the top-left corner (0,0).
+    #[arg(long, value_name = "X,Y", value_parser = parse_pixel, allow_hyphen_values = true)]
+    pub pixel: Option<[u32; 2]>,
 }
 
 fn parse_pixel(text: &str) -> Result<[u32; 2], String> {

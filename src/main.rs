@@ -4,6 +4,7 @@
 //! (clap's own code for usage errors).
 
 mod cli;
+mod debug_cmd;
 mod image_output;
 mod render_cmd;
 mod scene_input;
@@ -40,6 +41,7 @@ fn main() -> ExitCode {
         Command::Ir(args) => scene_input::ir(&args),
         Command::Render(args) => render_cmd::render(&args),
         Command::Trace(args) => trace_cmd::trace(&args),
+        Command::Debug(args) => debug_cmd::debug(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

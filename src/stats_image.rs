@@ -148,7 +148,7 @@ mod tests {
         // Rays: 2 of 8 is a quarter of the ramp; 8 of 8 is its top.
         assert_eq!(at(0), [90, 20, 140]);
         assert_eq!(at(1), [255, 250, 180]);
-        assert_eq!(at(2), [51, 51, 51]);
+        assert_eq!(at(2), [124, 124, 124], "the grey gap");
         // Depth: 0 and the maximum.
         assert_eq!(at(2 + GAP as usize), [0, 0, 0]);
         assert_eq!(at(3 + GAP as usize), [255, 250, 180]);

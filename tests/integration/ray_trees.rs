@@ -283,3 +283,47 @@ fn text_of_one_sample_of_many() {
         ),
     );
 }
+
+/// The text between the first fence that starts with `opening` and the next fence.
+fn fenced_block<'a>(doc: &'a str, opening: &str, after: &str) -> &'a str {
+    let from = doc.find(after).expect("the anchor text") + after.len();
+    let start = from + doc[from..].find(opening).expect("an opening fence") + opening.len();
+    let end = start + doc[start..].find("```").expect("a closing fence");
+    &doc[start..end]
+}
+
+#[test]
+fn the_examples_in_the_documentation_are_real_output() {
+    let doc = std::fs::read_to_string("docs/ray-tree.md").expect("docs/ray-tree.md");
+    let stale =
+        "docs/ray-tree.md is out of date: paste the output of the command above the example";
+
+    let text = fenced_block(
+        &doc,
+        "```\n",
+        "`whitted trace scenes/tir.scene --width 48 --height 36 --pixel 21,24`:",
+    );
+    let expected = text_of(
+        "scenes/tir.scene",
+        Some((48, 36)),
+        21,
+        24,
+        SampleChoice::All,
+    );
+    assert_eq!(text, expected, "{stale}");
+
+    let json = fenced_block(&doc, "```json\n", "--pixel 27,18 --json`");
+    let documented: serde_json::Value = serde_json::from_str(json).expect("the example is JSON");
+    let loaded = load("scenes/transparent-shadows.scene");
+    let tree = tree(
+        &loaded,
+        &options_at(&loaded, 48, 32),
+        27,
+        18,
+        SampleChoice::All,
+    );
+    // Through text, as the CLI does: f32 values print in their shortest form.
+    let printed = serde_json::to_string(&tree.document()).expect("the document serialises");
+    let actual: serde_json::Value = serde_json::from_str(&printed).expect("it reads back");
+    assert_eq!(documented, actual, "{stale}");
+}

@@ -126,6 +126,15 @@ fn json_matches_the_documented_schema_on_varied_scenes() {
 }
 
 #[test]
+fn the_documented_example_matches_the_schema() {
+    let doc = std::fs::read_to_string(workspace().join("docs/ray-tree.md")).expect("the doc");
+    let start = doc.find("```json\n").expect("a JSON example") + "```json\n".len();
+    let end = start + doc[start..].find("```").expect("the end of the example");
+    let example: Value = serde_json::from_str(&doc[start..end]).expect("the example is JSON");
+    assert_eq!(validate(&schema(), &example), Vec::<String>::new());
+}
+
+#[test]
 fn the_schema_rejects_a_document_that_breaks_it() {
     let schema = schema();
     let mut document = trace_json(&["scenes/whitted.scene", "--pixel", "400,270"]);

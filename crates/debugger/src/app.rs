@@ -53,17 +53,26 @@ impl SceneErrors {
 #[derive(Clone, Debug, PartialEq)]
 pub enum RenderState {
     /// Tiles are streaming in; `pixels` counts those received.
-    Rendering { generation: u64, pixels: u64 },
-    Done { stats: RenderStats },
+    Rendering {
+        generation: u64,
+        pixels: u64,
+    },
+    Done {
+        stats: RenderStats,
+    },
     /// A reload cancelled it, or the renderer stopped.
     Stopped,
 }
 
-/// The picked pixel's tree and how long recording it took.
+/// The picked pixel's tree and how long it took to appear.
 #[derive(Clone, Debug)]
 pub struct Picked {
     pub tree: TreeView,
+    /// Recording the tree (`trace_pixel`).
     pub trace_time: Duration,
+    /// From the key or click that picked it to the frame showing it on the terminal,
+    /// measured by the event loop (`None` until that frame is drawn, and in tests).
+    pub on_screen_after: Option<Duration>,
 }
 
 /// Which definition the source pane shows for the selected ray.
@@ -125,6 +134,8 @@ pub struct App {
     pub color_depth: ColorDepth,
     pub export_dir: PathBuf,
     pub should_quit: bool,
+    /// How many pixels have been traced: the event loop sees a new pick by its change.
+    pub traces: u64,
 }
 
 impl App {
@@ -156,6 +167,7 @@ impl App {
             color_depth: ColorDepth::TrueColor,
             export_dir,
             should_quit: false,
+            traces: 0,
         }
     }
 
@@ -216,8 +228,10 @@ impl App {
                 self.picked = Some(Picked {
                     tree: view,
                     trace_time,
+                    on_screen_after: None,
                 });
                 self.inspector_scroll = 0;
+                self.traces += 1;
             }
             Err(error) => self.set_message(error.to_string(), true),
         }
@@ -279,7 +293,10 @@ impl App {
 
     /// The reload worker's result: a new scene (start rendering it, re-trace the picked
     /// pixel) or errors (show them, keep the last good image and tree).
-    pub fn apply_reload(&mut self, result: Result<(LoadedScene, usize), SceneErrors>) -> Vec<Effect> {
+    pub fn apply_reload(
+        &mut self,
+        result: Result<(LoadedScene, usize), SceneErrors>,
+    ) -> Vec<Effect> {
         self.reloading = false;
         match result {
             Err(errors) => {
@@ -345,6 +362,7 @@ impl App {
             self.picked = Some(Picked {
                 tree: view,
                 trace_time: started.elapsed(),
+                on_screen_after: None,
             });
         }
     }
@@ -370,5 +388,147 @@ impl App {
             }
             Err(error) => self.set_message(format!("cannot export: {error}"), true),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_scene::{whitted_scene, GLASS_PIXEL};
+    use whitted_ir::{Diagnostic, Severity};
+    use whitted_tracer::RayKind;
+
+    fn app() -> App {
+        App::new(
+            "scenes/whitted.scene".into(),
+            LoadedScene::new(whitted_scene()),
+            Rect::new(0, 0, 120, 40),
+            "/tmp".into(),
+        )
+    }
+
+    fn tile(x: u32, y: u32, value: f32) -> TileResult {
+        TileResult {
+            x,
+            y,
+            width: 2,
+            height: 2,
+            pixels: vec![[value; 3]; 4],
+        }
+    }
+
+    #[test]
+    fn tiles_of_the_current_render_fill_the_image_and_stale_ones_are_dropped() {
+        let mut app = app();
+        app.render_started(2);
+        app.apply_tile(2, &tile(0, 0, 0.5));
+        app.apply_tile(1, &tile(4, 4, 0.5));
+        assert_eq!(app.image.linear(1, 1), Some([0.5; 3]));
+        assert_eq!(app.image.linear(4, 4), None);
+        assert_eq!(
+            app.render,
+            RenderState::Rendering {
+                generation: 2,
+                pixels: 4
+            }
+        );
+        // The end of an older render changes nothing.
+        app.apply_render_done(1, Some((RenderStats::default(), Vec::new())));
+        assert!(matches!(app.render, RenderState::Rendering { .. }));
+        app.apply_render_done(2, None);
+        assert_eq!(app.render, RenderState::Stopped);
+    }
+
+    #[test]
+    fn a_finished_render_brings_the_statistics_for_overlays() {
+        let mut app = app();
+        app.overlay = Some(HeatMapKind::DeepestLevel);
+        app.render_started(1);
+        let stats = vec![PixelStats::default(); 640 * 480];
+        app.apply_render_done(1, Some((RenderStats::default(), stats)));
+        assert!(matches!(app.render, RenderState::Done { .. }));
+        assert!(app.heat_map.is_some());
+    }
+
+    #[test]
+    fn a_good_reload_renders_again_and_retraces_the_picked_pixel() {
+        let mut app = app();
+        app.cursor = GLASS_PIXEL;
+        app.trace_cursor();
+        if let Some(picked) = &mut app.picked {
+            let transmitted = (0..picked.tree.len())
+                .find(|&id| {
+                    picked
+                        .tree
+                        .node(id)
+                        .is_some_and(|n| n.kind == RayKind::Transmitted)
+                })
+                .unwrap();
+            picked.tree.select(transmitted);
+        }
+        let selected = app.picked.as_ref().map(|p| p.tree.selected());
+        app.reloading = true;
+        let effects = app.apply_reload(Ok((LoadedScene::new(whitted_scene()), 0)));
+        assert_eq!(effects, vec![Effect::StartRender]);
+        assert!(!app.reloading);
+        assert!(app.errors.is_none());
+        assert_eq!(app.picked.as_ref().map(|p| p.tree.selected()), selected);
+        assert_eq!(
+            app.message.as_ref().unwrap().text,
+            "reloaded scenes/whitted.scene"
+        );
+    }
+
+    #[test]
+    fn a_failed_reload_keeps_the_scene_and_shows_errors_until_a_good_one() {
+        let mut app = app();
+        app.render_started(1);
+        app.apply_tile(1, &tile(0, 0, 0.25));
+        let errors = SceneErrors {
+            diagnostics: vec![
+                Diagnostic::new(Severity::Error, "one", None),
+                Diagnostic::new(Severity::Warning, "two", None),
+            ],
+            sources: SourceMap::new(),
+        };
+        assert!(app.apply_reload(Err(errors)).is_empty());
+        assert_eq!(app.errors.as_ref().map(SceneErrors::error_count), Some(1));
+        assert_eq!(app.image.linear(0, 0), Some([0.25; 3]));
+        let message = app.message.clone().unwrap();
+        assert!(
+            message.is_error && message.text.contains("1 error;"),
+            "{message:?}"
+        );
+        app.apply_reload(Ok((LoadedScene::new(whitted_scene()), 2)));
+        assert!(app.errors.is_none());
+        assert_eq!(
+            app.message.as_ref().unwrap().text,
+            "reloaded scenes/whitted.scene (2 warnings)"
+        );
+    }
+
+    #[test]
+    fn a_reload_that_changes_the_image_size_refits_and_keeps_the_cursor_inside() {
+        let mut app = app();
+        app.cursor = (600, 400);
+        app.view = View::Manual(app.viewport());
+        let mut smaller = whitted_scene().into_inner();
+        smaller.settings.width = 320;
+        smaller.settings.height = 240;
+        let smaller = whitted_ir::validate(smaller).unwrap();
+        app.apply_reload(Ok((LoadedScene::new(smaller), 0)));
+        assert_eq!(app.image_size(), (320, 240));
+        assert_eq!(app.image.width(), 320);
+        assert_eq!(app.cursor, (319, 239));
+        assert_eq!(app.view, View::Fit);
+    }
+
+    #[test]
+    fn tracing_outside_the_image_is_an_error_message_not_a_panic() {
+        let mut app = app();
+        app.cursor = (9999, 0);
+        app.trace_cursor();
+        assert!(app.picked.is_none());
+        assert!(app.message.as_ref().unwrap().is_error);
     }
 }

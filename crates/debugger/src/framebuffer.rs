@@ -38,8 +38,7 @@ impl Framebuffer {
     }
 
     fn index(&self, x: u32, y: u32) -> Option<usize> {
-        (x < self.width && y < self.height)
-            .then(|| y as usize * self.width as usize + x as usize)
+        (x < self.width && y < self.height).then(|| y as usize * self.width as usize + x as usize)
     }
 
     /// Copies a finished tile in. Pixels outside the image are ignored, so a tile from a

@@ -2,7 +2,7 @@
 //! checked against what the camera actually sees at that pixel. For a blocked shadow ray the
 //! point is where its blocker stopped it.
 
-use whitted_ir::{DVec3, Handle};
+use whitted_ir::{DVec3, Handle, Object};
 
 use crate::app::App;
 use crate::projection::{project, sight, Projected, Sight};
@@ -40,6 +40,7 @@ pub fn hit_point_view(app: &App) -> Option<HitPointView> {
         }
         (None, None) => return None,
     };
+    let object = Handle::<Object>::from_index(object as usize);
     let point = DVec3::new(
         f64::from(point[0]),
         f64::from(point[1]),
@@ -51,16 +52,19 @@ pub fn hit_point_view(app: &App) -> Option<HitPointView> {
         Projected::OffScreen => HitPointView::OffScreen,
         Projected::Behind => HitPointView::BehindCamera,
         Projected::Pixel(x, y) => {
-            let object = Handle::from_index(object as usize);
-            match sight(
+            let seen = sight(
                 &app.loaded.prepared,
                 &app.options,
                 scene.camera.eye,
                 (x, y),
                 point,
-                object,
-            ) {
+            );
+            match seen {
                 Sight::Visible => HitPointView::Shown(x, y),
+                Sight::HiddenBy(blocker) if blocker == object => HitPointView::HiddenBy(format!(
+                    "the near side of {}",
+                    scene.object_label(blocker)
+                )),
                 Sight::HiddenBy(blocker) if scene.objects.contains(blocker) => {
                     HitPointView::HiddenBy(scene.object_label(blocker))
                 }
@@ -100,16 +104,58 @@ mod tests {
     }
 
     #[test]
-    fn the_far_side_of_the_glass_is_hidden_by_the_glass_itself_or_shown() {
+    fn the_far_side_of_the_glass_is_hidden_by_its_near_side() {
         let mut app = picked();
         let tree = &mut app.picked.as_mut().unwrap().tree;
-        // The transmitted ray inside the sphere hits the sphere's back: the camera sees the
-        // front of the same sphere there, which counts as the same object.
+        // The transmitted ray inside the sphere hits the sphere's back; the camera sees the
+        // front of the same sphere at that pixel.
         let inside = (0..tree.len())
-            .find(|&id| tree.node(id).is_some_and(|n| n.kind == RayKind::Transmitted))
+            .find(|&id| {
+                tree.node(id)
+                    .is_some_and(|n| n.kind == RayKind::Transmitted)
+            })
             .unwrap();
         tree.select(inside);
-        let view = hit_point_view(&app).expect("the ray inside the glass hits its far side");
-        assert!(matches!(view, HitPointView::Shown(..)), "{view:?}");
+        assert_eq!(
+            hit_point_view(&app),
+            Some(HitPointView::HiddenBy(
+                "the near side of glass sphere".to_string()
+            ))
+        );
+    }
+
+    /// On the mirror sphere, some reflected rays hit things the camera also sees directly:
+    /// their hit points are marked elsewhere in the picture.
+    #[test]
+    fn a_mirrored_hit_point_is_marked_where_the_camera_sees_it() {
+        let mut app = picked();
+        let mut found = None;
+        'search: for y in (180..340).step_by(8) {
+            for x in (150..330).step_by(8) {
+                app.cursor = (x, y);
+                app.trace_cursor();
+                let tree = &mut app.picked.as_mut().unwrap().tree;
+                let root = tree.node(0).unwrap();
+                let on_mirror = root
+                    .hit
+                    .as_ref()
+                    .is_some_and(|h| h.object.label == "mirror sphere");
+                let Some(reflected) = (0..tree.len())
+                    .find(|&id| tree.node(id).is_some_and(|n| n.kind == RayKind::Reflected))
+                else {
+                    continue;
+                };
+                if !on_mirror {
+                    continue;
+                }
+                tree.select(reflected);
+                if let Some(HitPointView::Shown(hx, hy)) = hit_point_view(&app) {
+                    found = Some(((x, y), (hx, hy)));
+                    break 'search;
+                }
+            }
+        }
+        let (pixel, marked) = found.expect("a mirrored point the camera sees");
+        assert_ne!(pixel, marked);
     }
 }

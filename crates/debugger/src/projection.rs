@@ -63,7 +63,8 @@ pub fn project(camera: &Camera, width: u32, height: u32, point: DVec3) -> Projec
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Sight {
     Visible,
-    /// The camera ray through the pixel stops at this object first.
+    /// The camera ray through the pixel stops at this object first (possibly the point's
+    /// own object: the near side of a sphere hides its far side).
     HiddenBy(Handle<Object>),
 }
 
@@ -79,29 +80,28 @@ impl Recorder for FirstHit {
     }
 }
 
-/// Traces the camera ray of pixel (`x`, `y`) and says whether it reaches `point` on `object`
-/// before anything else. The ray through the pixel passes near, not exactly through, the
-/// point, so a hit on the same object, or one no nearer than the point (within a small
-/// tolerance), counts as seeing it.
+/// How much nearer than the point (as a fraction of its distance) the camera's own hit must
+/// be to hide it. The pixel's ray passes near, not exactly through, the point, so a surface
+/// seen at a grazing angle lands a little in front of or behind it.
+const HIDDEN_MARGIN: f64 = 0.02;
+
+/// Traces the camera ray of pixel (`x`, `y`) and says whether it reaches `point` before
+/// anything else.
 pub fn sight(
     prepared: &PreparedScene,
     options: &RenderOptions,
     eye: DVec3,
     (x, y): (u32, u32),
     point: DVec3,
-    object: Handle<Object>,
 ) -> Sight {
     let mut first = FirstHit::default();
     trace_pixel_with(prepared, options, x, y, 0, &mut first);
     let Some(hit) = first.0 else {
         return Sight::Visible;
     };
-    if hit.object == object {
-        return Sight::Visible;
-    }
     let point_distance = (point - eye).length();
     let hit_distance = (hit.point.as_dvec3() - eye).length();
-    if hit_distance + 1e-3 * point_distance.max(1.0) < point_distance {
+    if hit_distance < point_distance * (1.0 - HIDDEN_MARGIN) {
         Sight::HiddenBy(hit.object)
     } else {
         Sight::Visible
@@ -185,7 +185,6 @@ mod tests {
                 scene.camera.eye,
                 (x, y),
                 hit.point.as_dvec3(),
-                hit.object,
             );
             assert_eq!(seen, Sight::Visible);
         }

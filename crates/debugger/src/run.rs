@@ -36,7 +36,10 @@ impl fmt::Display for DebugError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             DebugError::NotATerminal => {
-                write!(f, "whitted debug needs an interactive terminal (stdin and stdout)")
+                write!(
+                    f,
+                    "whitted debug needs an interactive terminal (stdin and stdout)"
+                )
             }
             DebugError::Terminal(error) => write!(f, "terminal error: {error}"),
         }
@@ -154,8 +157,19 @@ fn event_loop(
     watch: &mut Option<FileWatch>,
 ) -> Result<(), DebugError> {
     let mut reload_at: Option<Instant> = None;
+    // When the batch being drawn picked a pixel: when its first event arrived.
+    let mut picked_at: Option<Instant> = None;
     loop {
-        guard.terminal.draw(|frame| frame.render_widget(&*app, frame.area()))?;
+        guard
+            .terminal
+            .draw(|frame| frame.render_widget(&*app, frame.area()))?;
+        if let (Some(arrived), Some(picked)) = (picked_at.take(), app.picked.as_mut()) {
+            // The figure covers the pick's own frame, so it shows in one more.
+            picked.on_screen_after = Some(arrived.elapsed());
+            guard
+                .terminal
+                .draw(|frame| frame.render_widget(&*app, frame.area()))?;
+        }
         if app.should_quit {
             return Ok(());
         }
@@ -168,6 +182,7 @@ fn event_loop(
             Err(RecvTimeoutError::Disconnected) => return Ok(()),
         };
         let started = Instant::now();
+        let traces_before = app.traces;
         let mut next = Some(first);
         while let Some(event) = next.take() {
             match event {
@@ -196,6 +211,9 @@ fn event_loop(
             if started.elapsed() < DRAIN_BUDGET {
                 next = inbox.try_recv().ok();
             }
+        }
+        if app.traces != traces_before {
+            picked_at = Some(started);
         }
         if let Some(at) = reload_at {
             if Instant::now() >= at {
@@ -244,12 +262,13 @@ fn handle(app: &mut App, event: Event) -> Vec<Effect> {
             message,
         } => {
             app.apply_render_done(generation, None);
-            app.set_message(format!("the renderer crashed (a bug in whitted): {message}"), true);
+            app.set_message(
+                format!("the renderer crashed (a bug in whitted): {message}"),
+                true,
+            );
             Vec::new()
         }
-        Event::InputFailed(_) | Event::FileChanged | Event::Tick | Event::Reloaded(_) => {
-            Vec::new()
-        }
+        Event::InputFailed(_) | Event::FileChanged | Event::Tick | Event::Reloaded(_) => Vec::new(),
     }
 }
 

@@ -4,9 +4,8 @@
 use std::sync::Arc;
 
 use whitted_ir::{
-    validate, Attenuation, Camera, Color, DMat4, DVec3, FileId, Light, LightKind, Material,
-    Object, ObjectKind, Pattern, PatternKind, Projection, Scene, Shape, SourceFile, Span,
-    ValidScene,
+    validate, Attenuation, Camera, Color, DMat4, DVec3, FileId, Light, LightKind, Material, Object,
+    ObjectKind, Pattern, PatternKind, Projection, Scene, Shape, SourceFile, Span, ValidScene,
 };
 use whitted_tracer::ray_tree::{trace_pixel, RayTree, SampleChoice};
 use whitted_tracer::{PreparedScene, RenderOptions};
@@ -96,10 +95,9 @@ pub fn whitted_scene() -> ValidScene {
         diffuse,
         ..Material::default()
     };
-    let a = scene.materials.append(
-        tile("floor_tiles/a", Color::new(0.9, 0.1, 0.1)),
-        floor_span,
-    );
+    let a = scene
+        .materials
+        .append(tile("floor_tiles/a", Color::new(0.9, 0.1, 0.1)), floor_span);
     let b = scene.materials.append(
         tile("floor_tiles/b", Color::new(0.95, 0.9, 0.2)),
         floor_span,

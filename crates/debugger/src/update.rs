@@ -74,7 +74,10 @@ fn move_cursor(app: &mut App, dx: i32, dy: i32) {
         let moved = i64::from(value) + i64::from(delta);
         moved.clamp(0, i64::from(size.saturating_sub(1))) as u32
     };
-    app.cursor = (clamp(app.cursor.0, dx, width), clamp(app.cursor.1, dy, height));
+    app.cursor = (
+        clamp(app.cursor.0, dx, width),
+        clamp(app.cursor.1, dy, height),
+    );
     keep_cursor_in_view(app);
 }
 
@@ -254,7 +257,13 @@ mod tests {
         assert_eq!(app.cursor, (320, 240));
         update(&mut app, Action::MoveCursor { dx: 10, dy: -1 });
         assert_eq!(app.cursor, (330, 239));
-        update(&mut app, Action::MoveCursor { dx: -1000, dy: 1000 });
+        update(
+            &mut app,
+            Action::MoveCursor {
+                dx: -1000,
+                dy: 1000,
+            },
+        );
         assert_eq!(app.cursor, (0, 479));
     }
 
@@ -406,7 +415,10 @@ mod tests {
         let mut app = app();
         update(&mut app, Action::ToggleOverlay(HeatMapKind::RaysPerPixel));
         assert_eq!(app.overlay, Some(HeatMapKind::RaysPerPixel));
-        assert!(app.heat_map.is_none(), "no statistics before the render ends");
+        assert!(
+            app.heat_map.is_none(),
+            "no statistics before the render ends"
+        );
         update(&mut app, Action::ToggleOverlay(HeatMapKind::DeepestLevel));
         assert_eq!(app.overlay, Some(HeatMapKind::DeepestLevel));
         update(&mut app, Action::ToggleOverlay(HeatMapKind::DeepestLevel));
@@ -433,10 +445,7 @@ mod tests {
         let [Effect::Export { path, contents }] = effects.as_slice() else {
             panic!("{effects:?}");
         };
-        assert_eq!(
-            path,
-            Path::new("/tmp/out/whitted-400-270.ray-tree.json")
-        );
+        assert_eq!(path, Path::new("/tmp/out/whitted-400-270.ray-tree.json"));
         let json: serde_json::Value = serde_json::from_str(contents).unwrap();
         assert_eq!(json["pixel"], serde_json::json!([400, 270]));
         assert_eq!(json["root"]["kind"], "camera");

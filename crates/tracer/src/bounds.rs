@@ -113,22 +113,10 @@ pub fn segment_touches_box(
 /// invert becomes ±1/ε, so slab distances stay finite and comparisons stay meaningful.
 #[inline]
 pub fn inverse_direction(direction: Vec3A) -> Vec3A {
-    let inverse = |x: f32| {
-        if x.abs() <= f32::EPSILON {
-            if x.is_sign_negative() {
-                -1.0 / f32::EPSILON
-            } else {
-                1.0 / f32::EPSILON
-            }
-        } else {
-            1.0 / x
-        }
-    };
-    Vec3A::new(
-        inverse(direction.x),
-        inverse(direction.y),
-        inverse(direction.z),
-    )
+    // One vector division, then the tiny components replaced (branch-free).
+    let tiny = direction.abs().cmple(Vec3A::splat(f32::EPSILON));
+    let clamped = Vec3A::splat(1.0 / f32::EPSILON).copysign(direction);
+    Vec3A::select(tiny, clamped, Vec3A::ONE / direction)
 }
 
 #[cfg(test)]
@@ -144,6 +132,16 @@ mod tests {
         assert_eq!(a.union(Bound::Infinite), Bound::Infinite);
         assert_eq!(a.intersection(Bound::Infinite), a);
         assert_eq!(Bound::Empty.union(a), a);
+    }
+
+    #[test]
+    fn inverse_direction_stays_finite() {
+        let inv = inverse_direction(Vec3A::new(0.5, -0.0, 1e-9));
+        assert_eq!(inv.x, 2.0);
+        assert_eq!(inv.y, -1.0 / f32::EPSILON);
+        assert_eq!(inv.z, 1.0 / f32::EPSILON);
+        assert!(inverse_direction(Vec3A::new(-1e-20, 0.0, -4.0))
+            .abs_diff_eq(Vec3A::new(-1.0 / f32::EPSILON, 1.0 / f32::EPSILON, -0.25), 0.0));
     }
 
     #[test]

@@ -18,18 +18,31 @@ use obvhs::cwbvh::CwBvh;
 use crate::bounds::inverse_direction;
 use crate::ray::Ray;
 
-/// Children's box planes of one node: `planes[axis * 2]` holds the eight minima along
-/// `axis`, `planes[axis * 2 + 1]` the maxima.
+/// Children's box planes of one node, four children per half: `halves[h][axis * 2]` holds
+/// the minima along `axis` of children `4h..4h + 4`, `halves[h][axis * 2 + 1]` the maxima.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[repr(C, align(16))]
 struct NodePlanes {
-    planes: [[f32; 8]; 6],
+    halves: [[Vec4; 6]; 2],
+}
+
+impl NodePlanes {
+    #[cfg(test)]
+    fn get(&self, slot: usize, child: usize) -> f32 {
+        self.halves[child / 4][slot][child % 4]
+    }
+}
+
+/// A node's dequantised child planes next to obvhs's node (child and primitive indices,
+/// ordering metadata), so one node is one contiguous read.
+#[derive(Clone, Debug)]
+struct WideNode {
+    planes: NodePlanes,
+    node: CwBvhNode,
 }
 
 #[derive(Clone, Debug)]
 pub struct Bvh {
-    nodes: Vec<CwBvhNode>,
-    planes: Vec<NodePlanes>,
+    nodes: Vec<WideNode>,
 }
 
 /// What the visitor wants after testing a primitive.
@@ -53,11 +66,15 @@ impl Bvh {
             obvhs::BvhBuildParams::medium_build(),
             &mut std::time::Duration::default(),
         );
-        let planes = cwbvh.nodes.iter().map(dequantise).collect();
-        let bvh = Bvh {
-            nodes: cwbvh.nodes,
-            planes,
-        };
+        let nodes = cwbvh
+            .nodes
+            .iter()
+            .map(|node| WideNode {
+                planes: dequantise(node),
+                node: *node,
+            })
+            .collect();
+        let bvh = Bvh { nodes };
         (bvh, cwbvh.primitive_indices)
     }
 
@@ -103,8 +120,7 @@ impl Bvh {
                 let slot_index = (child_index_offset - 24) ^ (oct_inv4 & 0xff);
                 let relative_index = (hits_imask & !(0xffff_ffffu32 << slot_index)).count_ones();
                 let index = (current_group.x + relative_index) as usize;
-                let (Some(node), Some(planes)) = (self.nodes.get(index), self.planes.get(index))
-                else {
+                let Some(WideNode { planes, node }) = self.nodes.get(index) else {
                     return;
                 };
                 let hitmask = query.intersect(node, planes, tmax, oct_inv4);
@@ -134,15 +150,15 @@ impl Bvh {
 struct NodeQuery {
     origin: [Vec4; 3],
     inv_direction: [Vec4; 3],
-    /// Which plane (min or max) is met first along each axis.
-    near: [usize; 3],
+    /// Whether the max plane is met first along each axis (the ray goes towards −axis).
+    backwards: [bool; 3],
     tmin: Vec4,
 }
 
 impl NodeQuery {
     fn new(ray: &Ray, tmin: f32) -> NodeQuery {
         let inv = inverse_direction(ray.direction);
-        let near = |d: f32| usize::from(d < 0.0);
+
         NodeQuery {
             origin: [
                 Vec4::splat(ray.origin.x),
@@ -150,10 +166,10 @@ impl NodeQuery {
                 Vec4::splat(ray.origin.z),
             ],
             inv_direction: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
-            near: [
-                near(ray.direction.x),
-                near(ray.direction.y),
-                near(ray.direction.z),
+            backwards: [
+                ray.direction.x < 0.0,
+                ray.direction.y < 0.0,
+                ray.direction.z < 0.0,
             ],
             tmin: Vec4::splat(tmin),
         }
@@ -165,17 +181,15 @@ impl NodeQuery {
     fn intersect(&self, node: &CwBvhNode, planes: &NodePlanes, tmax: f32, oct_inv4: u32) -> u32 {
         let tmax = Vec4::splat(tmax);
         let mut touched = 0u32;
-        for half in 0..2 {
-            let lanes = half * 4..half * 4 + 4;
+        for (half, planes) in planes.halves.iter().enumerate() {
             let mut enter = self.tmin;
             let mut exit = tmax;
             for axis in 0..3 {
-                let near_plane = &planes.planes[axis * 2 + self.near[axis]][lanes.clone()];
-                let far_plane = &planes.planes[axis * 2 + 1 - self.near[axis]][lanes.clone()];
-                let t_near =
-                    (Vec4::from_slice(near_plane) - self.origin[axis]) * self.inv_direction[axis];
-                let t_far =
-                    (Vec4::from_slice(far_plane) - self.origin[axis]) * self.inv_direction[axis];
+                let backwards = usize::from(self.backwards[axis]);
+                let near_plane = planes[axis * 2 + backwards];
+                let far_plane = planes[axis * 2 + 1 - backwards];
+                let t_near = (near_plane - self.origin[axis]) * self.inv_direction[axis];
+                let t_far = (far_plane - self.origin[axis]) * self.inv_direction[axis];
                 enter = enter.max(t_near);
                 exit = exit.min(t_far);
             }
@@ -234,7 +248,7 @@ fn dequantise(node: &CwBvhNode) -> NodePlanes {
             } else if !is_max && f64::from(rounded) > exact {
                 rounded = rounded.next_down();
             }
-            out.planes[slot][child] = rounded;
+            out.halves[child / 4][slot][child % 4] = rounded;
         }
     }
     out
@@ -295,7 +309,8 @@ mod tests {
         let (one, one_indices) = build_on(1);
         for threads in [2, 3, 4] {
             let (other, other_indices) = build_on(threads);
-            assert_eq!(one.nodes, other.nodes, "{threads} threads");
+            let metadata = |bvh: &Bvh| bvh.nodes.iter().map(|n| n.node).collect::<Vec<_>>();
+            assert_eq!(metadata(&one), metadata(&other), "{threads} threads");
             assert_eq!(one_indices, other_indices, "{threads} threads");
         }
     }
@@ -306,12 +321,12 @@ mod tests {
         let (bvh, _) = Bvh::build(&aabbs);
         assert!(bvh.node_count() > 1);
         // The root's children together cover every box.
-        let root = &bvh.planes[0];
+        let root = &bvh.nodes[0].planes;
         for aabb in &aabbs {
             let covered = (0..8).any(|c| {
                 (0..3).all(|axis| {
-                    root.planes[axis * 2][c] <= aabb.min[axis]
-                        && root.planes[axis * 2 + 1][c] >= aabb.max[axis]
+                    root.get(axis * 2, c) <= aabb.min[axis]
+                        && root.get(axis * 2 + 1, c) >= aabb.max[axis]
                 })
             });
             assert!(covered, "{aabb:?}");

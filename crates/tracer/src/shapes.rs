@@ -339,7 +339,13 @@ impl Geometry {
                 sphere_first_hit(ray, *center, *radius, tmin, tmax).map(|t| (t, WALL))
             }
             Geometry::Plane { normal, offset } => {
-                let t = (offset - normal.dot(ray.origin)) / normal.dot(ray.direction);
+                let depth = offset - normal.dot(ray.origin);
+                let rate = normal.dot(ray.direction);
+                // Behind the origin, parallel, or NaN: no division needed to say so.
+                if depth * rate <= 0.0 || (depth * rate).is_nan() {
+                    return None;
+                }
+                let t = depth / rate;
                 (t > tmin && t < tmax).then_some((t, WALL))
             }
             Geometry::Disk(disk) => {

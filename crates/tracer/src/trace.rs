@@ -12,6 +12,7 @@
 use glam::Vec3A;
 use whitted_ir::ShadowMode;
 
+use crate::material::PreparedMaterial;
 use crate::optics::{beer_lambert, max_channel, reflect, refract, schlick, surface_offset};
 use crate::query::{Scratch, Shadow};
 use crate::ray::Ray;
@@ -159,13 +160,87 @@ impl<'a> Tracer<'a> {
             absorption,
         });
 
-        // Local illumination.
+        let offset = surface_offset(point, scene.epsilon) * self.offset_scale;
+        let outside = point + offset * n;
+        let mut color = self.local_illumination(m, outside, n, -d, rec);
+
+        // Secondary rays.
+        let solid = surface.leaf.geometry.is_solid();
+        let split = split_weights(m, d, n, solid, front_face);
+        let mut outcome = Outcome::default();
+        let carried = path.weight * absorption;
+        let depth = path.depth + 1;
+        if split.reflect != Vec3A::ZERO {
+            let child = PathState {
+                kind: RayKind::Reflected,
+                depth,
+                weight: carried * split.reflect,
+                coefficient: split.reflect,
+                medium: path.medium,
+                interface: Some(split.interface),
+            };
+            // Unit already: a reflection preserves length (to a few ulps).
+            let reflected = Ray::new(outside, reflect(d, n));
+            if let Some(c) = self.spawn(&reflected, &child, &mut outcome, rec) {
+                color += split.reflect * c;
+            }
+        }
+        if split.interface.total_internal_reflection {
+            let reason = Termination::TotalInternalReflection;
+            rec.secondary_skipped(&SkippedRay {
+                kind: RayKind::Transmitted,
+                depth,
+                weight: Vec3A::ZERO,
+                coefficient: Vec3A::ZERO,
+                reason,
+            });
+            outcome.skipped(reason);
+        }
+        if let Some(direction) = split.refracted.filter(|_| split.transmit != Vec3A::ZERO) {
+            let medium = match (solid, front_face) {
+                (false, _) => path.medium,
+                (true, true) => m.absorption,
+                (true, false) => Vec3A::ZERO,
+            };
+            let child = PathState {
+                kind: RayKind::Transmitted,
+                depth,
+                weight: carried * split.transmit,
+                coefficient: split.transmit,
+                medium,
+                interface: Some(split.interface),
+            };
+            let transmitted = Ray::new(point - offset * n, direction);
+            if let Some(c) = self.spawn(&transmitted, &child, &mut outcome, rec) {
+                color += split.transmit * c;
+            }
+        }
+
+        let color = color * absorption;
+        let termination = if outcome.traced_any {
+            Termination::NotEnded
+        } else {
+            outcome.first_skip.unwrap_or(Termination::Absorbed)
+        };
+        rec.ray_finished(color, termination);
+        color
+    }
+
+    /// `ka·Ia·kd` plus, for every light on the visible side, `fatt·spot·Ii·(kd·(N·L) +
+    /// ks·(R·V)^n)` times what the shadow ray lets through. `outside` is the hit point
+    /// already moved off the surface along `n`, which faces the viewer.
+    fn local_illumination<R: Recorder>(
+        &mut self,
+        m: &PreparedMaterial,
+        outside: Vec3A,
+        n: Vec3A,
+        view: Vec3A,
+        rec: &mut R,
+    ) -> Vec3A {
+        let scene = self.scene;
         let ambient = m.ambient * scene.ambient * m.diffuse;
         rec.ambient(ambient);
         let mut color = ambient;
-        let offset = surface_offset(point, scene.epsilon) * self.offset_scale;
-        let outside = point + offset * n;
-        let view = -d;
         for light in &scene.lights {
             let incidence = light.incidence(outside);
             let n_dot_l = n.dot(incidence.to_light);
@@ -185,47 +260,9 @@ impl<'a> Tracer<'a> {
                 rec.light_sampled(&sample);
                 continue;
             }
-            let shadow_ray = Ray::new(outside, incidence.to_light);
-            self.counters.shadow += 1;
-            let shadow = match scene.shadows {
-                ShadowMode::Opaque => {
-                    match scene.occluded(&shadow_ray, 0.0, incidence.distance, &mut self.scratch) {
-                        Some(blocker) => Shadow::Blocked(blocker),
-                        None => Shadow::Clear,
-                    }
-                }
-                ShadowMode::Filtered => {
-                    scene.filter_shadow(&shadow_ray, 0.0, incidence.distance, &mut self.scratch)
-                }
-            };
-            let (passed, result) = match shadow {
-                Shadow::Clear => (Vec3A::ONE, ShadowResult::Unblocked),
-                Shadow::Blocked(blocker) => {
-                    let item = scene.item(blocker.item);
-                    let result = ShadowResult::Blocked {
-                        object: item.object(),
-                        leaf: item.leaf(blocker.leaf).object,
-                        t: blocker.t,
-                    };
-                    (Vec3A::ZERO, result)
-                }
-                Shadow::Filtered {
-                    transmittance,
-                    blockers,
-                } => (
-                    transmittance,
-                    ShadowResult::Filtered {
-                        transmittance,
-                        blockers,
-                    },
-                ),
-            };
-            sample.shadow_ray = Some(ShadowRay {
-                origin: outside,
-                direction: incidence.to_light,
-                max_t: incidence.distance,
-                result,
-            });
+            let (passed, shadow_ray) =
+                self.cast_shadow(outside, incidence.to_light, incidence.distance);
+            sample.shadow_ray = Some(shadow_ray);
             if passed != Vec3A::ZERO {
                 let light_in = light.intensity * strength * passed;
                 sample.diffuse = light_in * m.diffuse * n_dot_l;
@@ -237,121 +274,77 @@ impl<'a> Tracer<'a> {
             }
             rec.light_sampled(&sample);
         }
-
-        // Secondary rays: split the weights, then reflect and refract.
-        let cos_incidence = view.dot(n).clamp(0.0, 1.0);
-        let mut reflect_coefficient = m.reflective;
-        let mut transmit_coefficient = Vec3A::ZERO;
-        let mut refracted = None;
-        let solid = surface.leaf.geometry.is_solid();
-        let mut interface = Interface {
-            cos_incidence,
-            ior: None,
-            entering: solid && front_face,
-            fresnel_reflectance: None,
-            total_internal_reflection: false,
-        };
-        if m.transmissive != Vec3A::ZERO {
-            let (from, to) = match (solid, front_face) {
-                (false, _) => (1.0, 1.0),
-                (true, true) => (1.0, m.ior),
-                (true, false) => (m.ior, 1.0),
-            };
-            interface.ior = Some((from, to));
-            match refract(d, n, from, to) {
-                None => {
-                    interface.total_internal_reflection = true;
-                    if m.schlick {
-                        interface.fresnel_reflectance = Some(1.0);
-                    }
-                    reflect_coefficient = m.reflective + m.transmissive;
-                }
-                Some(direction) => {
-                    if m.schlick {
-                        let r = schlick(cos_incidence, from, to);
-                        interface.fresnel_reflectance = Some(r);
-                        reflect_coefficient = m.reflective + m.transmissive * r;
-                        transmit_coefficient = m.transmissive * (1.0 - r);
-                    } else {
-                        transmit_coefficient = m.transmissive;
-                    }
-                    refracted = Some(direction);
-                }
-            }
-        }
-
-        let mut traced_any = false;
-        let mut first_skip: Option<Termination> = None;
-        let carried = path.weight * absorption;
-        let depth = path.depth + 1;
-        if reflect_coefficient != Vec3A::ZERO {
-            let child = PathState {
-                kind: RayKind::Reflected,
-                depth,
-                weight: carried * reflect_coefficient,
-                coefficient: reflect_coefficient,
-                medium: path.medium,
-                interface: Some(interface),
-            };
-            match self.secondary_verdict(&child) {
-                None => {
-                    let reflected = Ray::new(outside, reflect(d, n).normalize());
-                    color += reflect_coefficient * self.trace(&reflected, &child, rec);
-                    traced_any = true;
-                }
-                Some(reason) => {
-                    skip(rec, &child, reason);
-                    first_skip = first_skip.or(Some(reason));
-                }
-            }
-        }
-        if interface.total_internal_reflection {
-            let reason = Termination::TotalInternalReflection;
-            rec.secondary_skipped(&SkippedRay {
-                kind: RayKind::Transmitted,
-                depth,
-                weight: Vec3A::ZERO,
-                coefficient: Vec3A::ZERO,
-                reason,
-            });
-            first_skip = first_skip.or(Some(reason));
-        }
-        if let Some(direction) = refracted.filter(|_| transmit_coefficient != Vec3A::ZERO) {
-            let medium = match (solid, front_face) {
-                (false, _) => path.medium,
-                (true, true) => m.absorption,
-                (true, false) => Vec3A::ZERO,
-            };
-            let child = PathState {
-                kind: RayKind::Transmitted,
-                depth,
-                weight: carried * transmit_coefficient,
-                coefficient: transmit_coefficient,
-                medium,
-                interface: Some(interface),
-            };
-            match self.secondary_verdict(&child) {
-                None => {
-                    let inside = point - offset * n;
-                    let transmitted = Ray::new(inside, direction);
-                    color += transmit_coefficient * self.trace(&transmitted, &child, rec);
-                    traced_any = true;
-                }
-                Some(reason) => {
-                    skip(rec, &child, reason);
-                    first_skip = first_skip.or(Some(reason));
-                }
-            }
-        }
-
-        let color = color * absorption;
-        let termination = if traced_any {
-            Termination::NotEnded
-        } else {
-            first_skip.unwrap_or(Termination::Absorbed)
-        };
-        rec.ray_finished(color, termination);
         color
+    }
+
+    /// Casts a shadow ray; returns what fraction of the light passes, and the record.
+    fn cast_shadow(&mut self, origin: Vec3A, to_light: Vec3A, distance: f32) -> (Vec3A, ShadowRay) {
+        let scene = self.scene;
+        let ray = Ray::new(origin, to_light);
+        self.counters.shadow += 1;
+        let shadow = match scene.shadows {
+            ShadowMode::Opaque => match scene.occluded(&ray, 0.0, distance, &mut self.scratch) {
+                Some(blocker) => Shadow::Blocked(blocker),
+                None => Shadow::Clear,
+            },
+            ShadowMode::Filtered => scene.filter_shadow(&ray, 0.0, distance, &mut self.scratch),
+        };
+        let (passed, result) = match shadow {
+            Shadow::Clear => (Vec3A::ONE, ShadowResult::Unblocked),
+            Shadow::Blocked(blocker) => {
+                let item = scene.item(blocker.item);
+                let result = ShadowResult::Blocked {
+                    object: item.object(),
+                    leaf: item.leaf(blocker.leaf).object,
+                    t: blocker.t,
+                };
+                (Vec3A::ZERO, result)
+            }
+            Shadow::Filtered {
+                transmittance,
+                blockers,
+            } => (
+                transmittance,
+                ShadowResult::Filtered {
+                    transmittance,
+                    blockers,
+                },
+            ),
+        };
+        let record = ShadowRay {
+            origin,
+            direction: to_light,
+            max_t: distance,
+            result,
+        };
+        (passed, record)
+    }
+
+    /// Traces a secondary ray unless a stopping criterion forbids it (then records why).
+    fn spawn<R: Recorder>(
+        &mut self,
+        ray: &Ray,
+        child: &PathState,
+        outcome: &mut Outcome,
+        rec: &mut R,
+    ) -> Option<Vec3A> {
+        match self.secondary_verdict(child) {
+            None => {
+                outcome.traced_any = true;
+                Some(self.trace(ray, child, rec))
+            }
+            Some(reason) => {
+                rec.secondary_skipped(&SkippedRay {
+                    kind: child.kind,
+                    depth: child.depth,
+                    weight: child.weight,
+                    coefficient: child.coefficient,
+                    reason,
+                });
+                outcome.skipped(reason);
+                None
+            }
+        }
     }
 
     /// `None` when the secondary ray may be traced; otherwise why not.
@@ -367,12 +360,163 @@ impl<'a> Tracer<'a> {
     }
 }
 
-fn skip<R: Recorder>(rec: &mut R, child: &PathState, reason: Termination) {
-    rec.secondary_skipped(&SkippedRay {
-        kind: child.kind,
-        depth: child.depth,
-        weight: child.weight,
-        coefficient: child.coefficient,
-        reason,
-    });
+/// What happened to a ray's secondary rays, for its termination.
+#[derive(Default)]
+struct Outcome {
+    traced_any: bool,
+    first_skip: Option<Termination>,
+}
+
+impl Outcome {
+    fn skipped(&mut self, reason: Termination) {
+        self.first_skip = self.first_skip.or(Some(reason));
+    }
+}
+
+/// How a surface divides a ray's weight between reflection and transmission.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Split {
+    pub interface: Interface,
+    /// `kr`, plus `kt·R` with Fresnel, plus all of `kt` on total internal reflection.
+    pub reflect: Vec3A,
+    /// `kt`, times `1 − R` with Fresnel; zero on total internal reflection.
+    pub transmit: Vec3A,
+    /// The refracted direction, when the material transmits and refraction is possible.
+    pub refracted: Option<Vec3A>,
+}
+
+/// The reflection/transmission split at a surface hit along `d`, with `n` the unit normal
+/// facing the incoming ray. Solids refract between air (1.0) and the material's ior, the
+/// direction decided by `front_face`; thin surfaces (no inside) have 1.0 on both sides.
+pub fn split_weights(
+    m: &PreparedMaterial,
+    d: Vec3A,
+    n: Vec3A,
+    solid: bool,
+    front_face: bool,
+) -> Split {
+    let cos_incidence = (-d).dot(n).clamp(0.0, 1.0);
+    let mut split = Split {
+        interface: Interface {
+            cos_incidence,
+            ior: None,
+            entering: solid && front_face,
+            fresnel_reflectance: None,
+            total_internal_reflection: false,
+        },
+        reflect: m.reflective,
+        transmit: Vec3A::ZERO,
+        refracted: None,
+    };
+    if m.transmissive == Vec3A::ZERO {
+        return split;
+    }
+    let (from, to) = match (solid, front_face) {
+        (false, _) => (1.0, 1.0),
+        (true, true) => (1.0, m.ior),
+        (true, false) => (m.ior, 1.0),
+    };
+    split.interface.ior = Some((from, to));
+    match refract(d, n, from, to) {
+        None => {
+            split.interface.total_internal_reflection = true;
+            if m.schlick {
+                split.interface.fresnel_reflectance = Some(1.0);
+            }
+            split.reflect = m.reflective + m.transmissive;
+        }
+        Some(direction) => {
+            if m.schlick {
+                let r = schlick(cos_incidence, from, to);
+                split.interface.fresnel_reflectance = Some(r);
+                split.reflect = m.reflective + m.transmissive * r;
+                split.transmit = m.transmissive * (1.0 - r);
+            } else {
+                split.transmit = m.transmissive;
+            }
+            split.refracted = Some(direction);
+        }
+    }
+    split
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use whitted_ir::{Color, Fresnel, Material};
+
+    fn glass(reflective: f64, fresnel: Fresnel) -> PreparedMaterial {
+        PreparedMaterial::new(&Material {
+            reflective: Color::gray(reflective),
+            transmissive: Color::gray(0.9),
+            ior: 1.5,
+            fresnel,
+            ..Material::default()
+        })
+    }
+
+    fn incoming(degrees: f32) -> Vec3A {
+        let theta = degrees.to_radians();
+        Vec3A::new(theta.sin(), -theta.cos(), 0.0)
+    }
+
+    #[test]
+    fn without_fresnel_the_coefficients_are_the_material_s() {
+        let split = split_weights(
+            &glass(0.1, Fresnel::Off),
+            incoming(30.0),
+            Vec3A::Y,
+            true,
+            true,
+        );
+        assert_eq!(split.reflect, Vec3A::splat(0.1));
+        assert_eq!(split.transmit, Vec3A::splat(0.9));
+        assert_eq!(split.interface.ior, Some((1.0, 1.5)));
+        assert!(split.interface.entering);
+        assert!(split.refracted.is_some());
+    }
+
+    #[test]
+    fn schlick_moves_part_of_the_transmission_into_reflection() {
+        let split = split_weights(
+            &glass(0.1, Fresnel::Schlick),
+            incoming(60.0),
+            Vec3A::Y,
+            true,
+            true,
+        );
+        let r = split.interface.fresnel_reflectance.unwrap_or(-1.0);
+        assert!(r > 0.04 && r < 1.0, "{r}");
+        assert!(split.reflect.abs_diff_eq(Vec3A::splat(0.1 + 0.9 * r), 1e-6));
+        assert!(split
+            .transmit
+            .abs_diff_eq(Vec3A::splat(0.9 * (1.0 - r)), 1e-6));
+    }
+
+    #[test]
+    fn total_internal_reflection_reflects_everything() {
+        // Leaving glass (a back face) at 60°, beyond the critical angle of 41.8°.
+        let split = split_weights(
+            &glass(0.1, Fresnel::Schlick),
+            incoming(60.0),
+            Vec3A::Y,
+            true,
+            false,
+        );
+        assert!(split.interface.total_internal_reflection);
+        assert_eq!(split.interface.ior, Some((1.5, 1.0)));
+        assert_eq!(split.interface.fresnel_reflectance, Some(1.0));
+        assert_eq!(split.reflect, Vec3A::splat(0.1 + 0.9));
+        assert_eq!(split.transmit, Vec3A::ZERO);
+        assert!(split.refracted.is_none());
+    }
+
+    #[test]
+    fn thin_surfaces_pass_light_straight_through() {
+        let d = incoming(50.0);
+        let split = split_weights(&glass(0.0, Fresnel::Off), d, Vec3A::Y, false, true);
+        assert_eq!(split.interface.ior, Some((1.0, 1.0)));
+        assert!(!split.interface.entering);
+        assert!(split.refracted.unwrap_or(Vec3A::ZERO).abs_diff_eq(d, 1e-6));
+    }
 }

@@ -6,7 +6,7 @@ use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{Block, Paragraph, Widget, Wrap};
+use ratatui::widgets::{Block, Paragraph, Widget};
 use whitted_ir::{Diagnostic, Severity, SourceMap};
 
 use crate::app::SceneErrors;
@@ -19,36 +19,54 @@ pub fn draw(errors: &SceneErrors, pane: Rect, buf: &mut Buffer) {
     );
     let block = Block::bordered()
         .border_style(Style::new().fg(Color::LightRed))
-        .title(Line::from(title).style(Style::new().fg(Color::LightRed).add_modifier(Modifier::BOLD)));
+        .title(
+            Line::from(title).style(
+                Style::new()
+                    .fg(Color::LightRed)
+                    .add_modifier(Modifier::BOLD),
+            ),
+        );
+    let width = usize::from(block.inner(pane).width);
     let mut lines = Vec::new();
     for diagnostic in &errors.diagnostics {
-        lines.extend(diagnostic_lines(&errors.sources, diagnostic));
+        lines.extend(diagnostic_lines(&errors.sources, diagnostic, width));
         lines.push(Line::default());
     }
-    Paragraph::new(lines)
-        .wrap(Wrap { trim: false })
-        .block(block)
-        .render(pane, buf);
+    Paragraph::new(lines).block(block).render(pane, buf);
 }
 
-/// A diagnostic as rustc-like lines: severity and message, location, the source line with a
-/// caret underline and label, then hints.
-pub fn diagnostic_lines(sources: &SourceMap, diagnostic: &Diagnostic) -> Vec<Line<'static>> {
+/// A diagnostic as rustc-like lines fitted to `width` columns: severity and message
+/// (wrapped), location, the source line with a caret underline and label (scrolled sideways
+/// so the caret shows), then hints (wrapped).
+pub fn diagnostic_lines(
+    sources: &SourceMap,
+    diagnostic: &Diagnostic,
+    width: usize,
+) -> Vec<Line<'static>> {
     let (word, color) = match diagnostic.severity {
         Severity::Error => ("error", Color::LightRed),
         Severity::Warning => ("warning", Color::Yellow),
         Severity::Note => ("note", Color::LightBlue),
     };
-    let mut lines = vec![Line::from(vec![
-        Span::styled(
-            format!("{word}: "),
-            Style::new().fg(color).add_modifier(Modifier::BOLD),
-        ),
-        Span::styled(
-            diagnostic.message.clone(),
-            Style::new().add_modifier(Modifier::BOLD),
-        ),
-    ])];
+    let head = format!("{word}: ");
+    let mut lines = Vec::new();
+    for (index, piece) in wrap(&diagnostic.message, width.saturating_sub(head.len()))
+        .into_iter()
+        .enumerate()
+    {
+        let lead = if index == 0 {
+            Span::styled(
+                head.clone(),
+                Style::new().fg(color).add_modifier(Modifier::BOLD),
+            )
+        } else {
+            Span::raw(" ".repeat(head.len()))
+        };
+        lines.push(Line::from(vec![
+            lead,
+            Span::styled(piece, Style::new().add_modifier(Modifier::BOLD)),
+        ]));
+    }
     let dim = Style::new().fg(Color::DarkGray);
     if let Some(span) = diagnostic.span {
         lines.push(Line::from(Span::styled(
@@ -58,35 +76,83 @@ pub fn diagnostic_lines(sources: &SourceMap, diagnostic: &Diagnostic) -> Vec<Lin
         if let Some(file) = sources.get(span.file) {
             let start = file.line_col(span.start);
             let end = file.line_col(span.end);
-            let text = file.line_text(start.line).replace('\t', " ");
+            let text: Vec<char> = file
+                .line_text(start.line)
+                .replace('\t', " ")
+                .chars()
+                .collect();
             let number = start.line.to_string();
-            let pad = " ".repeat(number.len());
+            let gutter = number.len() + 3;
+            let from = (start.column as usize - 1).min(text.len());
+            let underline_width = if end.line == start.line {
+                (end.column as usize)
+                    .saturating_sub(start.column as usize)
+                    .max(1)
+            } else {
+                text.len().saturating_sub(from).max(1)
+            };
+            // Scroll a long line so that the underlined part starts a third of the way in.
+            let room = width.saturating_sub(gutter).max(1);
+            let shift = if from + underline_width > room {
+                from.saturating_sub(room / 3)
+            } else {
+                0
+            };
+            let shown: String = text.iter().skip(shift).take(room).collect();
             lines.push(Line::from(vec![
                 Span::styled(format!("{number} │ "), dim),
-                Span::raw(text.clone()),
+                Span::raw(shown),
             ]));
-            let from = start.column as usize - 1;
-            let width = if end.line == start.line {
-                (end.column as usize).saturating_sub(start.column as usize).max(1)
-            } else {
-                text.chars().count().saturating_sub(from).max(1)
-            };
-            let mut underline = format!("{}{}", " ".repeat(from), "^".repeat(width));
+            let mut underline = format!(
+                "{}{}",
+                " ".repeat(from - shift),
+                "^".repeat(underline_width)
+            );
             if let Some(label) = &diagnostic.label {
                 underline.push(' ');
                 underline.push_str(label);
             }
             lines.push(Line::from(vec![
-                Span::styled(format!("{pad} │ "), dim),
+                Span::styled(format!("{} │ ", " ".repeat(number.len())), dim),
                 Span::styled(underline, Style::new().fg(color)),
             ]));
         }
     }
+    let help = "  = help: ";
     for hint in &diagnostic.hints {
-        lines.push(Line::from(vec![
-            Span::styled("  = help: ", Style::new().fg(Color::LightCyan)),
-            Span::raw(hint.clone()),
-        ]));
+        for (index, piece) in wrap(hint, width.saturating_sub(help.len()))
+            .into_iter()
+            .enumerate()
+        {
+            let lead = if index == 0 {
+                Span::styled(help, Style::new().fg(Color::LightCyan))
+            } else {
+                Span::raw(" ".repeat(help.len()))
+            };
+            lines.push(Line::from(vec![lead, Span::raw(piece)]));
+        }
+    }
+    lines
+}
+
+/// Splits text into lines of at most `width` characters at spaces (a word longer than the
+/// width gets a line of its own).
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let width = width.max(8);
+    let mut lines = Vec::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        let needed = line.chars().count() + usize::from(!line.is_empty()) + word.chars().count();
+        if !line.is_empty() && needed > width {
+            lines.push(std::mem::take(&mut line));
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    }
+    if !line.is_empty() || lines.is_empty() {
+        lines.push(line);
     }
     lines
 }
@@ -108,7 +174,7 @@ mod tests {
         )
         .with_label("this is negative")
         .with_hint("use a radius above 0");
-        let lines: Vec<String> = diagnostic_lines(&sources, &diagnostic)
+        let lines: Vec<String> = diagnostic_lines(&sources, &diagnostic, 60)
             .iter()
             .map(|l| l.to_string())
             .collect();
@@ -122,5 +188,31 @@ mod tests {
                 "  = help: use a radius above 0",
             ]
         );
+    }
+
+    #[test]
+    fn long_lines_scroll_to_the_error_and_messages_wrap() {
+        let mut sources = SourceMap::new();
+        let text = format!("{}radius -1\n", "x ".repeat(40));
+        let file = sources.add(SourceFile::new("long.scene", text.as_str()));
+        let start = text.find("-1").unwrap();
+        let diagnostic = Diagnostic::error(
+            "a radius must be positive and this message is long enough to wrap",
+            SourceSpan::new(file, start, start + 2),
+        );
+        let lines: Vec<String> = diagnostic_lines(&sources, &diagnostic, 30)
+            .iter()
+            .map(|l| l.to_string())
+            .collect();
+        assert!(lines.iter().all(|l| l.chars().count() <= 30), "{lines:#?}");
+        let caret = lines.iter().position(|l| l.contains("^^")).unwrap();
+        let column = lines[caret].find("^^").unwrap();
+        assert_eq!(&lines[caret - 1][column..column + 2], "-1", "{lines:#?}");
+    }
+
+    #[test]
+    fn wrapping_breaks_at_spaces() {
+        assert_eq!(wrap("one two three", 8), ["one two", "three"]);
+        assert_eq!(wrap("", 8), [""]);
     }
 }

@@ -50,7 +50,10 @@ pub fn help_lines() -> Vec<Line<'static>> {
                 format!("{shown:<SECTION_WIDTH$}"),
                 Style::new().add_modifier(Modifier::BOLD),
             ),
-            Span::styled(format!("{keys:<KEY_WIDTH$}"), Style::new().fg(Color::Yellow)),
+            Span::styled(
+                format!("{keys:<KEY_WIDTH$}"),
+                Style::new().fg(Color::Yellow),
+            ),
             Span::raw(what),
         ]));
     }
@@ -67,6 +70,10 @@ mod tests {
         let lines = help_lines();
         let width = lines.iter().map(Line::width).max().unwrap() + 4;
         assert!(width <= usize::from(MIN_WIDTH), "{width}");
-        assert!(lines.len() + 2 <= usize::from(MIN_HEIGHT), "{}", lines.len());
+        assert!(
+            lines.len() + 2 <= usize::from(MIN_HEIGHT),
+            "{}",
+            lines.len()
+        );
     }
 }

@@ -53,16 +53,17 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         let (column, half_row) = viewport.cell_of(x, y, area)?;
         viewport.pixel_at(column, half_row, width, height)
     };
+    // The first mark of a pixel wins: the cursor over a hit point at the same place.
     let mut marked = Vec::new();
+    if let Some(pixel) = sampled(app.cursor) {
+        marked.push((pixel, CURSOR_COLOR));
+    }
     if app.show_hit_point {
         if let Some(HitPointView::Shown(x, y)) = hit_point_view(app) {
             if let Some(pixel) = sampled((x, y)) {
                 marked.push((pixel, HIT_POINT_COLOR));
             }
         }
-    }
-    if let Some(pixel) = sampled(app.cursor) {
-        marked.push((pixel, CURSOR_COLOR));
     }
     draw_image(source, &viewport, app.color_depth, &marked, area, buf);
     draw_rulers(app, &viewport, pane, area, buf);
@@ -74,9 +75,7 @@ fn draw_rulers(app: &App, viewport: &Viewport, pane: Rect, area: Rect, buf: &mut
     let Some((column, half_row)) = viewport.cell_of(app.cursor.0, app.cursor.1, area) else {
         return;
     };
-    let style = Style::new()
-        .fg(CURSOR_COLOR)
-        .add_modifier(Modifier::BOLD);
+    let style = Style::new().fg(CURSOR_COLOR).add_modifier(Modifier::BOLD);
     let row = u16::try_from(half_row / 2).unwrap_or(u16::MAX);
     let bottom = pane.y + pane.height.saturating_sub(1);
     if let Some(cell) = buf.cell_mut((area.x + column, bottom)) {

@@ -21,7 +21,7 @@ use super::format::{self, number, swatch, vector};
 use super::pane_block;
 use super::tree_pane::contribution;
 
-const LABEL_WIDTH: usize = 12;
+const LABEL_WIDTH: usize = 13;
 
 pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let focused = app.focus == Focus::Inspector;
@@ -43,7 +43,11 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let Some(node) = tree.node(id) else {
         return;
     };
-    let title = format!(" Inspector · {} ray, depth {} ", node.kind.name(), node.depth);
+    let title = format!(
+        " Inspector · {} ray, depth {} ",
+        node.kind.name(),
+        node.depth
+    );
     let block = pane_block(Line::from(title), focused);
     let lines = Lines::new(app.color_depth).node(app, tree, id, node);
     let inner_height = usize::from(block.inner(pane).height);
@@ -102,10 +106,20 @@ impl Lines {
             .push(Line::from(Span::styled(title.to_string(), section_style())));
     }
 
-    fn node(mut self, app: &App, tree: &TreeView, id: NodeId, node: &RayNode) -> Vec<Line<'static>> {
+    fn node(
+        mut self,
+        app: &App,
+        tree: &TreeView,
+        id: NodeId,
+        node: &RayNode,
+    ) -> Vec<Line<'static>> {
         let whole = tree.tree();
         let [x, y] = whole.pixel;
-        self.color(&format!("pixel {x},{y}"), whole.color, "its rendered colour");
+        self.color(
+            &format!("pixel {x},{y}"),
+            whole.color,
+            "its rendered colour",
+        );
         if let Some(sample) = tree.sample(id) {
             if whole.samples_per_pixel > 1 {
                 self.color(
@@ -115,7 +129,6 @@ impl Lines {
                 );
             }
         }
-        self.section(&format!("{} ray, depth {}", node.kind.name(), node.depth));
         self.text("origin", vector(node.origin));
         self.text("direction", vector(node.direction));
         self.color("path weight", node.weight, "share of the pixel");
@@ -145,7 +158,7 @@ impl Lines {
                 Some(hit) => self.hit(hit),
                 None => self.text("hit", "nothing: the ray left the scene"),
             }
-            if node.hit.is_some() || node.shadow.is_some() {
+            if node.hit.is_some() {
                 if let Some(view) = hit_point_view(app) {
                     self.text("on screen", view.describe());
                 }
@@ -153,12 +166,12 @@ impl Lines {
             if let Some(local) = &node.local {
                 self.local(local);
             }
-            self.color("returned", node.color, "colour sent back up");
+            self.why_this_colour(node);
         }
         self.color(
             "contributes",
             contribution(tree, id, node),
-            "to the pixel",
+            "weight × returned",
         );
         self.text("ended", termination(node));
         for skipped in &node.skipped {
@@ -184,10 +197,7 @@ impl Lines {
         };
         self.text(
             "leaves from",
-            format!(
-                "incidence {:.1}°, {side}",
-                interface.incidence_degrees
-            ),
+            format!("incidence {:.1}°, {side}", interface.incidence_degrees),
         );
         if let Some([from, to]) = interface.ior {
             self.text("ior", format!("{} → {}", number(from), number(to)));
@@ -204,20 +214,18 @@ impl Lines {
     }
 
     fn hit(&mut self, hit: &HitInfo) {
-        self.section("hit");
         self.text(
-            "t, point",
-            format!("{}  {}", number(hit.t), vector(hit.point)),
+            "hit at t",
+            format!("{}  point {}", number(hit.t), vector(hit.point)),
         );
         self.text(
             "object",
-            format!("{} ({})  {}", hit.object.label, hit.object.kind, hit.object.location),
+            format!("{} ({})", hit.object.label, hit.object.kind),
         );
+        self.text("", format!("defined at {}", hit.object.location));
         if hit.leaf.handle != hit.object.handle {
-            self.text(
-                "leaf",
-                format!("{} ({})  {}", hit.leaf.label, hit.leaf.kind, hit.leaf.location),
-            );
+            self.text("leaf", format!("{} ({})", hit.leaf.label, hit.leaf.kind));
+            self.text("", format!("defined at {}", hit.leaf.location));
         }
         if !hit.csg_path.is_empty() {
             let path: Vec<String> = hit
@@ -227,20 +235,23 @@ impl Lines {
                 .collect();
             self.text("csg", path.join(" › "));
         }
+        let face = if hit.front_face {
+            "front face"
+        } else {
+            "back face (inside)"
+        };
         self.text(
-            "face",
-            if hit.front_face {
-                "front (outside)"
-            } else {
-                "back (from inside)"
-            },
+            "normal",
+            format!("{}  {face}", vector(hit.geometric_normal)),
         );
-        self.text("normal", format!("geometric {}", vector(hit.geometric_normal)));
-        self.text("", format!("shading   {}", vector(hit.shading_normal)));
-        self.text(
-            "material",
-            format!("{}  {}", hit.material.label, hit.material.location),
-        );
+        if hit.shading_normal != hit.geometric_normal {
+            self.text(
+                "shading",
+                format!("{}  faces the ray", vector(hit.shading_normal)),
+            );
+        }
+        self.text("material", hit.material.label.clone());
+        self.text("", format!("defined at {}", hit.material.location));
         if hit.resolved_material.handle != hit.material.handle {
             self.text("pattern →", hit.resolved_material.label.clone());
         }
@@ -275,6 +286,35 @@ impl Lines {
         self.color("local total", local.total, "");
     }
 
+    /// The returned colour as the tracer adds it up: the local colour, plus each traced
+    /// secondary ray's colour times its coefficient, all times the absorption on the way.
+    fn why_this_colour(&mut self, node: &RayNode) {
+        self.section("returned colour");
+        let Some(local) = &node.local else {
+            self.color("background", node.color, "the scene's background");
+            return;
+        };
+        self.color("local", local.total, "ambient + lights");
+        for child in &node.children {
+            let (label, coefficient) = match child.kind {
+                RayKind::Reflected => ("+ reflected", "kr"),
+                RayKind::Transmitted => ("+ transmitted", "kt"),
+                RayKind::Camera | RayKind::Shadow => continue,
+            };
+            self.color(
+                label,
+                format::mul(child.coefficient, child.color),
+                &format!("{coefficient} × its colour"),
+            );
+        }
+        if let Some(hit) = &node.hit {
+            if hit.absorption != [1.0; 3] {
+                self.color("× absorption", hit.absorption, "");
+            }
+        }
+        self.color("= returned", node.color, "");
+    }
+
     fn shadow(&mut self, shadow: &ShadowInfo) {
         self.text(
             "towards",
@@ -301,10 +341,9 @@ impl Lines {
                 ),
                 None => "blocked".to_string(),
             },
-            ShadowOutcome::Filtered => format!(
-                "filtered through {} object(s)",
-                shadow.filters.unwrap_or(0)
-            ),
+            ShadowOutcome::Filtered => {
+                format!("filtered through {} object(s)", shadow.filters.unwrap_or(0))
+            }
         };
         self.text("result", result);
         if let Some(transmittance) = shadow.transmittance {

@@ -6,6 +6,8 @@ pub mod format;
 mod help;
 mod image_pane;
 mod inspector;
+#[cfg(test)]
+mod snapshot_tests;
 mod source_pane;
 mod status;
 mod tree_pane;
@@ -70,5 +72,8 @@ fn too_small(area: Rect, buf: &mut Buffer) {
     Paragraph::new(lines)
         .alignment(Alignment::Center)
         .wrap(Wrap { trim: true })
-        .render(Rect::new(area.x, top, area.width, area.height - (top - area.y)), buf);
+        .render(
+            Rect::new(area.x, top, area.width, area.height - (top - area.y)),
+            buf,
+        );
 }

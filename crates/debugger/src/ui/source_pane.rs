@@ -49,7 +49,10 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
 /// The definition to show for the selected ray, or a note saying why there is none.
 fn target(app: &App) -> (Option<Target>, String) {
     let Some(picked) = &app.picked else {
-        return (None, "The definition of what the selected ray hit shows here.".into());
+        return (
+            None,
+            "The definition of what the selected ray hit shows here.".into(),
+        );
     };
     let Some(node) = picked.tree.selected_node() else {
         return (None, String::new());
@@ -105,9 +108,7 @@ fn excerpt(sources: &SourceMap, span: SourceSpan, height: u16) -> Option<Vec<Lin
         .min(file.line_count().saturating_sub(height - 1).max(1));
     let last = (first + height - 1).min(file.line_count());
     let gutter = last.to_string().len();
-    let highlight = Style::new()
-        .fg(Color::Yellow)
-        .add_modifier(Modifier::BOLD);
+    let highlight = Style::new().fg(Color::Yellow).add_modifier(Modifier::BOLD);
     let mut lines = Vec::new();
     for number in first..=last {
         let text = file.line_text(number).replace('\t', "    ");

@@ -1,5 +1,6 @@
 //! The status line: the scene, the latest message (or the render's progress), the cursor
 //! pixel's colour and statistics, how long the tree took to record, and where help is.
+//! When the line is too narrow, the least useful parts go first.
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -11,49 +12,105 @@ use crate::app::{App, RenderState};
 
 use super::format::{self, swatch};
 
+/// A part of the status line; lower `rank` parts are dropped last.
+struct Part {
+    rank: u8,
+    spans: Vec<Span<'static>>,
+}
+
 pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
-    let separator = || Span::styled(" │ ", Style::new().fg(Color::DarkGray));
-    let mut spans = vec![Span::styled(
-        format!(" {}", app.scene_name),
-        Style::new().add_modifier(Modifier::BOLD),
-    )];
-    spans.push(separator());
-    match &app.message {
-        Some(message) if message.is_error => spans.push(Span::styled(
+    let mut parts = Vec::new();
+    parts.push(Part {
+        rank: 4,
+        spans: vec![Span::styled(
+            app.scene_name.clone(),
+            Style::new().add_modifier(Modifier::BOLD),
+        )],
+    });
+    let news = match &app.message {
+        Some(message) if message.is_error => Span::styled(
             message.text.clone(),
-            Style::new().fg(Color::LightRed).add_modifier(Modifier::BOLD),
-        )),
-        Some(message) => spans.push(Span::styled(
-            message.text.clone(),
-            Style::new().fg(Color::LightGreen),
-        )),
-        None => spans.push(Span::raw(render_state(app))),
-    }
-    spans.push(separator());
+            Style::new()
+                .fg(Color::LightRed)
+                .add_modifier(Modifier::BOLD),
+        ),
+        Some(message) => Span::styled(message.text.clone(), Style::new().fg(Color::LightGreen)),
+        None => Span::raw(render_state(app)),
+    };
+    parts.push(Part {
+        rank: 0,
+        spans: vec![news],
+    });
     let (x, y) = app.cursor;
-    spans.push(Span::raw(format!("({x}, {y}) ")));
+    let mut cursor = vec![Span::raw(format!("({x}, {y}) "))];
     match app.image.linear(x, y) {
         Some(color) => {
-            spans.push(swatch(color, app.color_depth));
-            spans.push(Span::raw(format!(" {}", format::rgb(color))));
+            cursor.push(swatch(color, app.color_depth));
+            cursor.push(Span::raw(format!(" {}", format::rgb(color))));
         }
-        None => spans.push(Span::raw("not rendered yet")),
+        None => cursor.push(Span::raw("not rendered yet")),
     }
     if let Some(map) = &app.heat_map {
         if let Some(value) = map.value(x, y) {
-            spans.push(Span::raw(format!(" · {} {value}", map.kind.title())));
+            cursor.push(Span::raw(format!(" · {} {value}", map.kind.title())));
         }
     }
+    parts.push(Part {
+        rank: 1,
+        spans: cursor,
+    });
     if let Some(picked) = &app.picked {
-        spans.push(separator());
-        spans.push(Span::raw(format!(
-            "tree recorded in {:.2} ms",
-            picked.trace_time.as_secs_f64() * 1000.0
-        )));
+        parts.push(Part {
+            rank: 3,
+            spans: vec![Span::raw(match picked.on_screen_after {
+                Some(shown) => format!(
+                    "tree in {:.2} ms, on screen in {:.1} ms",
+                    picked.trace_time.as_secs_f64() * 1000.0,
+                    shown.as_secs_f64() * 1000.0
+                ),
+                None => format!(
+                    "tree in {:.2} ms",
+                    picked.trace_time.as_secs_f64() * 1000.0
+                ),
+            })],
+        });
     }
-    spans.push(separator());
-    spans.push(Span::styled("? help", Style::new().fg(Color::Yellow)));
+    parts.push(Part {
+        rank: 2,
+        spans: vec![Span::styled("? help", Style::new().fg(Color::Yellow))],
+    });
+    fit(&mut parts, usize::from(area.width));
+    let separator = Span::styled(" │ ", Style::new().fg(Color::DarkGray));
+    let mut spans = vec![Span::raw(" ")];
+    for (index, part) in parts.into_iter().enumerate() {
+        if index > 0 {
+            spans.push(separator.clone());
+        }
+        spans.extend(part.spans);
+    }
     Line::from(spans).render(area, buf);
+}
+
+/// Drops the highest-ranked parts until the line fits (the last part left is cut).
+fn fit(parts: &mut Vec<Part>, width: usize) {
+    let total = |parts: &[Part]| -> usize {
+        1 + parts
+            .iter()
+            .map(|p| p.spans.iter().map(Span::width).sum::<usize>())
+            .sum::<usize>()
+            + 3 * parts.len().saturating_sub(1)
+    };
+    while parts.len() > 1 && total(parts) > width {
+        let Some(worst) = parts
+            .iter()
+            .enumerate()
+            .max_by_key(|(_, p)| p.rank)
+            .map(|(i, _)| i)
+        else {
+            break;
+        };
+        parts.remove(worst);
+    }
 }
 
 fn render_state(app: &App) -> String {

@@ -33,10 +33,7 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     };
     let tree = &picked.tree;
     let [x, y] = tree.tree().pixel;
-    let title = format!(
-        " Ray tree of ({x}, {y}) · {} rays ",
-        tree.len()
-    );
+    let title = format!(" Ray tree of ({x}, {y}) · {} rays ", tree.len());
     let block = pane_block(Line::from(title), focused);
     let area = block.inner(pane);
     block.render(pane, buf);
@@ -60,7 +57,8 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     }
 }
 
-/// One ray's row, fitted to `width` columns: the label is cut first, the numbers last.
+/// One ray's row, fitted to `width` columns: the label is cut first, the numbers only
+/// when the pane is very narrow.
 fn row_line(app: &App, tree: &TreeView, id: NodeId, width: usize) -> Line<'static> {
     let Some(node) = tree.node(id) else {
         return Line::default();
@@ -73,11 +71,12 @@ fn row_line(app: &App, tree: &TreeView, id: NodeId, width: usize) -> Line<'stati
     };
     let head = format!("{indent}{marker}{:<11} d{} ", node.kind.name(), node.depth);
     let contribution = contribution(tree, id, node);
-    let numbers = format!(" {}", format::rgb(contribution));
-    // Columns: head, label, swatch (2), numbers; drop the numbers when the pane is narrow.
-    let show_numbers = width >= head.chars().count() + 12 + 2 + numbers.len();
-    let tail = 2 + if show_numbers { numbers.len() } else { 0 };
-    let label_width = width.saturating_sub(head.chars().count() + tail + 1);
+    let [r, g, b] = contribution;
+    let numbers = format!(" {r:.2} {g:.2} {b:.2}");
+    let head_width = head.chars().count();
+    let show_numbers = width >= head_width + 8 + 3 + numbers.len();
+    let tail = 3 + if show_numbers { numbers.len() } else { 0 };
+    let label_width = width.saturating_sub(head_width + tail);
     let label = format!(
         "{:<label_width$}",
         format::truncate(&describe(node), label_width)
@@ -101,7 +100,7 @@ fn row_line(app: &App, tree: &TreeView, id: NodeId, width: usize) -> Line<'stati
 }
 
 /// What the ray met: the object it hit, a miss, or for a shadow ray its light and blocker;
-/// plus why recursion stopped when that is worth a glance.
+/// plus why recursion stopped when it stopped early.
 fn describe(node: &RayNode) -> String {
     if let Some(shadow) = &node.shadow {
         let light = &shadow.light.label;
@@ -109,7 +108,7 @@ fn describe(node: &RayNode) -> String {
             ShadowOutcome::Unblocked => format!("→ {light}: lit"),
             ShadowOutcome::Filtered => format!("→ {light}: filtered"),
             ShadowOutcome::Blocked => match &shadow.blocker {
-                Some(blocker) => format!("→ {light}: blocked by {}", blocker.object.label),
+                Some(blocker) => format!("→ {light}: blocked ({})", blocker.object.label),
                 None => format!("→ {light}: blocked"),
             },
         };
@@ -119,17 +118,17 @@ fn describe(node: &RayNode) -> String {
             format!("{} ({})", hit.object.label, hit.leaf.label)
         }
         Some(hit) => hit.object.label.clone(),
-        None => "miss (background)".to_string(),
+        None => "miss: background".to_string(),
     };
     if node.hit.as_ref().is_some_and(|h| !h.front_face) {
-        text.push_str(" from inside");
+        text.push_str(" (inside)");
     }
+    // A matte surface ends recursion as "absorbed" all the time: not worth a mention here.
     let ended = match node.termination {
         Termination::MaxDepth => Some("max depth"),
         Termination::WeightCutoff => Some("weight cut-off"),
         Termination::TotalInternalReflection => Some("total internal reflection"),
-        Termination::Absorbed => Some("absorbed"),
-        Termination::NotEnded | Termination::Miss => None,
+        Termination::Absorbed | Termination::NotEnded | Termination::Miss => None,
     };
     if let Some(ended) = ended {
         text.push_str(&format!(" · {ended}"));

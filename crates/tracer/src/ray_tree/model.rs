@@ -108,7 +108,7 @@ pub struct InterfaceInfo {
     pub cos_incidence: f32,
     /// `[from, to]` refractive indices when the material transmits (air is 1).
     pub ior: Option<[f32; 2]>,
-    /// Whether the incoming ray was entering the solid (it hit the outside).
+    /// Whether the incoming ray hit the outside of a solid (always false on thin surfaces).
     pub entering: bool,
     /// Schlick's `R` when the material uses Fresnel.
     pub fresnel_reflectance: Option<f32>,

@@ -1,0 +1,140 @@
+//! Screen snapshots of whole frames (ratatui's TestBackend, insta): the layout at the usual
+//! sizes, a picked pixel with its tree, the help, a failed reload, a terminal too small.
+//! Timings that vary from run to run are pinned before drawing.
+
+use std::time::Duration;
+
+use insta::assert_snapshot;
+use ratatui::backend::TestBackend;
+use ratatui::layout::Rect;
+use ratatui::Terminal;
+use whitted_ir::{Diagnostic, SourceFile, SourceMap, Span};
+use whitted_tracer::{render_with_pixel_stats, NoObserver, RayKind, TileResult};
+
+use crate::action::{Action, Focus};
+use crate::app::{App, LoadedScene, SceneErrors};
+use crate::heat_map::HeatMapKind;
+use crate::test_scene::{whitted_scene, GLASS_PIXEL};
+use crate::update::update;
+
+/// The app after a finished render of scenes/whitted.scene in a `width × height` terminal.
+fn rendered_app(width: u16, height: u16) -> App {
+    let mut app = App::new(
+        "scenes/whitted.scene".into(),
+        LoadedScene::new(whitted_scene()),
+        Rect::new(0, 0, width, height),
+        "/tmp".into(),
+    );
+    let (image, mut stats, pixel_stats) =
+        render_with_pixel_stats(&app.loaded.prepared, &app.options, &NoObserver)
+            .expect("not cancelled");
+    stats.render_seconds = 0.25;
+    app.render_started(1);
+    app.apply_tile(
+        1,
+        &TileResult {
+            x: 0,
+            y: 0,
+            width: image.width,
+            height: image.height,
+            pixels: image.pixels,
+        },
+    );
+    app.apply_render_done(1, Some((stats, pixel_stats)));
+    app
+}
+
+fn pick_glass_pixel(app: &mut App) {
+    app.cursor = GLASS_PIXEL;
+    update(app, Action::TraceCursor);
+    if let Some(picked) = &mut app.picked {
+        picked.trace_time = Duration::from_micros(60);
+    }
+}
+
+fn draw(app: &App) -> Terminal<TestBackend> {
+    let mut terminal =
+        Terminal::new(TestBackend::new(app.area.width, app.area.height)).expect("a test terminal");
+    terminal
+        .draw(|frame| frame.render_widget(app, frame.area()))
+        .expect("drawing to a test terminal");
+    terminal
+}
+
+#[test]
+fn start_screen_at_120x40() {
+    let app = rendered_app(120, 40);
+    assert_snapshot!(draw(&app).backend());
+}
+
+#[test]
+fn glass_pixel_walked_to_its_transmitted_ray_at_120x40() {
+    let mut app = rendered_app(120, 40);
+    pick_glass_pixel(&mut app);
+    update(&mut app, Action::FocusNext);
+    assert_eq!(app.focus, Focus::Tree);
+    while app
+        .picked
+        .as_ref()
+        .and_then(|p| p.tree.selected_node())
+        .is_some_and(|n| n.kind != RayKind::Transmitted)
+    {
+        update(&mut app, Action::TreeDown);
+    }
+    assert_snapshot!(draw(&app).backend());
+}
+
+#[test]
+fn glass_pixel_at_80x24() {
+    let mut app = rendered_app(80, 24);
+    pick_glass_pixel(&mut app);
+    assert_snapshot!(draw(&app).backend());
+}
+
+#[test]
+fn rays_per_pixel_overlay_and_material_source() {
+    let mut app = rendered_app(120, 40);
+    pick_glass_pixel(&mut app);
+    update(&mut app, Action::ToggleOverlay(HeatMapKind::RaysPerPixel));
+    update(&mut app, Action::ToggleSourceTarget);
+    assert_snapshot!(draw(&app).backend());
+}
+
+#[test]
+fn help_at_80x24() {
+    let mut app = rendered_app(80, 24);
+    update(&mut app, Action::ToggleHelp);
+    assert_snapshot!(draw(&app).backend());
+}
+
+#[test]
+fn failed_reload_keeps_the_image_and_shows_the_errors() {
+    let mut app = rendered_app(120, 40);
+    pick_glass_pixel(&mut app);
+    let mut sources = SourceMap::new();
+    let text = "sphere \"glass sphere\" { center <-0.75, 1.1, -1.2> radius -1 material glass }\n";
+    let file = sources.add(SourceFile::new("scenes/whitted.scene", text));
+    let start = text.find("-1 ").expect("the radius");
+    let errors = SceneErrors {
+        diagnostics: vec![Diagnostic::error(
+            "a sphere's radius must be positive",
+            Span::new(file, start, start + 2),
+        )
+        .with_label("this radius is -1")
+        .with_hint("use a radius above 0")],
+        sources,
+    };
+    let effects = app.apply_reload(Err(errors));
+    assert!(effects.is_empty(), "nothing is re-rendered");
+    assert!(
+        app.image.linear(0, 0).is_some(),
+        "the last good image stays"
+    );
+    assert_snapshot!(draw(&app).backend());
+}
+
+#[test]
+fn a_terminal_too_small_says_so() {
+    let app = rendered_app(40, 10);
+    assert_snapshot!(draw(&app).backend());
+}

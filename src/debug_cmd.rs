@@ -1,0 +1,84 @@
+//! `whitted debug`: compiles the scene, then hands it to the terminal debugger together with
+//! a way to compile it again from disk and the files to watch. The debugger itself never
+//! parses or reads scene files.
+
+use std::path::{Path, PathBuf};
+
+use whitted_debugger::{Compiled, DebugError, Recompile, Session};
+use whitted_ir::SourceMap;
+use whitted_lang::{compile_file, CompileOptions, SourceLoader};
+
+use crate::cli::{DebugArgs, SceneArgs};
+use crate::scene_input::load_scene;
+use crate::Failure;
+
+/// Reads scene files (the root and its imports) from the file system for the compiler.
+struct DiskLoader;
+
+impl SourceLoader for DiskLoader {
+    fn load(&mut self, path: &Path) -> std::io::Result<String> {
+        std::fs::read_to_string(path)
+    }
+}
+
+pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
+    // The first compile prints its diagnostics like every other command; a scene with
+    // errors stops here, before the terminal is taken over.
+    let loaded = load_scene(&args.scene, false)?;
+    let settings = &loaded.scene.settings;
+    if let Some([x, y]) = args.pixel {
+        if x >= settings.width || y >= settings.height {
+            return Err(Failure::Message(format!(
+                "pixel ({x}, {y}) is outside the {}x{} image (x must be 0 to {}, y 0 to {})",
+                settings.width,
+                settings.height,
+                settings.width.saturating_sub(1),
+                settings.height.saturating_sub(1)
+            )));
+        }
+    }
+    let watch = watch_list(&args.scene.scene, &loaded.scene.sources);
+    let scene_args = args.scene.clone();
+    let recompile: Recompile = Box::new(move || compile(&scene_args));
+    let session = Session {
+        scene_name: args.scene.scene.display().to_string(),
+        scene: loaded.scene,
+        watch,
+        recompile,
+        pixel: args.pixel.map(|[x, y]| (x, y)),
+        export_dir: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+    };
+    whitted_debugger::run(session).map_err(|error| match error {
+        DebugError::NotATerminal => Failure::Usage(error.to_string()),
+        DebugError::Terminal(_) => Failure::Message(error.to_string()),
+    })
+}
+
+/// Compiles the scene again, silently: the debugger shows the diagnostics itself.
+fn compile(args: &SceneArgs) -> Compiled {
+    let options = CompileOptions {
+        defines: args.define.clone(),
+        ..CompileOptions::default()
+    };
+    let compilation = compile_file(&args.scene, &mut DiskLoader, &options);
+    let watch = watch_list(&args.scene, &compilation.sources);
+    Compiled {
+        scene: compilation.scene,
+        diagnostics: compilation.diagnostics,
+        sources: compilation.sources,
+        watch,
+    }
+}
+
+/// The root file and every source file that exists on disk (imports; not the pseudo-files
+/// of `-D` values).
+fn watch_list(root: &Path, sources: &SourceMap) -> Vec<PathBuf> {
+    let mut files = vec![root.to_path_buf()];
+    for (_, file) in sources.files() {
+        let path = PathBuf::from(&file.path);
+        if path.is_file() && !files.contains(&path) {
+            files.push(path);
+        }
+    }
+    files
+}

@@ -1,0 +1,320 @@
+//! End to end: the real `whitted debug` in a tmux terminal, driven by keys and read back as
+//! screen text, the way a user would see it. Each test runs its own tmux server (a private
+//! socket), so tests never touch a user's tmux or each other.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+/// A tmux server with one 120x40 session, killed when dropped.
+struct Tmux {
+    socket: String,
+    session: String,
+}
+
+/// How long any one expected screen may take to appear (a cold debug build on a busy CI
+/// machine is slow; a healthy run waits well under a second for each).
+const PATIENCE: Duration = Duration::from_secs(60);
+
+impl Tmux {
+    /// Starts `command` (run by `sh -c` in `dir`) in a detached session of the given size.
+    /// When the command ends, the shell prints a marker and stays, so the screen can be read.
+    fn start(name: &str, dir: &Path, command: &str, width: u16, height: u16) -> Tmux {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.subsec_nanos());
+        let unique = format!("whitted-{name}-{}-{nanos}", std::process::id());
+        let tmux = Tmux {
+            socket: unique.clone(),
+            session: unique,
+        };
+        let script = format!("{command}; echo \"debugger exited with $?\"; sleep 600");
+        let output = tmux.run(&[
+            "new-session",
+            "-d",
+            "-s",
+            &tmux.session,
+            "-x",
+            &width.to_string(),
+            "-y",
+            &height.to_string(),
+            "-c",
+            &dir.display().to_string(),
+            "sh",
+            "-c",
+            &script,
+        ]);
+        assert!(
+            output.status.success(),
+            "cannot start tmux (is it installed? .ci/run installs it): {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        tmux
+    }
+
+    fn run(&self, args: &[&str]) -> Output {
+        Command::new("tmux")
+            .arg("-L")
+            .arg(&self.socket)
+            .args(args)
+            .env_remove("TMUX")
+            .output()
+            .expect("tmux runs (it is installed by .ci/run)")
+    }
+
+    fn keys(&self, keys: &[&str]) {
+        for key in keys {
+            let output = self.run(&["send-keys", "-t", &self.session, key]);
+            assert!(output.status.success(), "send-keys {key}");
+        }
+    }
+
+    fn screen(&self) -> String {
+        let output = self.run(&["capture-pane", "-p", "-t", &self.session]);
+        String::from_utf8_lossy(&output.stdout).into_owned()
+    }
+
+    /// A tmux format variable of the pane, e.g. `alternate_on`.
+    fn pane_flag(&self, name: &str) -> String {
+        let format = format!("#{{{name}}}");
+        let output = self.run(&["display-message", "-p", "-t", &self.session, &format]);
+        String::from_utf8_lossy(&output.stdout).trim().to_string()
+    }
+
+    /// Polls the screen until `ready` holds; fails with the last screen after [`PATIENCE`].
+    fn wait_for(&self, what: &str, ready: impl Fn(&str) -> bool) -> String {
+        let started = Instant::now();
+        loop {
+            let screen = self.screen();
+            if ready(&screen) {
+                return screen;
+            }
+            assert!(
+                started.elapsed() < PATIENCE,
+                "waited {PATIENCE:?} for {what}; the screen shows:\n{screen}"
+            );
+            std::thread::sleep(Duration::from_millis(40));
+        }
+    }
+
+    /// Presses Down in the tree until the inspector shows a ray of `kind` (each press waits
+    /// for the inspector to change, so no fixed delays).
+    fn select_in_tree(&self, kind: &str) -> String {
+        let wanted = format!("Inspector · {kind} ray");
+        for _ in 0..30 {
+            let before = inspector_title(&self.screen());
+            if before.contains(&wanted) {
+                break;
+            }
+            self.keys(&["Down"]);
+            self.wait_for("the selection to move", |s| inspector_title(s) != before);
+        }
+        self.wait_for(&wanted, |s| s.contains(&wanted))
+    }
+}
+
+/// The inspector pane's title (it names the selected ray).
+fn inspector_title(screen: &str) -> String {
+    let line = line_with(screen, "Inspector");
+    line.find("Inspector")
+        .map(|start| line[start..].chars().take(40).collect())
+        .unwrap_or_default()
+}
+
+impl Drop for Tmux {
+    fn drop(&mut self) {
+        let _ = self.run(&["kill-server"]);
+    }
+}
+
+fn whitted() -> &'static str {
+    env!("CARGO_BIN_EXE_whitted")
+}
+
+fn repository() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The line of the screen that contains `needle`.
+fn line_with<'a>(screen: &'a str, needle: &str) -> &'a str {
+    screen.lines().find(|l| l.contains(needle)).unwrap_or("")
+}
+
+#[test]
+fn pick_the_glass_sphere_walk_to_the_transmitted_ray_export_and_quit() {
+    let out = tempfile::tempdir().expect("a temporary directory");
+    let scene = repository().join("scenes/whitted.scene");
+    let command = format!("'{}' debug '{}'", whitted(), scene.display());
+    let tmux = Tmux::start("pick", out.path(), &command, 120, 40);
+
+    tmux.wait_for("the finished image", |s| s.contains("rendered in"));
+    assert_eq!(
+        tmux.pane_flag("alternate_on"),
+        "1",
+        "the debugger uses the alternate screen"
+    );
+    assert!(
+        tmux.screen().contains("(320, 240)"),
+        "the cursor starts in the middle"
+    );
+
+    // The glass sphere is right of centre (+x is on the image's left): 80 px right, 30 down.
+    tmux.keys(&["L", "L", "L", "L", "L", "L", "L", "L", "J", "J", "J"]);
+    tmux.wait_for("the cursor on (400, 270)", |s| s.contains("(400, 270)"));
+    tmux.keys(&["Enter"]);
+    let screen = tmux.wait_for("the ray tree of the pixel", |s| {
+        s.contains("Ray tree of (400, 270)")
+    });
+    assert!(
+        line_with(&screen, "▼ camera").contains("glass sphere"),
+        "the camera ray hits the glass sphere:\n{screen}"
+    );
+    assert!(
+        screen.contains("Inspector · camera ray, depth 0"),
+        "{screen}"
+    );
+    assert!(screen.contains("Source · "), "{screen}");
+    assert!(
+        line_with(&screen, "Source · ").contains("whitted.scene:20:1"),
+        "{screen}"
+    );
+
+    // Into the tree, then down until the transmitted ray is selected.
+    tmux.keys(&["Tab"]);
+    let screen = tmux.select_in_tree("transmitted");
+    assert!(
+        screen.contains("Inspector · transmitted ray, depth 1"),
+        "{screen}"
+    );
+    assert!(
+        screen.contains("1.000 → 1.500"),
+        "refraction into glass:\n{screen}"
+    );
+    assert!(screen.contains("entering the solid"), "{screen}");
+    assert!(
+        screen.contains("back face (inside)"),
+        "it hits the far side:\n{screen}"
+    );
+    assert!(
+        line_with(&screen, "transmitted d1").contains("glass sphere (inside)"),
+        "{screen}"
+    );
+
+    // Export the tree as JSON into the working directory.
+    tmux.keys(&["e"]);
+    tmux.wait_for("the export message", |s| s.contains("wrote the ray tree"));
+    let exported = out.path().join("whitted-400-270.ray-tree.json");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&exported).expect("the export file exists"))
+            .expect("the export is JSON");
+    assert_eq!(json["pixel"], serde_json::json!([400, 270]));
+    assert_eq!(json["root"]["kind"], "camera");
+
+    // Help lists the keys; any key closes it; q quits and gives the terminal back.
+    tmux.keys(&["?"]);
+    tmux.wait_for("the help", |s| s.contains("Keys · any key closes"));
+    tmux.keys(&["x"]);
+    tmux.wait_for("the help to close", |s| {
+        !s.contains("Keys · any key closes")
+    });
+    tmux.keys(&["q"]);
+    let screen = tmux.wait_for("the shell after quitting", |s| {
+        s.contains("debugger exited with 0")
+    });
+    assert!(
+        !screen.contains("Ray tree"),
+        "the main screen is back:\n{screen}"
+    );
+    assert_eq!(
+        tmux.pane_flag("alternate_on"),
+        "0",
+        "the alternate screen was left"
+    );
+    assert_eq!(
+        tmux.pane_flag("mouse_any_flag"),
+        "0",
+        "mouse capture is off"
+    );
+    assert_eq!(
+        tmux.pane_flag("cursor_flag"),
+        "1",
+        "the cursor is shown again"
+    );
+}
+
+#[test]
+fn resizing_to_a_tiny_terminal_says_so_and_back_redraws() {
+    let scene = repository().join("scenes/whitted.scene");
+    let command = format!(
+        "'{}' debug '{}' --pixel 400,270",
+        whitted(),
+        scene.display()
+    );
+    let tmux = Tmux::start("resize", &repository(), &command, 80, 24);
+    let screen = tmux.wait_for("the tree of --pixel", |s| {
+        s.contains("Ray tree of (400, 270)") && s.contains("rendered in")
+    });
+    assert!(screen.contains("Inspector · camera ray"), "{screen}");
+    tmux.run(&["resize-window", "-t", &tmux.session, "-x", "40", "-y", "10"]);
+    tmux.wait_for("the too-small message", |s| {
+        s.contains("Terminal too small")
+    });
+    tmux.run(&[
+        "resize-window",
+        "-t",
+        &tmux.session,
+        "-x",
+        "120",
+        "-y",
+        "40",
+    ]);
+    tmux.wait_for("the full layout again", |s| {
+        s.contains("Ray tree of (400, 270)") && !s.contains("Terminal too small")
+    });
+    tmux.keys(&["Escape"]);
+    tmux.wait_for("the shell after Esc", |s| {
+        s.contains("debugger exited with 0")
+    });
+    assert_eq!(tmux.pane_flag("alternate_on"), "0");
+}
+
+#[test]
+fn editing_the_scene_reloads_it_and_errors_keep_the_last_good_image() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let scene = dir.path().join("scene.scene");
+    let good = std::fs::read_to_string(repository().join("scenes/whitted.scene"))
+        .expect("the scene is readable");
+    std::fs::write(&scene, &good).expect("writable");
+    let command = format!("'{}' debug scene.scene --pixel 400,270", whitted());
+    let tmux = Tmux::start("reload", dir.path(), &command, 120, 40);
+    tmux.wait_for("the first image", |s| s.contains("rendered in"));
+
+    let broken = good.replace("radius 1 material glass", "radius material glass");
+    assert_ne!(broken, good, "the test breaks the glass sphere's radius");
+    std::fs::write(&scene, &broken).expect("writable");
+    let screen = tmux.wait_for("the scene's errors", |s| {
+        s.contains("last good image shown")
+    });
+    assert!(screen.contains("error:"), "{screen}");
+    assert!(
+        screen.contains("scene.scene:"),
+        "the error says where:\n{screen}"
+    );
+    assert!(
+        screen.contains("Ray tree of (400, 270)"),
+        "the tree stays:\n{screen}"
+    );
+
+    std::fs::write(&scene, good.replace("ior 1.5", "ior 1.2")).expect("writable");
+    tmux.wait_for("the fixed scene", |s| {
+        s.contains("reloaded scene.scene") && !s.contains("last good image shown")
+    });
+    // The re-traced tree shows the new index of refraction.
+    tmux.keys(&["Tab"]);
+    let screen = tmux.select_in_tree("transmitted");
+    assert!(screen.contains("1.000 → 1.200"), "{screen}");
+    tmux.keys(&["q"]);
+    tmux.wait_for("the shell after quitting", |s| {
+        s.contains("debugger exited with 0")
+    });
+}
