@@ -43,10 +43,16 @@ pub fn write_image(
         _ => Path::new("."),
     };
     let describe = |e: &dyn std::fmt::Display| format!("cannot write {}: {e}", path.display());
-    let mut temp = tempfile::Builder::new()
-        .prefix(".whitted-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".whitted-").suffix(".tmp");
+    // Temporary files are private (0600) by default; an image is not, so ask for the usual
+    // 0666 and let the umask decide, as for any file a program creates.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let mut temp = builder.tempfile_in(dir)
         .map_err(|e| describe(&e))?;
     encode(temp.as_file_mut(), format, width, height, pixels).map_err(|e| describe(&e))?;
     temp.as_file().sync_all().map_err(|e| describe(&e))?;
@@ -144,5 +150,16 @@ mod tests {
             })
             .count();
         assert_eq!(leftovers, 0, "the temporary file must be removed");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn images_get_ordinary_permissions_not_the_temporary_files_private_ones() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.png");
+        write_image(&path, ImageFormat::Png, 1, 1, &[[0.5, 0.5, 0.5]]).unwrap();
+        let mode = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
+        assert_ne!(mode & 0o044, 0, "others cannot read the image: mode {mode:o}");
     }
 }

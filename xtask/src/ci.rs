@@ -57,6 +57,7 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     })?;
     step("tests", || run_cargo(&["test", "--workspace", "--locked"]))?;
     step("dependency directions", check_dependency_directions)?;
+    step("golden images and ray trees", || crate::golden::run(&[]))?;
     eprintln!(
         "\nci: all checks passed in {:.0} s",
         started.elapsed().as_secs_f64()

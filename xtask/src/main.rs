@@ -11,7 +11,7 @@ const USAGE: &str = "\
 usage: cargo xtask <command>
 
 commands:
-  ci       fmt check, clippy -D warnings, every test, dependency-direction checks
+  ci       fmt check, clippy -D warnings, every test, dependency directions, golden
   deps     only the dependency-direction checks
   golden   render the golden scenes and compare with tests/golden/ (--bless to update;
            --scenes DIR --refs DIR for your own folders)

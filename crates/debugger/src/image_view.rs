@@ -159,28 +159,30 @@ pub fn draw_image(
     buffer: &mut Buffer,
 ) {
     let (width, height) = source.size();
-    let background = Color::Reset;
     let not_yet = depth.color([40, 40, 40]);
     for row in 0..area.height {
         for column in 0..area.width {
-            let half_color = |half: u32| -> Color {
-                match viewport.pixel_at(column, u32::from(row) * 2 + half, width, height) {
-                    None => background,
-                    Some(pixel) => {
-                        if let Some((_, color)) = marked.iter().find(|(p, _)| *p == pixel) {
-                            *color
-                        } else {
-                            source
-                                .srgb(pixel.0, pixel.1)
-                                .map_or(not_yet, |c| depth.color(c))
-                        }
-                    }
-                }
+            // `None` outside the image: that half shows the terminal's own background.
+            let half_color = |half: u32| -> Option<Color> {
+                let pixel = viewport.pixel_at(column, u32::from(row) * 2 + half, width, height)?;
+                Some(match marked.iter().find(|(p, _)| *p == pixel) {
+                    Some((_, color)) => *color,
+                    None => source
+                        .srgb(pixel.0, pixel.1)
+                        .map_or(not_yet, |c| depth.color(c)),
+                })
             };
-            let (top, bottom) = (half_color(0), half_color(1));
-            if let Some(cell) = buffer.cell_mut((area.x + column, area.y + row)) {
-                cell.set_char('▀').set_fg(top).set_bg(bottom);
-            }
+            let Some(cell) = buffer.cell_mut((area.x + column, area.y + row)) else {
+                continue;
+            };
+            // The foreground of `▀` must never be `Reset`: terminals draw it in their
+            // default text colour, not their background.
+            match (half_color(0), half_color(1)) {
+                (Some(top), Some(bottom)) => cell.set_char('▀').set_fg(top).set_bg(bottom),
+                (Some(top), None) => cell.set_char('▀').set_fg(top).set_bg(Color::Reset),
+                (None, Some(bottom)) => cell.set_char('▄').set_fg(bottom).set_bg(Color::Reset),
+                (None, None) => cell.set_char(' ').set_fg(Color::Reset).set_bg(Color::Reset),
+            };
         }
     }
 }
@@ -281,5 +283,37 @@ mod tests {
         assert_eq!(xterm_index(255, 0, 0), 196);
         assert_eq!(xterm_index(0, 0, 0), 16);
         assert_eq!(xterm_index(128, 128, 128), 244);
+    }
+
+    #[test]
+    fn outside_the_image_cells_are_blank_not_default_coloured_blocks() {
+        let source = Checker {
+            width: 2,
+            height: 3,
+        };
+        let area = Rect::new(0, 0, 4, 2);
+        let mut buffer = Buffer::empty(area);
+        let viewport = Viewport {
+            scale: 1.0,
+            origin_x: 0.0,
+            origin_y: -1.0,
+        };
+        draw_image(
+            &source,
+            &viewport,
+            ColorDepth::TrueColor,
+            &[],
+            area,
+            &mut buffer,
+        );
+        // Row 0: top half above the image, bottom half its first row.
+        assert_eq!(buffer[(0, 0)].symbol(), "▄");
+        assert_eq!(buffer[(0, 0)].fg, Color::Rgb(255, 255, 255));
+        assert_eq!(buffer[(0, 0)].bg, Color::Reset);
+        // Column 3 is right of the image: blank.
+        assert_eq!(buffer[(3, 0)].symbol(), " ");
+        assert_eq!(buffer[(3, 1)].bg, Color::Reset);
+        // Row 1 holds image rows 1 and 2 in full.
+        assert_eq!(buffer[(0, 1)].symbol(), "▀");
     }
 }

@@ -7,6 +7,7 @@
 //! message for the worker to report instead (see [`take_worker_panic`]).
 
 use std::io::{self, IsTerminal, Stdout};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, Once, OnceLock};
 use std::thread::{self, ThreadId};
 
@@ -23,6 +24,10 @@ pub type Tui = Terminal<CrosstermBackend<Stdout>>;
 static UI_THREAD: OnceLock<ThreadId> = OnceLock::new();
 static HOOK: Once = Once::new();
 static WORKER_PANIC: Mutex<Option<String>> = Mutex::new(None);
+/// Whether the terminal is ours right now. Restoring twice would leave the alternate screen
+/// twice, and terminals then move the cursor back up over whatever was printed between
+/// (the panic message).
+static TAKEN_OVER: AtomicBool = AtomicBool::new(false);
 
 /// Restores the terminal when dropped.
 pub struct TerminalGuard {
@@ -45,6 +50,7 @@ pub fn init() -> io::Result<TerminalGuard> {
     let _ = UI_THREAD.set(thread::current().id());
     install_panic_hook();
     let set_up = || -> io::Result<Tui> {
+        TAKEN_OVER.store(true, Ordering::SeqCst);
         enable_raw_mode()?;
         execute!(io::stdout(), EnterAlternateScreen, EnableMouseCapture)?;
         let mut terminal = Terminal::new(CrosstermBackend::new(io::stdout()))?;
@@ -61,9 +67,12 @@ pub fn init() -> io::Result<TerminalGuard> {
     }
 }
 
-/// Gives the terminal back: mouse capture off, main screen, cooked mode, cursor shown. Safe
-/// to call more than once.
+/// Gives the terminal back: mouse capture off, main screen, cooked mode, cursor shown. Only
+/// the first call after [`init`] does anything.
 pub fn restore() -> io::Result<()> {
+    if !TAKEN_OVER.swap(false, Ordering::SeqCst) {
+        return Ok(());
+    }
     let mouse = execute!(
         io::stdout(),
         DisableMouseCapture,

@@ -11,6 +11,9 @@ use crate::layout;
 
 /// Applies one action; returns what the event loop must do about it.
 pub fn update(app: &mut App, action: Action) -> Vec<Effect> {
+    // A message answers the previous action; the next one replaces or clears it. Scene
+    // errors stay in their own pane until a reload succeeds.
+    app.message = None;
     match action {
         Action::Quit => app.should_quit = true,
         Action::ToggleHelp => app.help_open = !app.help_open,

@@ -140,8 +140,12 @@ mod tests {
         assert_eq!(inv.x, 2.0);
         assert_eq!(inv.y, -1.0 / f32::EPSILON);
         assert_eq!(inv.z, 1.0 / f32::EPSILON);
-        assert!(inverse_direction(Vec3A::new(-1e-20, 0.0, -4.0))
-            .abs_diff_eq(Vec3A::new(-1.0 / f32::EPSILON, 1.0 / f32::EPSILON, -0.25), 0.0));
+        assert!(
+            inverse_direction(Vec3A::new(-1e-20, 0.0, -4.0)).abs_diff_eq(
+                Vec3A::new(-1.0 / f32::EPSILON, 1.0 / f32::EPSILON, -0.25),
+                0.0
+            )
+        );
     }
 
     #[test]

@@ -14,7 +14,7 @@ use crate::bvh::Step;
 use crate::csg::CsgScratch;
 use crate::ray::Ray;
 use crate::scene::{Item, Leaf, PreparedScene};
-use crate::shapes::{sphere_first_hit, Geometry, Part};
+use crate::shapes::{plane_first_hit, sphere_first_hit, Geometry, Part};
 
 /// Below this many bounded items a plain loop beats walking the BVH.
 const LINEAR_LIMIT: usize = 4;
@@ -81,6 +81,10 @@ fn item_hit(
             geometry: Geometry::Sphere { center, radius },
             ..
         }) => sphere_first_hit(ray, *center, *radius, tmin, tmax).map(|t| (t, 0, 0, false)),
+        Item::Shape(Leaf {
+            geometry: Geometry::Plane { normal, offset },
+            ..
+        }) => plane_first_hit(ray, *normal, *offset, tmin, tmax).map(|t| (t, 0, 0, false)),
         Item::Shape(leaf) => leaf
             .geometry
             .first_hit(ray, tmin, tmax)

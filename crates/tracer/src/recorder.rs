@@ -18,7 +18,14 @@
 //! ```
 //!
 //! A secondary ray that the material does not ask for (a zero coefficient) is neither
-//! started nor skipped. Colours are linear RGB; "weight" is always the path weight: the
+//! started nor skipped.
+//!
+//! The colour a ray returns is computed in exactly this order (f32, per channel), so a
+//! recorder can re-add the parts bit for bit:
+//! `c = ambient; c += diffuse + specular` for each light in order; `c += coefficient ×
+//! returned colour` for the reflected, then the transmitted ray; finally `c × absorption`
+//! (the [`SurfaceHit::absorption`] factor). A miss returns the background times the
+//! medium's transmittance over an infinite distance. Colours are linear RGB; "weight" is always the path weight: the
 //! product of every coefficient (and Beer-Lambert factor) from the eye up to and including
 //! this ray's own coefficient, i.e. how much this ray's returned colour counts in the pixel.
 

@@ -339,14 +339,7 @@ impl Geometry {
                 sphere_first_hit(ray, *center, *radius, tmin, tmax).map(|t| (t, WALL))
             }
             Geometry::Plane { normal, offset } => {
-                let depth = offset - normal.dot(ray.origin);
-                let rate = normal.dot(ray.direction);
-                // Behind the origin, parallel, or NaN: no division needed to say so.
-                if depth * rate <= 0.0 || (depth * rate).is_nan() {
-                    return None;
-                }
-                let t = depth / rate;
-                (t > tmin && t < tmax).then_some((t, WALL))
+                plane_first_hit(ray, *normal, *offset, tmin, tmax).map(|t| (t, WALL))
             }
             Geometry::Disk(disk) => {
                 let t =
@@ -547,6 +540,20 @@ pub fn sphere_first_hit(
     } else {
         (t1 > tmin && t1 < tmax).then_some(t1)
     }
+}
+
+/// The crossing of a plane in `(tmin, tmax)`; planes are tested by every ray of a scene
+/// that has a floor, so this is kept small enough to inline.
+#[inline(always)]
+pub fn plane_first_hit(ray: &Ray, normal: Vec3A, offset: f32, tmin: f32, tmax: f32) -> Option<f32> {
+    let depth = offset - normal.dot(ray.origin);
+    let rate = normal.dot(ray.direction);
+    // Behind the origin, parallel, or NaN: no division needed to say so.
+    if depth * rate <= 0.0 || (depth * rate).is_nan() {
+        return None;
+    }
+    let t = depth / rate;
+    (t > tmin && t < tmax).then_some(t)
 }
 
 /// Sphere roots with the robust discriminant of Ray Tracing Gems, ch. 7: `r² − |f − (f·d)d|²`

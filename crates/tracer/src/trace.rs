@@ -228,7 +228,8 @@ impl<'a> Tracer<'a> {
 
     /// `ka·Ia·kd` plus, for every light on the visible side, `fatt·spot·Ii·(kd·(N·L) +
     /// ks·(R·V)^n)` times what the shadow ray lets through. `outside` is the hit point
-    /// already moved off the surface along `n`, which faces the viewer.
+    /// already moved off the surface along `n`, which faces the viewer. The order of the
+    /// additions is part of the recorder contract (see `recorder.rs`): keep it.
     fn local_illumination<R: Recorder>(
         &mut self,
         m: &PreparedMaterial,

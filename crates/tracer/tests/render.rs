@@ -337,3 +337,19 @@ fn excessive_depth_is_clamped_not_a_stack_overflow() {
         .unwrap_or_else(|| panic!("cancelled"));
     assert_eq!(stats.deepest_ray, MAX_DEPTH_LIMIT);
 }
+
+#[test]
+fn an_empty_scene_renders_its_background() {
+    let mut b = SceneBuilder::new();
+    b.settings().background = Color::new(0.25, 0.5, 0.75);
+    let scene = prepare(b);
+    assert_eq!(scene.object_count(), 0);
+    let (image, stats) =
+        render(&scene, &options(7, 5, 2), &NoObserver).unwrap_or_else(|| panic!("cancelled"));
+    assert!(image.pixels.iter().all(|p| *p == [0.25, 0.5, 0.75]));
+    assert_eq!(stats.total_rays(), 7 * 5 * 2);
+    // A zero-sized image is empty, not an error.
+    let (empty, _) =
+        render(&scene, &options(0, 0, 1), &NoObserver).unwrap_or_else(|| panic!("cancelled"));
+    assert!(empty.pixels.is_empty());
+}

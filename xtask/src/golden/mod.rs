@@ -396,7 +396,9 @@ fn bless(
         let verdict = match image::open(&reference) {
             Ok(old) => {
                 let figures = compare::compare(&old.into_rgb8(), &actual, &scene.thresholds);
-                if figures.max_error == 0.0 && figures.mismatch.is_none() {
+                if let Some(mismatch) = &figures.mismatch {
+                    format!("updated ({mismatch})")
+                } else if figures.max_error == 0.0 {
                     "unchanged".to_string()
                 } else {
                     format!(

@@ -41,6 +41,12 @@ pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
         rank: 0,
         spans: vec![news],
     });
+    if app.message.is_some() && matches!(app.render, RenderState::Rendering { .. }) {
+        parts.push(Part {
+            rank: 2,
+            spans: vec![Span::raw(render_state(app))],
+        });
+    }
     let (x, y) = app.cursor;
     let mut cursor = vec![Span::raw(format!("({x}, {y}) "))];
     match app.image.linear(x, y) {
@@ -68,10 +74,7 @@ pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
                     picked.trace_time.as_secs_f64() * 1000.0,
                     shown.as_secs_f64() * 1000.0
                 ),
-                None => format!(
-                    "tree in {:.2} ms",
-                    picked.trace_time.as_secs_f64() * 1000.0
-                ),
+                None => format!("tree in {:.2} ms", picked.trace_time.as_secs_f64() * 1000.0),
             })],
         });
     }

@@ -77,9 +77,15 @@ fn row_line(app: &App, tree: &TreeView, id: NodeId, width: usize) -> Line<'stati
     let show_numbers = width >= head_width + 8 + 3 + numbers.len();
     let tail = 3 + if show_numbers { numbers.len() } else { 0 };
     let label_width = width.saturating_sub(head_width + tail);
+    let mut description = describe(node);
+    if node.kind == RayKind::Camera && tree.tree().samples.len() > 1 {
+        if let Some(sample) = tree.sample(id) {
+            description = format!("sample {}: {description}", sample.index);
+        }
+    }
     let label = format!(
         "{:<label_width$}",
-        format::truncate(&describe(node), label_width)
+        format::truncate(&description, label_width)
     );
     let kind_style = Style::new().fg(match node.kind {
         RayKind::Camera => Color::LightBlue,
