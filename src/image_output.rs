@@ -52,8 +52,7 @@ pub fn write_image(
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let mut temp = builder.tempfile_in(dir)
-        .map_err(|e| describe(&e))?;
+    let mut temp = builder.tempfile_in(dir).map_err(|e| describe(&e))?;
     encode(temp.as_file_mut(), format, width, height, pixels).map_err(|e| describe(&e))?;
     temp.as_file().sync_all().map_err(|e| describe(&e))?;
     temp.persist(path).map_err(|e| describe(&e.error))?;
@@ -160,6 +159,10 @@ mod tests {
         let path = dir.path().join("p.png");
         write_image(&path, ImageFormat::Png, 1, 1, &[[0.5, 0.5, 0.5]]).unwrap();
         let mode = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
-        assert_ne!(mode & 0o044, 0, "others cannot read the image: mode {mode:o}");
+        assert_ne!(
+            mode & 0o044,
+            0,
+            "others cannot read the image: mode {mode:o}"
+        );
     }
 }
