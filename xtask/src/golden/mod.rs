@@ -76,6 +76,12 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         bail!("no golden scenes to run");
     }
 
+    // Scene paths are relative to the workspace for the project's own manifest, and to the
+    // directory the user ran the command from for `--scenes DIR`.
+    let base = match &options.scenes_dir {
+        Some(_) => std::env::current_dir()?,
+        None => root.clone(),
+    };
     run_cargo(&["build", "--locked", "--bin", "whitted"])?;
     let exe = root.join("target/debug/whitted");
     let out_dir = root.join("target/golden");
@@ -87,12 +93,12 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     std::fs::create_dir_all(&refs_dir)?;
 
     if options.bless.is_some() {
-        return bless(&exe, &root, &refs_dir, &out_dir, &selected);
+        return bless(&exe, &base, &refs_dir, &out_dir, &selected);
     }
 
     let mut reports = Vec::new();
     for scene in &selected {
-        reports.push(check_scene(&exe, &root, &refs_dir, &out_dir, scene));
+        reports.push(check_scene(&exe, &base, &refs_dir, &out_dir, scene));
     }
     print_table(&reports);
     let report_path = out_dir.join("report.html");
@@ -180,7 +186,9 @@ fn load_manifest(root: &Path, options: &Options) -> anyhow::Result<(Manifest, Pa
 /// Renders a scene at its golden size into `out`.
 fn render(exe: &Path, root: &Path, scene: &GoldenScene, out: &Path) -> anyhow::Result<RgbImage> {
     let mut command = Command::new(exe);
-    command.arg("render").arg(root.join(&scene.path));
+    // Scene paths stay relative so that locations in stored ray trees do not depend on where
+    // the checkout lives.
+    command.current_dir(root).arg("render").arg(&scene.path);
     for define in &scene.defines {
         command.args(["-D", define]);
     }
@@ -210,7 +218,7 @@ fn render(exe: &Path, root: &Path, scene: &GoldenScene, out: &Path) -> anyhow::R
 /// The ray tree of one pixel as `whitted trace` prints it (plain text).
 fn trace(exe: &Path, root: &Path, scene: &GoldenScene, [x, y]: [u32; 2]) -> anyhow::Result<String> {
     let mut command = Command::new(exe);
-    command.arg("trace").arg(root.join(&scene.path));
+    command.current_dir(root).arg("trace").arg(&scene.path);
     for define in &scene.defines {
         command.args(["-D", define]);
     }
