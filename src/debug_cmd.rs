@@ -26,6 +26,7 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
     // errors stops here, before the terminal is taken over.
     let loaded = load_scene(&args.scene, false)?;
     let settings = &loaded.scene.settings;
+    crate::render_cmd::check_image_size(settings.width, settings.height)?;
     if let Some([x, y]) = args.pixel {
         if x >= settings.width || y >= settings.height {
             return Err(Failure::Message(format!(

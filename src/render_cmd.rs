@@ -38,6 +38,21 @@ pub fn render_options(settings: &Settings, overrides: &RenderOverrides) -> Rende
     options
 }
 
+/// The most pixels one image may have: 2^27 (about 11,585 x 11,585), 1.5 GiB of linear RGB.
+/// Larger sizes are almost always a typo (`--width 64000`) and would exhaust memory.
+pub const MAX_PIXELS: u64 = 1 << 27;
+
+/// Refuses image sizes that cannot be held in memory, before any work starts.
+pub fn check_image_size(width: u32, height: u32) -> Result<(), Failure> {
+    let pixels = u64::from(width) * u64::from(height);
+    if pixels > MAX_PIXELS {
+        return Err(Failure::Message(format!(
+            "a {width}x{height} image has {pixels} pixels, more than the limit of {MAX_PIXELS} (about 11585x11585)"
+        )));
+    }
+    Ok(())
+}
+
 /// `scenes/whitted.scene` renders to `whitted.png` in the current directory by default.
 fn default_output(scene: &Path) -> PathBuf {
     let stem = scene.file_stem().map(|s| s.to_string_lossy().into_owned());
@@ -72,6 +87,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     let prepared = PreparedScene::new(&loaded.scene);
 
     let options = render_options(&loaded.scene.settings, &args.overrides);
+    check_image_size(options.width, options.height)?;
 
     let threads = match args.threads {
         Some(n) => n as usize,

@@ -277,3 +277,26 @@ fn stats_report_ray_counts_as_text_and_json() {
         stdout(&output)
     );
 }
+
+#[test]
+fn an_image_too_large_for_memory_is_refused_before_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("huge.png");
+    let output = run(&[
+        "render",
+        "scenes/whitted.scene",
+        "--width",
+        "60000",
+        "--height",
+        "60000",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(output.status.code(), Some(1));
+    assert!(
+        stderr(&output).contains("more than the limit"),
+        "{}",
+        stderr(&output)
+    );
+    assert!(!out.exists());
+}

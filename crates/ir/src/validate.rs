@@ -284,6 +284,15 @@ impl Checker {
     fn transform(&mut self, m: &DMat4, what: &str, span: Span) {
         if !m.is_finite() {
             self.error(format!("the {what} has a number that is not finite"), span);
+        } else if m.row(3) != glam::DVec4::W {
+            // The tracer maps rays with the affine part only; a projective matrix would be
+            // silently misread, so it is refused here.
+            self.error(
+                format!(
+                    "the {what} is projective: its last row must be 0, 0, 0, 1 (whitted supports affine transforms only)"
+                ),
+                span,
+            );
         } else if m.determinant().abs() < MIN_DETERMINANT {
             self.error(
                 format!("the {what} is not invertible (a scale by zero flattens the object)"),
@@ -622,6 +631,17 @@ mod tests {
         assert!(errors(scene)
             .iter()
             .any(|m| m.contains("not defined before")));
+    }
+
+    #[test]
+    fn projective_transforms_are_rejected() {
+        let mut scene = scene_with(Shape::Sphere { center: DVec3::ZERO, radius: 1.0 });
+        let mut m = DMat4::IDENTITY;
+        m.x_axis.w = 0.5; // row 3, column 0
+        scene.objects[Handle::from_index(0)].world_from_object = m;
+        let messages = errors(scene);
+        assert_eq!(messages.len(), 1);
+        assert!(messages[0].contains("projective"), "{messages:?}");
     }
 
     #[test]
