@@ -3,27 +3,15 @@
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-use crate::cli::ImageFormat;
+use whitted_tracer::display::linear_to_srgb8_rgb;
 
-/// The sRGB transfer function (IEC 61966-2-1) of a linear value, clamped to [0, 1].
-pub fn linear_to_srgb(linear: f32) -> f32 {
-    let v = if linear.is_nan() {
-        0.0
-    } else {
-        linear.clamp(0.0, 1.0)
-    };
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
-}
+use crate::cli::ImageFormat;
 
 /// 8-bit sRGB bytes, three per pixel, rounded to nearest.
 pub fn to_srgb8(pixels: &[[f32; 3]]) -> Vec<u8> {
     pixels
         .iter()
-        .flat_map(|p| p.map(|c| (linear_to_srgb(c) * 255.0 + 0.5) as u8))
+        .flat_map(|&p| linear_to_srgb8_rgb(p))
         .collect()
 }
 
@@ -103,14 +91,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn srgb_encoding_matches_the_standard_at_known_points() {
-        assert_eq!(linear_to_srgb(0.0), 0.0);
-        assert!((linear_to_srgb(1.0) - 1.0).abs() < 1e-6);
-        // Mid grey: linear 0.2140 is sRGB 0.5 (127.5 / 255).
-        assert!((linear_to_srgb(0.214_041) - 0.5).abs() < 1e-4);
-        assert_eq!(linear_to_srgb(-3.0), 0.0);
-        assert_eq!(linear_to_srgb(f32::NAN), 0.0);
-        assert_eq!(to_srgb8(&[[0.0, 1.0, 7.0]]), vec![0, 255, 255]);
+    fn pixels_become_three_srgb_bytes_each() {
+        assert_eq!(
+            to_srgb8(&[[0.0, 1.0, 7.0], [0.25; 3]]),
+            vec![0, 255, 255, 137, 137, 137]
+        );
     }
 
     #[test]

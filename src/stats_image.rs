@@ -9,20 +9,12 @@
 //! red and green together, and so on); black when nothing was cut short. The panels are
 //! separated by 4 columns of grey. docs/ray-tree.md describes the same.
 
+use whitted_tracer::display::{heat_color, srgb_to_linear};
 use whitted_tracer::{PixelStats, RenderOptions, Termination};
 
 /// Columns of grey between two panels.
 const GAP: u32 = 4;
 const GAP_COLOR: [f32; 3] = [0.2; 3];
-
-/// The ramp's stops as 8-bit sRGB, darkest first: equal steps of the scaled value.
-const RAMP: [[f32; 3]; 5] = [
-    [0.0, 0.0, 0.0],
-    [90.0, 20.0, 140.0],
-    [200.0, 40.0, 60.0],
-    [250.0, 150.0, 20.0],
-    [255.0, 250.0, 180.0],
-];
 
 /// The heat maps as a linear-RGB image, ready for `write_image`.
 pub struct StatsImage {
@@ -66,14 +58,10 @@ fn fraction(value: u32, max: u32) -> f32 {
     }
 }
 
-/// The ramp colour of `fraction` (0 to 1), interpolated in sRGB like the debugger's, then
-/// made linear for the image writer (which encodes sRGB again).
+/// The heat-map colour of `fraction` (0 to 1), the debugger's ramp, made linear for the image
+/// writer (which encodes sRGB again).
 fn ramp(fraction: f32) -> [f32; 3] {
-    let position = fraction.clamp(0.0, 1.0) * (RAMP.len() - 1) as f32;
-    let index = (position.floor() as usize).min(RAMP.len() - 2);
-    let local = position - index as f32;
-    let (a, b) = (RAMP[index], RAMP[index + 1]);
-    [0, 1, 2].map(|c| srgb_to_linear((a[c] + (b[c] - a[c]) * local).round() / 255.0))
+    heat_color(fraction).map(|c| srgb_to_linear(f32::from(c) / 255.0))
 }
 
 fn cut_offs(stats: &PixelStats) -> [f32; 3] {
@@ -91,15 +79,6 @@ fn cut_offs(stats: &PixelStats) -> [f32; 3] {
     ]
 }
 
-/// The inverse of the sRGB transfer function (IEC 61966-2-1).
-fn srgb_to_linear(encoded: f32) -> f32 {
-    if encoded <= 0.040_45 {
-        encoded / 12.92
-    } else {
-        ((encoded + 0.055) / 1.055).powf(2.4)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,10 +87,6 @@ mod tests {
 
     #[test]
     fn ramp_colours_survive_the_srgb_round_trip() {
-        for byte in 0..=255u8 {
-            let linear = srgb_to_linear(f32::from(byte) / 255.0);
-            assert_eq!(to_srgb8(&[[linear; 3]]), vec![byte; 3], "byte {byte}");
-        }
         assert_eq!(to_srgb8(&[ramp(0.0)]), vec![0, 0, 0]);
         assert_eq!(to_srgb8(&[ramp(0.25)]), vec![90, 20, 140]);
         assert_eq!(to_srgb8(&[ramp(1.0)]), vec![255, 250, 180]);

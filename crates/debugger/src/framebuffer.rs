@@ -4,6 +4,7 @@
 //! A new render writes over the previous image of the same size instead of clearing it, so the
 //! last good image stays on screen while its replacement streams in.
 
+use whitted_tracer::display::linear_to_srgb8_rgb;
 use whitted_tracer::TileResult;
 
 use crate::image_view::PixelSource;
@@ -74,22 +75,8 @@ impl PixelSource for Framebuffer {
 
     fn srgb(&self, x: u32, y: u32) -> Option<[u8; 3]> {
         let index = self.index(x, y)?;
-        self.filled[index].then(|| encode_srgb(self.linear[index]))
+        self.filled[index].then(|| linear_to_srgb8_rgb(self.linear[index]))
     }
-}
-
-/// Linear RGB to 8-bit sRGB, clamped (the display cannot show more than white). NaN shows
-/// as black rather than poisoning anything.
-pub fn encode_srgb(color: [f32; 3]) -> [u8; 3] {
-    color.map(|c| {
-        let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
-        let encoded = if c <= 0.003_130_8 {
-            12.92 * c
-        } else {
-            1.055 * c.powf(1.0 / 2.4) - 0.055
-        };
-        (encoded * 255.0 + 0.5) as u8
-    })
 }
 
 #[cfg(test)]
@@ -127,11 +114,5 @@ mod tests {
             pixels: vec![[1.0; 3]; 4],
         });
         assert_eq!(image.filled_count(), 1);
-    }
-
-    #[test]
-    fn srgb_encoding_clamps_and_survives_nan() {
-        assert_eq!(encode_srgb([0.0, 1.0, 2.0]), [0, 255, 255]);
-        assert_eq!(encode_srgb([f32::NAN, -1.0, 0.2]), [0, 0, 124]);
     }
 }

@@ -1,6 +1,7 @@
 //! Heat-map overlays drawn from the render's per-pixel statistics: rays per pixel and the
 //! deepest recursion level, each scaled to the image's own maximum.
 
+use whitted_tracer::display::heat_color;
 use whitted_tracer::PixelStats;
 
 use crate::image_view::PixelSource;
@@ -85,28 +86,6 @@ impl PixelSource for HeatMap {
     }
 }
 
-/// A dark-to-bright ramp (black, purple, red, orange, pale yellow) that stays readable in
-/// the 256-colour palette. `fraction` is clamped to 0..=1.
-pub fn heat_color(fraction: f32) -> [u8; 3] {
-    const STOPS: [[f32; 3]; 5] = [
-        [0.0, 0.0, 0.0],
-        [90.0, 20.0, 140.0],
-        [200.0, 40.0, 60.0],
-        [250.0, 150.0, 20.0],
-        [255.0, 250.0, 180.0],
-    ];
-    let f = if fraction.is_nan() {
-        0.0
-    } else {
-        fraction.clamp(0.0, 1.0)
-    };
-    let position = f * (STOPS.len() - 1) as f32;
-    let index = (position.floor() as usize).min(STOPS.len() - 2);
-    let local = position - index as f32;
-    let (a, b) = (STOPS[index], STOPS[index + 1]);
-    [0, 1, 2].map(|c| (a[c] + (b[c] - a[c]) * local).round() as u8)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,14 +115,5 @@ mod tests {
     #[test]
     fn mismatched_statistics_are_refused() {
         assert!(HeatMap::new(HeatMapKind::RaysPerPixel, 3, 3, &[stats(1, 0)]).is_none());
-    }
-
-    #[test]
-    fn the_ramp_runs_from_black_to_pale_yellow() {
-        assert_eq!(heat_color(0.0), [0, 0, 0]);
-        assert_eq!(heat_color(1.0), [255, 250, 180]);
-        assert_eq!(heat_color(2.0), [255, 250, 180]);
-        assert_eq!(heat_color(f32::NAN), [0, 0, 0]);
-        assert_eq!(heat_color(0.5), [200, 40, 60]);
     }
 }

@@ -9,6 +9,7 @@
 mod bounds;
 mod bvh;
 mod camera;
+pub mod display;
 mod csg;
 mod light;
 mod material;

@@ -4,8 +4,8 @@
 use ratatui::style::{Color, Style};
 use ratatui::text::Span;
 
-use crate::framebuffer::encode_srgb;
 use crate::image_view::ColorDepth;
+use whitted_tracer::display::linear_to_srgb8_rgb;
 
 /// A number with three decimals; very large or small magnitudes in scientific notation so
 /// that they never push a line off the pane.
@@ -32,7 +32,7 @@ pub fn rgb(c: [f32; 3]) -> String {
 
 /// The terminal colour of a linear RGB value (clamped to what a display shows).
 pub fn terminal_color(c: [f32; 3], depth: ColorDepth) -> Color {
-    depth.color(encode_srgb(c))
+    depth.color(linear_to_srgb8_rgb(c))
 }
 
 /// Two full blocks in the colour: the swatch shown before colour numbers.

@@ -235,7 +235,7 @@ impl Printer {
     fn color(&self, c: [f32; 3]) -> String {
         let numbers = format!("rgb({}, {}, {})", num(c[0]), num(c[1]), num(c[2]));
         if self.options.swatches {
-            let [r, g, b] = c.map(srgb8);
+            let [r, g, b] = c.map(crate::display::linear_to_srgb8);
             format!("\x1b[48;2;{r};{g};{b}m  \x1b[0m {numbers}")
         } else {
             numbers
@@ -342,21 +342,6 @@ fn num(value: f32) -> String {
 
 fn vector(v: [f32; 3]) -> String {
     format!("({}, {}, {})", num(v[0]), num(v[1]), num(v[2]))
-}
-
-/// The 8-bit sRGB value of a linear channel, clamped, for swatches.
-fn srgb8(linear: f32) -> u8 {
-    let v = if linear.is_nan() {
-        0.0
-    } else {
-        linear.clamp(0.0, 1.0)
-    };
-    let encoded = if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    };
-    (encoded * 255.0 + 0.5) as u8
 }
 
 #[cfg(test)]
