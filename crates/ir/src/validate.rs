@@ -635,7 +635,10 @@ mod tests {
 
     #[test]
     fn projective_transforms_are_rejected() {
-        let mut scene = scene_with(Shape::Sphere { center: DVec3::ZERO, radius: 1.0 });
+        let mut scene = scene_with(Shape::Sphere {
+            center: DVec3::ZERO,
+            radius: 1.0,
+        });
         let mut m = DMat4::IDENTITY;
         m.x_axis.w = 0.5; // row 3, column 0
         scene.objects[Handle::from_index(0)].world_from_object = m;
