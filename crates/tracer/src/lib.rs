@@ -9,8 +9,8 @@
 mod bounds;
 mod bvh;
 mod camera;
-pub mod display;
 mod csg;
+pub mod display;
 mod light;
 mod material;
 pub mod optics;
