@@ -41,7 +41,7 @@ impl PreparedMaterial {
     pub fn phong(&self, r_dot_v: f32) -> f32 {
         let x = r_dot_v.max(0.0);
         match self.shininess_integer {
-            Some(n) => x.powi(n),
+            Some(n) => powi(x, n),
             None => x.powf(self.shininess),
         }
     }
@@ -68,6 +68,30 @@ impl PreparedMaterial {
                 .as_affine3a(),
             }),
         }
+    }
+}
+
+/// `x.powi(n)`, computed inline by exactly the multiplications of the runtime routine that
+/// `powi` calls for an exponent only known at run time (compiler-builtins' `__powisf2`:
+/// square-and-multiply from the lowest bit, reciprocal last for negative `n`), so the result
+/// is bit-identical without a call that makes the caller save every vector register.
+#[inline]
+pub fn powi(x: f32, n: i32) -> f32 {
+    let mut base = x;
+    let mut bits = n.unsigned_abs();
+    let mut result = if bits & 1 != 0 { base } else { 1.0 };
+    bits >>= 1;
+    while bits != 0 {
+        base *= base;
+        if bits & 1 != 0 {
+            result *= base;
+        }
+        bits >>= 1;
+    }
+    if n < 0 {
+        1.0 / result
+    } else {
+        result
     }
 }
 
@@ -191,6 +215,38 @@ mod tests {
         // The scale widens the cells.
         let wide = pattern(PatternKind::Checker, 2.0);
         assert_eq!(wide.choose(Vec3A::new(1.5, 0.0, 0.5)), a);
+    }
+
+    #[test]
+    fn powi_is_bit_identical_to_the_runtime_routine() {
+        use std::hint::black_box;
+        let mut xs = vec![
+            0.0f32, -0.0, 1.0, -1.0, 0.5, 0.999_999, 1.000_001, 2.0, -3.5,
+        ];
+        xs.extend([
+            f32::MIN_POSITIVE,
+            f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ]);
+        // Values of R·V as Phong sees them, spread over (0, 1].
+        let mut state = 0x1234_5678u32;
+        for _ in 0..2000 {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            xs.push((state >> 8) as f32 / (1u32 << 24) as f32);
+        }
+        for n in (-40..=300).chain([511, 512, 1000, 2047, 4096, i32::MAX, i32::MIN]) {
+            for &x in &xs {
+                let expected = black_box(x).powi(black_box(n));
+                let got = powi(x, n);
+                assert!(
+                    got.to_bits() == expected.to_bits() || (got.is_nan() && expected.is_nan()),
+                    "{x}^{n}: {got} != {expected}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -84,7 +84,14 @@ pub fn spot_factor(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
 #[inline]
 pub fn surface_offset(point: Vec3A, epsilon: f32) -> f32 {
     const ULPS_OF_CLEARANCE: f32 = 64.0;
-    epsilon.max(point.abs().max_element() * f32::EPSILON * ULPS_OF_CLEARANCE)
+    let clearance = point.abs().max_element() * f32::EPSILON * ULPS_OF_CLEARANCE;
+    // `epsilon.max(clearance)` without its NaN handling: epsilon is never NaN (validated
+    // positive and finite), and a NaN clearance loses the comparison as `max` ignores it.
+    if clearance > epsilon {
+        clearance
+    } else {
+        epsilon
+    }
 }
 
 /// The largest of the three channels: the path-weight test looks at the strongest one.

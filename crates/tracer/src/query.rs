@@ -10,13 +10,13 @@
 use glam::{UVec2, Vec3A};
 use whitted_ir::{Handle, Material};
 
-use crate::bvh::Step;
+use crate::bvh::{Bvh, Step};
 use crate::csg::CsgScratch;
 use crate::ray::Ray;
 use crate::scene::{Item, Leaf, PreparedScene};
-use crate::shapes::{plane_first_hit, sphere_first_hit, Geometry, Part};
+use crate::shapes::{plane_first_hit, sphere_first_hit, unit_normal, Geometry, Part};
 
-/// Below this many bounded items a plain loop beats walking the BVH.
+/// Up to this many bounded items a plain loop beats walking the BVH.
 const LINEAR_LIMIT: usize = 4;
 
 /// Which top-level item was hit.
@@ -36,6 +36,19 @@ pub struct Hit {
     pub part: Part,
     /// Whether the leaf's outward normal is reversed (a subtracted surface).
     pub flip: bool,
+}
+
+impl Hit {
+    #[inline(always)]
+    fn new(item: ItemRef, (t, leaf, part, flip): ItemHit) -> Hit {
+        Hit {
+            t,
+            item,
+            leaf,
+            part,
+            flip,
+        }
+    }
 }
 
 /// What a shadow ray found between the surface and the light.
@@ -67,6 +80,13 @@ pub struct Scratch {
     bvh_stack: Vec<UVec2>,
 }
 
+/// What the cheap test of one item reports: the distance, the CSG leaf (0 for a plain
+/// shape), the part, and whether the leaf's normal is flipped.
+type ItemHit = (f32, u32, Part, bool);
+
+/// The cheap test of one item. Spheres and planes, nearly every item of the scenes that
+/// must be fast, are tested inline; everything else goes through [`other_item_hit`], kept
+/// out of line so that the query loops stay small enough for the compiler to inline.
 #[inline(always)]
 fn item_hit(
     item: &Item,
@@ -74,9 +94,8 @@ fn item_hit(
     tmin: f32,
     tmax: f32,
     scratch: &mut CsgScratch,
-) -> Option<(f32, u32, Part, bool)> {
+) -> Option<ItemHit> {
     match item {
-        // Spheres first and inline: they are most of the objects in big scenes.
         Item::Shape(Leaf {
             geometry: Geometry::Sphere { center, radius },
             ..
@@ -85,6 +104,20 @@ fn item_hit(
             geometry: Geometry::Plane { normal, offset },
             ..
         }) => plane_first_hit(ray, *normal, *offset, tmin, tmax).map(|t| (t, 0, 0, false)),
+        _ => other_item_hit(item, ray, tmin, tmax, scratch),
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn other_item_hit(
+    item: &Item,
+    ray: &Ray,
+    tmin: f32,
+    tmax: f32,
+    scratch: &mut CsgScratch,
+) -> Option<ItemHit> {
+    match item {
         Item::Shape(leaf) => leaf
             .geometry
             .first_hit(ray, tmin, tmax)
@@ -103,9 +136,130 @@ impl PreparedScene {
         }
     }
 
-    /// Visits unbounded items, then bounded items whose boxes the segment touches. The
-    /// visitor gets the current `tmax` and may shrink it or stop.
+    /// Whether bounded items are reached through the BVH (otherwise a plain loop).
     #[inline(always)]
+    fn walk_bvh(&self) -> Option<&Bvh> {
+        self.bvh
+            .as_ref()
+            .filter(|_| self.bounded.len() > LINEAR_LIMIT)
+    }
+
+    /// The closest hit strictly inside `(tmin, tmax)`. Unbounded items are tested first,
+    /// then bounded ones (in BVH order); a hit must be strictly nearer than the best so far,
+    /// so of two equally near surfaces the first tested wins. Inline, so that scenes of a few
+    /// objects pay no call; the BVH walk is a call of its own.
+    #[inline(always)]
+    pub(crate) fn intersect(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut Scratch,
+    ) -> Option<Hit> {
+        let mut best = None;
+        let mut tmax = tmax;
+        for (i, item) in self.unbounded.iter().enumerate() {
+            if let Some(found) = item_hit(item, ray, tmin, tmax, &mut scratch.csg) {
+                tmax = found.0;
+                best = Some(Hit::new(ItemRef::Unbounded(i as u32), found));
+            }
+        }
+        match self.walk_bvh() {
+            Some(bvh) => self.intersect_bvh(bvh, ray, tmin, tmax, scratch).or(best),
+            None => {
+                for (i, item) in self.bounded.iter().enumerate() {
+                    if let Some(found) = item_hit(item, ray, tmin, tmax, &mut scratch.csg) {
+                        tmax = found.0;
+                        best = Some(Hit::new(ItemRef::Bounded(i as u32), found));
+                    }
+                }
+                best
+            }
+        }
+    }
+
+    /// The closest hit among bounded items, through the BVH.
+    #[inline(never)]
+    fn intersect_bvh(
+        &self,
+        bvh: &Bvh,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut Scratch,
+    ) -> Option<Hit> {
+        let Scratch { csg, bvh_stack } = scratch;
+        let mut best = None;
+        bvh.traverse(ray, tmin, tmax, bvh_stack, |id, tmax| {
+            let Some(item) = self.bounded.get(id as usize) else {
+                return Step::Continue;
+            };
+            match item_hit(item, ray, tmin, tmax, csg) {
+                Some(found) => {
+                    best = Some(Hit::new(ItemRef::Bounded(id), found));
+                    Step::Shrink(found.0)
+                }
+                None => Step::Continue,
+            }
+        });
+        best
+    }
+
+    /// Any surface strictly inside `(tmin, tmax)`: the first one found, not the nearest
+    /// (unbounded items first, then bounded ones in BVH order).
+    #[inline(always)]
+    pub(crate) fn occluded(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut Scratch,
+    ) -> Option<Hit> {
+        for (i, item) in self.unbounded.iter().enumerate() {
+            if let Some(found) = item_hit(item, ray, tmin, tmax, &mut scratch.csg) {
+                return Some(Hit::new(ItemRef::Unbounded(i as u32), found));
+            }
+        }
+        match self.walk_bvh() {
+            Some(bvh) => self.occluded_bvh(bvh, ray, tmin, tmax, scratch),
+            None => self.bounded.iter().enumerate().find_map(|(i, item)| {
+                item_hit(item, ray, tmin, tmax, &mut scratch.csg)
+                    .map(|found| Hit::new(ItemRef::Bounded(i as u32), found))
+            }),
+        }
+    }
+
+    /// The first bounded item found in the segment, through the BVH.
+    #[inline(never)]
+    fn occluded_bvh(
+        &self,
+        bvh: &Bvh,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut Scratch,
+    ) -> Option<Hit> {
+        let Scratch { csg, bvh_stack } = scratch;
+        let mut blocker = None;
+        bvh.traverse(ray, tmin, tmax, bvh_stack, |id, tmax| {
+            let Some(item) = self.bounded.get(id as usize) else {
+                return Step::Continue;
+            };
+            match item_hit(item, ray, tmin, tmax, csg) {
+                Some(found) => {
+                    blocker = Some(Hit::new(ItemRef::Bounded(id), found));
+                    Step::Stop
+                }
+                None => Step::Continue,
+            }
+        });
+        blocker
+    }
+
+    /// Visits unbounded items, then bounded items whose boxes the segment touches, in the
+    /// same order as [`PreparedScene::intersect`] and [`PreparedScene::occluded`]. The
+    /// visitor gets the current `tmax` and may shrink it or stop. Only the filtered-shadow
+    /// query uses it; the hot queries spell their loops out.
     fn visit(
         &self,
         ray: &Ray,
@@ -122,16 +276,14 @@ impl PreparedScene {
                 Step::Stop => return,
             }
         }
-        match &self.bvh {
-            Some(bvh) if self.bounded.len() > LINEAR_LIMIT => {
-                bvh.traverse(ray, tmin, tmax, bvh_stack, |id, tmax| {
-                    match self.bounded.get(id as usize) {
-                        Some(item) => visitor(ItemRef::Bounded(id), item, tmax),
-                        None => Step::Continue,
-                    }
-                });
-            }
-            _ => {
+        match self.walk_bvh() {
+            Some(bvh) => bvh.traverse(ray, tmin, tmax, bvh_stack, |id, tmax| {
+                match self.bounded.get(id as usize) {
+                    Some(item) => visitor(ItemRef::Bounded(id), item, tmax),
+                    None => Step::Continue,
+                }
+            }),
+            None => {
                 for (i, item) in self.bounded.iter().enumerate() {
                     match visitor(ItemRef::Bounded(i as u32), item, tmax) {
                         Step::Continue => {}
@@ -141,70 +293,6 @@ impl PreparedScene {
                 }
             }
         }
-    }
-
-    /// The closest hit strictly inside `(tmin, tmax)`.
-    pub(crate) fn intersect(
-        &self,
-        ray: &Ray,
-        tmin: f32,
-        tmax: f32,
-        scratch: &mut Scratch,
-    ) -> Option<Hit> {
-        let Scratch { csg, bvh_stack } = scratch;
-        let mut best = None;
-        self.visit(
-            ray,
-            tmin,
-            tmax,
-            bvh_stack,
-            |item_ref, item, tmax| match item_hit(item, ray, tmin, tmax, csg) {
-                Some((t, leaf, part, flip)) => {
-                    best = Some(Hit {
-                        t,
-                        item: item_ref,
-                        leaf,
-                        part,
-                        flip,
-                    });
-                    Step::Shrink(t)
-                }
-                None => Step::Continue,
-            },
-        );
-        best
-    }
-
-    /// Any surface strictly inside `(tmin, tmax)`: the first one found, not the nearest.
-    pub(crate) fn occluded(
-        &self,
-        ray: &Ray,
-        tmin: f32,
-        tmax: f32,
-        scratch: &mut Scratch,
-    ) -> Option<Hit> {
-        let Scratch { csg, bvh_stack } = scratch;
-        let mut blocker = None;
-        self.visit(
-            ray,
-            tmin,
-            tmax,
-            bvh_stack,
-            |item_ref, item, tmax| match item_hit(item, ray, tmin, tmax, csg) {
-                Some((t, leaf, part, flip)) => {
-                    blocker = Some(Hit {
-                        t,
-                        item: item_ref,
-                        leaf,
-                        part,
-                        flip,
-                    });
-                    Step::Stop
-                }
-                None => Step::Continue,
-            },
-        );
-        blocker
     }
 
     /// Filtered shadows: every object crossing the segment multiplies the light by the
@@ -255,12 +343,15 @@ impl PreparedScene {
     }
 
     /// Full surface data for a hit along `ray`.
+    #[inline(always)]
     pub(crate) fn surface(&self, ray: &Ray, hit: &Hit) -> Surface<'_> {
         let item = self.item(hit.item);
         let leaf = item.leaf(hit.leaf);
         let point = ray.at(hit.t);
         let normal = match &leaf.geometry {
             Geometry::Sphere { center, .. } => (point - *center).normalize(),
+            // What `Geometry::normal` computes for a plane, inline: floors are hit often.
+            Geometry::Plane { normal, .. } => unit_normal(*normal, ray),
             geometry => geometry.normal(ray, hit.t, hit.part),
         };
         Surface {

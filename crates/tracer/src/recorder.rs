@@ -250,6 +250,11 @@ pub struct SkippedRay {
 /// Hooks called by the tracer; every method has an empty default. See the module
 /// documentation for the order of calls.
 pub trait Recorder {
+    /// Whether the hooks look at what they are given. When false (plain rendering), the
+    /// tracer skips work whose only use is a hook's argument, such as naming the object that
+    /// blocked a shadow ray; the colours it computes are the same either way.
+    const RECORDS: bool = true;
+
     #[inline(always)]
     fn ray_started(&mut self, _ray: &RayStart) {}
     #[inline(always)]
@@ -272,7 +277,9 @@ pub trait Recorder {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct NoRecord;
 
-impl Recorder for NoRecord {}
+impl Recorder for NoRecord {
+    const RECORDS: bool = false;
+}
 
 /// Per-pixel statistics, cheap enough to gather on a whole render: rays traced (camera,
 /// secondary and shadow), the deepest level reached, and which terminations occurred

@@ -5,12 +5,14 @@
 //! come from a hashed pattern, samples are summed in index order, and tiles only decide who
 //! computes a pixel, never its value. So the image is bit-identical on any thread count.
 
+use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
 
 use glam::Vec3A;
 use rayon::prelude::*;
 use whitted_ir::Settings;
 
+use crate::ray::Ray;
 use crate::recorder::{NoRecord, PixelStats, Recorder};
 use crate::sampling::sample_offset;
 use crate::scene::PreparedScene;
@@ -207,17 +209,37 @@ pub(crate) fn trace_sample<R: Recorder>(
     sample: u32,
     rec: &mut R,
 ) -> Vec3A {
-    let (dx, dy) = sample_offset(x, y, sample, options.samples());
-    let ray = scene
-        .camera
-        .ray(x as f32 + dx, y as f32 + dy, options.width, options.height);
+    let ray = camera_ray(scene, options, x, y, sample);
     tracer.trace(&ray, &PathState::camera(), rec)
 }
 
-struct TileOutput<R> {
-    tile: TileResult,
+/// The camera ray of sample `sample` of pixel `(x, y)`.
+#[inline]
+fn camera_ray(scene: &PreparedScene, options: &RenderOptions, x: u32, y: u32, sample: u32) -> Ray {
+    let (dx, dy) = sample_offset(x, y, sample, options.samples());
+    scene
+        .camera
+        .ray(x as f32 + dx, y as f32 + dy, options.width, options.height)
+}
+
+/// A worker's reusable state: a tracer (with its query scratch space) and the buffers of
+/// the tile being rendered, so that a render allocates per worker, not per tile.
+struct Worker<'a, R> {
+    tracer: Tracer<'a>,
+    /// The camera rays of one tile row, made before any of them is traced: a camera ray
+    /// ends in a square root and a division, and made back to back these overlap instead
+    /// of each stalling the start of its trace.
+    rays: Vec<Ray>,
+    pixels: Vec<[f32; 3]>,
     recorders: Vec<R>,
-    counters: RayCounters,
+}
+
+/// The rows of the image (and of the per-pixel recorders) that one row of tiles covers.
+/// Workers copy finished tiles in under its lock; tiles of one band only ever wait for
+/// each other for the length of a copy.
+struct Band<'i, R> {
+    pixels: &'i mut [[f32; 3]],
+    recorders: &'i mut [R],
 }
 
 fn render_recorded<R: Recorder + Default + Send>(
@@ -230,37 +252,37 @@ fn render_recorded<R: Recorder + Default + Send>(
     let tiles_x = width.div_ceil(TILE_SIZE);
     let tiles_y = height.div_ceil(TILE_SIZE);
     let tile_count = tiles_x as usize * tiles_y as usize;
-    let outputs: Vec<Option<TileOutput<R>>> = (0..tile_count)
-        .into_par_iter()
-        .map(|index| {
-            let x0 = (index as u32 % tiles_x) * TILE_SIZE;
-            let y0 = (index as u32 / tiles_x) * TILE_SIZE;
-            render_tile::<R>(scene, options, observer, x0, y0)
-        })
-        .collect();
-
     let pixel_count = width as usize * height as usize;
     let mut pixels = vec![[0.0f32; 3]; pixel_count];
     let mut recorders: Vec<R> = Vec::with_capacity(pixel_count);
     recorders.resize_with(pixel_count, R::default);
-    let mut counters = RayCounters::default();
-    for output in outputs {
-        let output = output?;
-        counters.add(&output.counters);
-        let tile = &output.tile;
-        let tile_width = tile.width as usize;
-        let mut recorder_iter = output.recorders.into_iter();
-        for (row, tile_row) in tile.pixels.chunks(tile_width.max(1)).enumerate() {
-            let start = (tile.y as usize + row) * width as usize + tile.x as usize;
-            let end = start + tile_row.len();
-            pixels[start..end].copy_from_slice(tile_row);
-            for slot in &mut recorders[start..end] {
-                if let Some(recorder) = recorder_iter.next() {
-                    *slot = recorder;
-                }
-            }
-        }
-    }
+    let band_len = (width as usize * TILE_SIZE as usize).max(1);
+    let bands: Vec<Mutex<Band<'_, R>>> = pixels
+        .chunks_mut(band_len)
+        .zip(recorders.chunks_mut(band_len))
+        .map(|(pixels, recorders)| Mutex::new(Band { pixels, recorders }))
+        .collect();
+    let counters = (0..tile_count)
+        .into_par_iter()
+        .map_init(
+            || Worker {
+                tracer: Tracer::new(scene, options.depth_limit(), options.min_weight),
+                rays: Vec::new(),
+                pixels: Vec::new(),
+                recorders: Vec::new(),
+            },
+            |worker, index| {
+                let x0 = (index as u32 % tiles_x) * TILE_SIZE;
+                let y0 = (index as u32 / tiles_x) * TILE_SIZE;
+                let band = bands.get((y0 / TILE_SIZE) as usize)?;
+                render_tile::<R>(worker, scene, options, observer, band, x0, y0)
+            },
+        )
+        .try_reduce(RayCounters::default, |mut a, b| {
+            a.add(&b);
+            Some(a)
+        })?;
+    drop(bands);
     let stats = RenderStats {
         camera_rays: counters.camera,
         shadow_rays: counters.shadow,
@@ -278,32 +300,46 @@ fn render_recorded<R: Recorder + Default + Send>(
     Some((image, stats, recorders))
 }
 
+/// Renders the tile at `(x0, y0)`, shows it to the observer, and copies it into its band
+/// of the image. Returns the tile's ray counts, or `None` when the observer cancels.
 fn render_tile<R: Recorder + Default>(
+    worker: &mut Worker<'_, R>,
     scene: &PreparedScene,
     options: &RenderOptions,
     observer: &dyn RenderObserver,
+    band: &Mutex<Band<'_, R>>,
     x0: u32,
     y0: u32,
-) -> Option<TileOutput<R>> {
+) -> Option<RayCounters> {
     let width = TILE_SIZE.min(options.width - x0);
     let height = TILE_SIZE.min(options.height - y0);
     let samples = options.samples();
-    let mut tracer = Tracer::new(scene, options.depth_limit(), options.min_weight);
-    let mut pixels = Vec::with_capacity(width as usize * height as usize);
-    let mut recorders = Vec::with_capacity(width as usize * height as usize);
+    let tracer = &mut worker.tracer;
+    let mut pixels = std::mem::take(&mut worker.pixels);
+    pixels.clear();
+    worker.recorders.clear();
+    let rays = &mut worker.rays;
     for y in y0..y0 + height {
         if observer.should_stop() {
             return None;
         }
+        rays.clear();
         for x in x0..x0 + width {
+            for sample in 0..samples {
+                rays.push(camera_ray(scene, options, x, y, sample));
+            }
+        }
+        // The rays in the order they were made: pixel by pixel, sample by sample, exactly
+        // as `trace_sample` traces them one at a time.
+        for pixel_rays in rays.chunks(samples as usize) {
             let mut rec = R::default();
             let mut accumulator = PixelAccumulator::new();
-            for sample in 0..samples {
-                let color = trace_sample(&mut tracer, scene, options, x, y, sample, &mut rec);
+            for ray in pixel_rays {
+                let color = tracer.trace(ray, &PathState::camera(), &mut rec);
                 accumulator.add(color.to_array());
             }
             pixels.push(accumulator.mean());
-            recorders.push(rec);
+            worker.recorders.push(rec);
         }
     }
     let tile = TileResult {
@@ -314,9 +350,27 @@ fn render_tile<R: Recorder + Default>(
         pixels,
     };
     observer.tile_done(&tile);
-    Some(TileOutput {
-        tile,
-        recorders,
-        counters: tracer.counters,
-    })
+    {
+        // A worker that panicked while copying cannot have left a row half written in a
+        // way that matters: the render is lost either way, so a poisoned lock is used as is.
+        let mut band = band.lock().unwrap_or_else(PoisonError::into_inner);
+        let band = &mut *band;
+        let row_len = options.width as usize;
+        let tile_width = width as usize;
+        let mut recorders = worker.recorders.drain(..);
+        for (row, tile_row) in tile.pixels.chunks(tile_width.max(1)).enumerate() {
+            let start = row * row_len + x0 as usize;
+            let end = start + tile_row.len();
+            if let Some(target) = band.pixels.get_mut(start..end) {
+                target.copy_from_slice(tile_row);
+            }
+            if let Some(targets) = band.recorders.get_mut(start..end) {
+                for (target, recorder) in targets.iter_mut().zip(recorders.by_ref()) {
+                    *target = recorder;
+                }
+            }
+        }
+    }
+    worker.pixels = tile.pixels;
+    Some(std::mem::take(&mut tracer.counters))
 }

@@ -6,6 +6,7 @@
 //! its own, for any count (not only squares), with hashing instead of random state.
 
 /// The sample's offset inside the pixel, each coordinate in `[0, 1)`.
+#[inline]
 pub fn sample_offset(x: u32, y: u32, sample: u32, samples: u32) -> (f32, f32) {
     if samples <= 1 {
         return (0.5, 0.5);

@@ -439,13 +439,19 @@ impl Geometry {
                 local.normal_from_canonical * n
             }
         };
-        let unit = n.normalize_or_zero();
-        if unit == Vec3A::ZERO {
-            // A singular point (a cone's tip): face the ray, the only sensible choice.
-            -ray.direction
-        } else {
-            unit
-        }
+        unit_normal(n, ray)
+    }
+}
+
+/// `n` made unit length; at a singular point (a cone's tip, where `n` is zero) the normal
+/// faces the ray, the only sensible choice.
+#[inline(always)]
+pub fn unit_normal(n: Vec3A, ray: &Ray) -> Vec3A {
+    let unit = n.normalize_or_zero();
+    if unit == Vec3A::ZERO {
+        -ray.direction
+    } else {
+        unit
     }
 }
 

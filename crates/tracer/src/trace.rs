@@ -68,6 +68,15 @@ impl PathState {
     }
 }
 
+/// What the recursion carries from ray to ray: all that a ray's colour depends on.
+#[derive(Clone, Copy, Debug)]
+struct Path {
+    kind: RayKind,
+    depth: u32,
+    weight: Vec3A,
+    medium: Vec3A,
+}
+
 /// One worker's tracing context: the scene, the limits, CSG scratch space and counters.
 pub struct Tracer<'a> {
     scene: &'a PreparedScene,
@@ -110,6 +119,19 @@ impl<'a> Tracer<'a> {
             coefficient: path.coefficient,
             interface: path.interface,
         });
+        let path = Path {
+            kind: path.kind,
+            depth: path.depth,
+            weight: path.weight,
+            medium: path.medium,
+        };
+        self.count(&path);
+        self.trace_started(ray, &path, rec)
+    }
+
+    /// Counts a ray about to be traced (its caller has reported it to the recorder).
+    #[inline(always)]
+    fn count(&mut self, path: &Path) {
         match path.kind {
             RayKind::Camera => self.counters.camera += 1,
             RayKind::Reflected => self.counters.reflected += 1,
@@ -118,10 +140,18 @@ impl<'a> Tracer<'a> {
             RayKind::Shadow => {}
         }
         self.counters.deepest = self.counters.deepest.max(path.depth);
+    }
+
+    /// The body of [`Tracer::trace`], once the recorder has heard of the ray: the recursion
+    /// passes only what the colour depends on, and each caller reports the rest.
+    fn trace_started<R: Recorder>(&mut self, ray: &Ray, path: &Path, rec: &mut R) -> Vec3A {
         let scene = self.scene;
+        // Most rays travel in air; then nothing is absorbed and multiplying by the
+        // transmittance (exactly 1) can be skipped without changing a bit.
+        let in_air = path.medium == Vec3A::ZERO;
 
         let Some(hit) = scene.intersect(ray, 0.0, f32::INFINITY, &mut self.scratch) else {
-            let color = if path.medium == Vec3A::ZERO {
+            let color = if in_air {
                 scene.background
             } else {
                 scene.background * beer_lambert(path.medium, f32::INFINITY)
@@ -130,7 +160,7 @@ impl<'a> Tracer<'a> {
             rec.ray_finished(color, Termination::Miss);
             return color;
         };
-        let absorption = if path.medium == Vec3A::ZERO {
+        let absorption = if in_air {
             Vec3A::ONE
         } else {
             beer_lambert(path.medium, hit.t)
@@ -168,20 +198,22 @@ impl<'a> Tracer<'a> {
         let solid = surface.leaf.geometry.is_solid();
         let split = split_weights(m, d, n, solid, front_face);
         let mut outcome = Outcome::default();
-        let carried = path.weight * absorption;
+        let carried = if in_air {
+            path.weight
+        } else {
+            path.weight * absorption
+        };
         let depth = path.depth + 1;
         if split.reflect != Vec3A::ZERO {
-            let child = PathState {
+            let child = Path {
                 kind: RayKind::Reflected,
                 depth,
                 weight: carried * split.reflect,
-                coefficient: split.reflect,
                 medium: path.medium,
-                interface: Some(split.interface),
             };
             // Unit already: a reflection preserves length (to a few ulps).
             let reflected = Ray::new(outside, reflect(d, n));
-            if let Some(c) = self.spawn(&reflected, &child, &mut outcome, rec) {
+            if let Some(c) = self.spawn(&reflected, &child, &split, &mut outcome, rec) {
                 color += split.reflect * c;
             }
         }
@@ -202,21 +234,21 @@ impl<'a> Tracer<'a> {
                 (true, true) => m.absorption,
                 (true, false) => Vec3A::ZERO,
             };
-            let child = PathState {
+            let child = Path {
                 kind: RayKind::Transmitted,
                 depth,
                 weight: carried * split.transmit,
-                coefficient: split.transmit,
                 medium,
-                interface: Some(split.interface),
             };
             let transmitted = Ray::new(point - offset * n, direction);
-            if let Some(c) = self.spawn(&transmitted, &child, &mut outcome, rec) {
+            if let Some(c) = self.spawn(&transmitted, &child, &split, &mut outcome, rec) {
                 color += split.transmit * c;
             }
         }
 
-        let color = color * absorption;
+        if !in_air {
+            color *= absorption;
+        }
         let termination = if outcome.traced_any {
             Termination::NotEnded
         } else {
@@ -262,8 +294,8 @@ impl<'a> Tracer<'a> {
                 continue;
             }
             let (passed, shadow_ray) =
-                self.cast_shadow(outside, incidence.to_light, incidence.distance);
-            sample.shadow_ray = Some(shadow_ray);
+                self.cast_shadow::<R>(outside, incidence.to_light, incidence.distance);
+            sample.shadow_ray = shadow_ray;
             if passed != Vec3A::ZERO {
                 let light_in = light.intensity * strength * passed;
                 sample.diffuse = light_in * m.diffuse * n_dot_l;
@@ -278,8 +310,14 @@ impl<'a> Tracer<'a> {
         color
     }
 
-    /// Casts a shadow ray; returns what fraction of the light passes, and the record.
-    fn cast_shadow(&mut self, origin: Vec3A, to_light: Vec3A, distance: f32) -> (Vec3A, ShadowRay) {
+    /// Casts a shadow ray; returns what fraction of the light passes, and the record when
+    /// the recorder wants one (finding the blocker's object is work for the recorder only).
+    fn cast_shadow<R: Recorder>(
+        &mut self,
+        origin: Vec3A,
+        to_light: Vec3A,
+        distance: f32,
+    ) -> (Vec3A, Option<ShadowRay>) {
         let scene = self.scene;
         let ray = Ray::new(origin, to_light);
         self.counters.shadow += 1;
@@ -290,56 +328,56 @@ impl<'a> Tracer<'a> {
             },
             ShadowMode::Filtered => scene.filter_shadow(&ray, 0.0, distance, &mut self.scratch),
         };
-        let (passed, result) = match shadow {
-            Shadow::Clear => (Vec3A::ONE, ShadowResult::Unblocked),
-            Shadow::Blocked(blocker) => {
-                let item = scene.item(blocker.item);
-                let result = ShadowResult::Blocked {
-                    object: item.object(),
-                    leaf: item.leaf(blocker.leaf).object,
-                    t: blocker.t,
-                };
-                (Vec3A::ZERO, result)
-            }
-            Shadow::Filtered {
-                transmittance,
-                blockers,
-            } => (
-                transmittance,
-                ShadowResult::Filtered {
-                    transmittance,
-                    blockers,
-                },
-            ),
+        let passed = match shadow {
+            Shadow::Clear => Vec3A::ONE,
+            Shadow::Blocked(_) => Vec3A::ZERO,
+            Shadow::Filtered { transmittance, .. } => transmittance,
         };
-        let record = ShadowRay {
+        let record = R::RECORDS.then(|| ShadowRay {
             origin,
             direction: to_light,
             max_t: distance,
-            result,
-        };
+            result: shadow_result(scene, shadow),
+        });
         (passed, record)
     }
 
     /// Traces a secondary ray unless a stopping criterion forbids it (then records why).
+    /// `split` gives the ray's coefficient and the interface it leaves, for the recorder.
+    #[inline(always)]
     fn spawn<R: Recorder>(
         &mut self,
         ray: &Ray,
-        child: &PathState,
+        child: &Path,
+        split: &Split,
         outcome: &mut Outcome,
         rec: &mut R,
     ) -> Option<Vec3A> {
+        let coefficient = match child.kind {
+            RayKind::Transmitted => split.transmit,
+            _ => split.reflect,
+        };
         match self.secondary_verdict(child) {
             None => {
                 outcome.traced_any = true;
-                Some(self.trace(ray, child, rec))
+                rec.ray_started(&RayStart {
+                    kind: child.kind,
+                    depth: child.depth,
+                    origin: ray.origin,
+                    direction: ray.direction,
+                    weight: child.weight,
+                    coefficient,
+                    interface: Some(split.interface),
+                });
+                self.count(child);
+                Some(self.trace_started(ray, child, rec))
             }
             Some(reason) => {
                 rec.secondary_skipped(&SkippedRay {
                     kind: child.kind,
                     depth: child.depth,
                     weight: child.weight,
-                    coefficient: child.coefficient,
+                    coefficient,
                     reason,
                 });
                 outcome.skipped(reason);
@@ -350,7 +388,7 @@ impl<'a> Tracer<'a> {
 
     /// `None` when the secondary ray may be traced; otherwise why not.
     #[inline]
-    fn secondary_verdict(&self, child: &PathState) -> Option<Termination> {
+    fn secondary_verdict(&self, child: &Path) -> Option<Termination> {
         if child.depth > self.max_depth {
             Some(Termination::MaxDepth)
         } else if max_channel(child.weight) < self.min_weight {
@@ -358,6 +396,28 @@ impl<'a> Tracer<'a> {
         } else {
             None
         }
+    }
+}
+
+/// A shadow query's outcome as the recorder reports it.
+fn shadow_result(scene: &PreparedScene, shadow: Shadow) -> ShadowResult {
+    match shadow {
+        Shadow::Clear => ShadowResult::Unblocked,
+        Shadow::Blocked(blocker) => {
+            let item = scene.item(blocker.item);
+            ShadowResult::Blocked {
+                object: item.object(),
+                leaf: item.leaf(blocker.leaf).object,
+                t: blocker.t,
+            }
+        }
+        Shadow::Filtered {
+            transmittance,
+            blockers,
+        } => ShadowResult::Filtered {
+            transmittance,
+            blockers,
+        },
     }
 }
 
