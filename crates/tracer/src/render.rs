@@ -4,6 +4,12 @@
 //! Every pixel is a pure function of the scene, the options and its coordinates: samples
 //! come from a hashed pattern, samples are summed in index order, and tiles only decide who
 //! computes a pixel, never its value. So the image is bit-identical on any thread count.
+//!
+//! Memory is part of the speed: each worker keeps its tracer and tile buffers for the whole
+//! render, and a finished tile is copied straight into its band of the image (one lock per
+//! band of tile rows), so a render allocates the image once and nothing per tile. Keeping
+//! every tile alive until the end, as a first version did, touched twice the image's memory
+//! and cost a tenth of a render in page faults.
 
 use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
