@@ -94,7 +94,9 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     std::fs::create_dir_all(&out_dir)?;
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
 
-    println!("\nrenders ({width}x{height}, max depth 5, 1 spp; release build)");
+    println!(
+        "\nrenders ({width}x{height}, max depth 5, 1 spp; release build; best of {RUNS} runs)"
+    );
     println!(
         "{:<26} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>10} {:>9}",
         "scene", "threads", "objects", "compile", "bvh", "render", "wall", "rays", "Mrays/s/core"
@@ -124,20 +126,34 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
                 ])
                 .args(["--stats=json", "--quiet", "-o"])
                 .arg(&output);
-            let started = Instant::now();
-            let result = command
-                .output()
-                .with_context(|| format!("cannot run {}", exe.display()))?;
-            let wall = started.elapsed().as_secs_f64();
-            if !result.status.success() {
-                bail!(
-                    "{} failed:\n{}",
-                    case.scene,
-                    String::from_utf8_lossy(&result.stderr)
-                );
+            // Best of RUNS: single-shot timings on a shared machine are noisy, and the
+            // fastest run is the one least disturbed by other work.
+            let mut best: Option<(Stats, f64)> = None;
+            for _ in 0..RUNS {
+                let started = Instant::now();
+                let result = command
+                    .output()
+                    .with_context(|| format!("cannot run {}", exe.display()))?;
+                let wall = started.elapsed().as_secs_f64();
+                if !result.status.success() {
+                    bail!(
+                        "{} failed:\n{}",
+                        case.scene,
+                        String::from_utf8_lossy(&result.stderr)
+                    );
+                }
+                let stats: Stats = serde_json::from_slice(&result.stdout)
+                    .with_context(|| format!("cannot read the stats of {}", case.scene))?;
+                if best
+                    .as_ref()
+                    .is_none_or(|(b, _)| stats.render_seconds < b.render_seconds)
+                {
+                    best = Some((stats, wall));
+                }
             }
-            let stats: Stats = serde_json::from_slice(&result.stdout)
-                .with_context(|| format!("cannot read the stats of {}", case.scene))?;
+            let Some((stats, wall)) = best else {
+                bail!("no run of {}", case.scene);
+            };
             let per_core =
                 stats.total_rays as f64 / stats.render_seconds.max(1e-9) / threads as f64 / 1e6;
             println!(
@@ -156,6 +172,36 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         }
     }
 
+    // One render per process pays for cold caches, first-touch page faults on the image and
+    // thread start-up: on a 40 ms render that is a fifth of the time. The tracer's own bench
+    // example renders the same scenes (built in Rust) repeatedly in one process: the
+    // steady-state speed per core.
+    println!("\nsteady state (same scenes rendered repeatedly in one process: crates/tracer/examples/bench.rs)");
+    run_cargo(&[
+        "run",
+        "--quiet",
+        "--release",
+        "--locked",
+        "-p",
+        "whitted-tracer",
+        "--example",
+        "bench",
+        "--",
+        "whitted",
+    ])?;
+    run_cargo(&[
+        "run",
+        "--quiet",
+        "--release",
+        "--locked",
+        "-p",
+        "whitted-tracer",
+        "--example",
+        "bench",
+        "--",
+        "spheres",
+    ])?;
+
     if Path::new(POVRAY).exists() {
         println!("\nPOV-Ray 3.7 on the equivalent scenes ({width}x{height}, max_trace_level 5, no anti-aliasing)");
         println!(
@@ -165,7 +211,13 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         for case in RENDERS {
             let Some(pov) = case.pov else { continue };
             for threads in [1, cores] {
-                let figures = run_povray(&root.join(pov), &out_dir, width, height, threads)?;
+                let mut figures = run_povray(&root.join(pov), &out_dir, width, height, threads)?;
+                for _ in 1..RUNS {
+                    let again = run_povray(&root.join(pov), &out_dir, width, height, threads)?;
+                    if again.trace_seconds < figures.trace_seconds {
+                        figures = again;
+                    }
+                }
                 let per_core =
                     figures.rays as f64 / figures.trace_seconds.max(1e-9) / threads as f64 / 1e6;
                 println!(
@@ -230,6 +282,9 @@ fn time_check(exe: &Path, scene: &Path, defines: &[&str]) -> anyhow::Result<(f64
 }
 
 const POVRAY: &str = "/usr/bin/povray";
+
+/// Each render is run this many times and the fastest run reported, for whitted and POV-Ray alike.
+const RUNS: usize = 3;
 
 /// What POV-Ray reports about one render.
 struct PovFigures {
