@@ -183,14 +183,10 @@ struct Summary<'a> {
 }
 
 impl Summary<'_> {
-    fn rays_per_second(&self) -> f64 {
-        self.stats.total_rays() as f64 / self.stats.render_seconds.max(1e-9)
-    }
-
     fn text(&self) -> String {
         let s = self.stats;
         let o = self.options;
-        let mrays = self.rays_per_second() / 1e6;
+        let mrays = self.stats.rays_per_second() / 1e6;
         [
             format!("scene            {}", self.scene.display()),
             format!("output           {}", self.output.display()),
@@ -240,7 +236,7 @@ impl Summary<'_> {
             "reflected_rays": s.reflected_rays,
             "transmitted_rays": s.transmitted_rays,
             "total_rays": s.total_rays(),
-            "rays_per_second": self.rays_per_second(),
+            "rays_per_second": self.stats.rays_per_second(),
             "wall_seconds": self.wall_seconds,
         })
     }

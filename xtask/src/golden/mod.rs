@@ -183,25 +183,30 @@ fn load_manifest(root: &Path, options: &Options) -> anyhow::Result<(Manifest, Pa
     Ok((manifest, refs_dir))
 }
 
-/// Renders a scene at its golden size into `out`.
-fn render(exe: &Path, root: &Path, scene: &GoldenScene, out: &Path) -> anyhow::Result<RgbImage> {
+/// `whitted SUBCOMMAND SCENE -D ... --width W --height H`, run from `root` with the scene's
+/// relative path, so that locations in stored ray trees do not depend on where the checkout
+/// lives.
+fn scene_command(exe: &Path, root: &Path, subcommand: &str, scene: &GoldenScene) -> Command {
     let mut command = Command::new(exe);
-    // Scene paths stay relative so that locations in stored ray trees do not depend on where
-    // the checkout lives.
-    command.current_dir(root).arg("render").arg(&scene.path);
+    command.current_dir(root).arg(subcommand).arg(&scene.path);
     for define in &scene.defines {
         command.args(["-D", define]);
     }
+    command.args([
+        "--width",
+        &scene.width.to_string(),
+        "--height",
+        &scene.height.to_string(),
+    ]);
+    command.env("NO_COLOR", "1");
     command
-        .args([
-            "--width",
-            &scene.width.to_string(),
-            "--height",
-            &scene.height.to_string(),
-        ])
+}
+
+/// Renders a scene at its golden size into `out`.
+fn render(exe: &Path, root: &Path, scene: &GoldenScene, out: &Path) -> anyhow::Result<RgbImage> {
+    let result = scene_command(exe, root, "render", scene)
         .args(["--quiet", "-o"])
-        .arg(out);
-    let result = command
+        .arg(out)
         .output()
         .with_context(|| format!("cannot run {}", exe.display()))?;
     if !result.status.success() {
@@ -217,18 +222,10 @@ fn render(exe: &Path, root: &Path, scene: &GoldenScene, out: &Path) -> anyhow::R
 
 /// The ray tree of one pixel as `whitted trace` prints it (plain text).
 fn trace(exe: &Path, root: &Path, scene: &GoldenScene, [x, y]: [u32; 2]) -> anyhow::Result<String> {
-    let mut command = Command::new(exe);
-    command.current_dir(root).arg("trace").arg(&scene.path);
-    for define in &scene.defines {
-        command.args(["-D", define]);
-    }
-    command.args(["--pixel", &format!("{x},{y}")]).args([
-        "--width",
-        &scene.width.to_string(),
-        "--height",
-        &scene.height.to_string(),
-    ]);
-    let result = command.env("NO_COLOR", "1").output()?;
+    let result = scene_command(exe, root, "trace", scene)
+        .args(["--pixel", &format!("{x},{y}")])
+        .output()
+        .with_context(|| format!("cannot run {}", exe.display()))?;
     if !result.status.success() {
         bail!(
             "whitted trace failed:\n{}",

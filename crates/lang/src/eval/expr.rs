@@ -33,20 +33,7 @@ impl<'a> Evaluator<'a> {
                 let z = self.number(z, "a vector's z component")?;
                 Value::Vector(DVec3::new(x, y, z))
             }
-            ExprKind::Name(name) => match name.res {
-                Res::Local(slot) => self
-                    .stack
-                    .get(self.base + slot as usize)
-                    .copied()
-                    .unwrap_or(Value::Poisoned),
-                Res::Global(slot) => self
-                    .globals
-                    .get(slot as usize)
-                    .copied()
-                    .unwrap_or(Value::Poisoned),
-                Res::Builtin(constant) => constant.value(),
-                Res::Word(_) | Res::Unresolved | Res::Error => Value::Poisoned,
-            },
+            ExprKind::Name(name) => self.name_value(name),
             ExprKind::Unary(op, inner) => {
                 let value = self.eval(inner)?;
                 match (op, value) {
