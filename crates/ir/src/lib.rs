@@ -6,6 +6,7 @@
 mod arena;
 mod diagnostic;
 mod json;
+pub mod limits;
 mod print;
 mod scene;
 mod source;
