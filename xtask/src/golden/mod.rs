@@ -82,7 +82,17 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         Some(_) => std::env::current_dir()?,
         None => root.clone(),
     };
-    run_cargo(&["build", "--locked", "--bin", "whitted"])?;
+    // Built as `cargo test --workspace` builds it (same profile and the same unified
+    // features, dev-dependencies included), so that after the tests of `cargo xtask ci` this
+    // is a no-op instead of a second build of five crates with other features.
+    run_cargo(&[
+        "test",
+        "--workspace",
+        "--locked",
+        "--no-run",
+        "--bin",
+        "whitted",
+    ])?;
     let exe = root.join("target/debug/whitted");
     let out_dir = root.join("target/golden");
     if out_dir.exists() {
