@@ -21,10 +21,11 @@ pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
         None => SampleChoice::All,
     };
     // Check the request before the BVH build, which is the slow part on big scenes.
-    check_request(&options, x, y, which).map_err(|error| Failure::Message(error.to_string()))?;
+    // A pixel or sample that does not exist is a usage error (exit 2), like a malformed one.
+    check_request(&options, x, y, which).map_err(|error| Failure::Usage(error.to_string()))?;
     let prepared = PreparedScene::new(&loaded.scene);
     let tree = trace_pixel(&prepared, &loaded.scene, &options, x, y, which)
-        .map_err(|error| Failure::Message(error.to_string()))?;
+        .map_err(|error| Failure::Usage(error.to_string()))?;
     let text = if args.json {
         serde_json::to_string_pretty(&tree.document())
             .map_err(|e| Failure::Message(format!("cannot write the tree as JSON: {e}")))?
