@@ -41,6 +41,8 @@ pub fn write_image(
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
     let mut temp = builder.tempfile_in(dir).map_err(|e| describe(&e))?;
+    // Dropped after the rename or the temporary file's own removal, both below.
+    let _registered = crate::interrupt::register(temp.path());
     encode(temp.as_file_mut(), format, width, height, pixels).map_err(|e| describe(&e))?;
     temp.as_file().sync_all().map_err(|e| describe(&e))?;
     temp.persist(path).map_err(|e| describe(&e.error))?;

@@ -6,6 +6,7 @@
 mod cli;
 mod debug_cmd;
 mod image_output;
+mod interrupt;
 mod render_cmd;
 mod scene_input;
 mod stats_image;

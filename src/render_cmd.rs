@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use whitted_ir::Settings;
+use whitted_ir::{Settings, SourceMap};
 use whitted_tracer::{PreparedScene, RenderObserver, RenderOptions, RenderStats, TileResult};
 
 use crate::cli::{ImageFormat, RenderArgs, RenderOverrides, StatsFormat};
@@ -62,6 +62,57 @@ fn default_output(scene: &Path) -> PathBuf {
     ))
 }
 
+/// Refuses an output that is the scene or one of the files it imports: rendering
+/// `s.ppm -o s.ppm` would replace the scene with its picture.
+fn refuse_outputs_over_sources(
+    scene: &Path,
+    sources: &SourceMap,
+    output: &Path,
+) -> Result<(), Failure> {
+    let imports = sources.files().map(|(_, file)| PathBuf::from(&file.path));
+    for source in std::iter::once(scene.to_path_buf()).chain(imports) {
+        if same_file(output, &source) {
+            let role = if source == scene {
+                "the scene"
+            } else {
+                "a file the scene imports"
+            };
+            return Err(Failure::Usage(format!(
+                "the output {} is {role} ({}): choose another output with -o",
+                output.display(),
+                source.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Whether two paths name the same file: the same device and inode when both exist (this
+/// sees through links and `..`), otherwise the same canonical folder and file name.
+fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return a.dev() == b.dev() && a.ino() == b.ino();
+        }
+    }
+    match (canonical_location(a), canonical_location(b)) {
+        (Some(a), Some(b)) => a == b,
+        _ => a == b,
+    }
+}
+
+/// The canonical folder of `path` joined with its file name (the file itself need not exist).
+fn canonical_location(path: &Path) -> Option<PathBuf> {
+    let name = path.file_name()?;
+    let folder = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    Some(std::fs::canonicalize(folder).ok()?.join(name))
+}
+
 pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     let started = Instant::now();
     let output = args
@@ -82,8 +133,23 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         }
     }
 
+    if let Some(stats_image) = &args.stats_image {
+        if same_file(stats_image, &output) {
+            return Err(Failure::Usage(format!(
+                "--stats-image {} is the same file as the output {}: the heat maps would replace the render",
+                stats_image.display(),
+                output.display()
+            )));
+        }
+    }
+    crate::interrupt::install();
+
     let loaded = load_scene(&args.scene, args.quiet)?;
     let compile_seconds = started.elapsed().as_secs_f64();
+    refuse_outputs_over_sources(&args.scene.scene, &loaded.scene.sources, &output)?;
+    if let Some(stats_image) = &args.stats_image {
+        refuse_outputs_over_sources(&args.scene.scene, &loaded.scene.sources, stats_image)?;
+    }
     let prepared = PreparedScene::new(&loaded.scene);
 
     let options = render_options(&loaded.scene.settings, &args.overrides);

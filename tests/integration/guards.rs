@@ -144,3 +144,138 @@ fn escape_sequences_in_names_never_reach_the_terminal_raw() {
     assert!(printed.contains(r"ball\u{1b}]0;owned\u{7}"), "{printed}");
     assert!(printed.contains(r"light l\u{1b}[2J"), "{printed}");
 }
+
+const SMALL_SCENE: &str = "settings { width 8 height 6 }\n\
+    camera perspective { eye <0, 0, -5> look_at <0, 0, 0> fov 45 }\n\
+    light point { position <0, 5, -5> }\n\
+    sphere { radius 1 }\n";
+
+#[test]
+fn an_output_that_is_the_scene_an_import_or_the_other_output_is_refused() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let in_dir = |args: &[&str]| {
+        whitted()
+            .current_dir(dir.path())
+            .args(args)
+            .output()
+            .expect("the whitted binary runs")
+    };
+    let refused = |output: &Output, what: &str| {
+        assert_eq!(output.status.code(), Some(2), "{}", stderr(output));
+        assert!(stderr(output).contains(what), "{}", stderr(output));
+    };
+    // A scene whose name looks like an image, as the output or as the default output.
+    write(dir.path(), "s.ppm", SMALL_SCENE);
+    refused(&in_dir(&["render", "s.ppm", "-o", "s.ppm"]), "is the scene");
+    refused(
+        &in_dir(&["render", "s.ppm", "-o", "./s.ppm"]),
+        "is the scene",
+    );
+    write(dir.path(), "x.png", SMALL_SCENE);
+    refused(&in_dir(&["render", "x.png"]), "is the scene");
+    // An imported file.
+    write(dir.path(), "part.png", "sphere { center <2, 0, 0> }\n");
+    write(
+        dir.path(),
+        "main.scene",
+        &format!("{SMALL_SCENE}import \"part.png\"\n"),
+    );
+    refused(
+        &in_dir(&["render", "main.scene", "-o", "part.png"]),
+        "is a file the scene imports",
+    );
+    refused(
+        &in_dir(&["render", "main.scene", "--stats-image", "part.png"]),
+        "is a file the scene imports",
+    );
+    // The two outputs of one command, also spelled differently.
+    refused(
+        &in_dir(&[
+            "render",
+            "main.scene",
+            "-o",
+            "a.png",
+            "--stats-image",
+            "./a.png",
+        ]),
+        "the same file as the output",
+    );
+    for (name, text) in [
+        ("s.ppm", SMALL_SCENE),
+        ("x.png", SMALL_SCENE),
+        ("part.png", "sphere { center <2, 0, 0> }\n"),
+    ] {
+        let kept = std::fs::read_to_string(dir.path().join(name)).expect("the file is still there");
+        assert_eq!(kept, text, "{name} was overwritten");
+    }
+    assert!(!dir.path().join("a.png").exists());
+    // A legitimate render next to them still works.
+    let output = in_dir(&[
+        "render",
+        "main.scene",
+        "-o",
+        "out.png",
+        "--stats-image",
+        "st.png",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+}
+
+/// The `.whitted-*.tmp` files in `dir`.
+fn temporary_files(dir: &Path) -> Vec<PathBuf> {
+    std::fs::read_dir(dir)
+        .expect("list the directory")
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|p| p.to_string_lossy().ends_with(".tmp"))
+        .collect()
+}
+
+#[cfg(unix)]
+#[test]
+fn a_signal_during_the_write_removes_the_temporary_file() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    // Nothing to hit: the render is quick, the PNG encoding of a big image is not.
+    let scene = write(
+        dir.path(),
+        "empty.scene",
+        "camera perspective { eye <0, 0, -5> look_at <0, 0, 0> fov 45 }\n",
+    );
+    let out = dir.path().join("big.png");
+    for (signal, code) in [("TERM", 143), ("INT", 130)] {
+        let mut child = whitted()
+            .args(["render", text(&scene), "-o", text(&out), "--quiet"])
+            .args(["--width", "4000", "--height", "4000"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("the whitted binary runs");
+        let started = Instant::now();
+        // Wait for the temporary file to appear, then interrupt the write.
+        let seen = loop {
+            if !temporary_files(dir.path()).is_empty() {
+                break true;
+            }
+            if child.try_wait().expect("poll whitted").is_some()
+                || started.elapsed() > Duration::from_secs(300)
+            {
+                break false;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        };
+        assert!(seen, "the temporary file never appeared");
+        let killed = Command::new("kill")
+            .arg(format!("-{signal}"))
+            .arg(child.id().to_string())
+            .status()
+            .expect("kill runs");
+        assert!(killed.success());
+        let status = child.wait().expect("wait for whitted");
+        assert_eq!(
+            temporary_files(dir.path()),
+            Vec::<PathBuf>::new(),
+            "SIG{signal}"
+        );
+        assert_eq!(status.code(), Some(code), "SIG{signal}: {status:?}");
+        assert!(!out.exists(), "no half image");
+    }
+}
