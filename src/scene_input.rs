@@ -166,13 +166,26 @@ pub fn check(args: &SceneArgs) -> Result<(), Failure> {
 /// `whitted ir`: the compiled IR as text or JSON on stdout.
 pub fn ir(args: &IrArgs) -> Result<(), Failure> {
     let loaded = load_scene(&args.scene, false)?;
-    let text = if args.json {
-        let value = whitted_ir::to_json(&loaded.scene);
-        serde_json::to_string_pretty(&value).map_err(|e| Failure::Message(e.to_string()))? + "\n"
+    if args.json {
+        write_json_stdout(&whitted_ir::json_document(&loaded.scene))
     } else {
-        whitted_ir::print(&loaded.scene)
-    };
-    write_stdout(&text)
+        write_stdout(&whitted_ir::print(&loaded.scene))
+    }
+}
+
+/// Writes `value` as pretty JSON and a newline to stdout as it is serialised, never holding
+/// the whole text (a million objects would take gigabytes); a closed pipe is success.
+pub fn write_json_stdout<T: serde::Serialize>(value: &T) -> Result<(), Failure> {
+    let mut writer = std::io::BufWriter::new(std::io::stdout().lock());
+    let written = serde_json::to_writer_pretty(&mut writer, value)
+        .map_err(std::io::Error::from)
+        .and_then(|()| writer.write_all(b"\n"))
+        .and_then(|()| writer.flush());
+    match written {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(Failure::Message(format!("cannot write to stdout: {e}"))),
+    }
 }
 
 /// Writes to stdout, treating a closed pipe (`| head`) as success rather than a crash.

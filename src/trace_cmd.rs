@@ -9,7 +9,7 @@ use whitted_tracer::PreparedScene;
 
 use crate::cli::TraceArgs;
 use crate::render_cmd::render_options;
-use crate::scene_input::{load_scene, write_stdout};
+use crate::scene_input::{load_scene, write_json_stdout, write_stdout};
 use crate::Failure;
 
 pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
@@ -26,13 +26,10 @@ pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
     let prepared = PreparedScene::new(&loaded.scene);
     let tree = trace_pixel(&prepared, &loaded.scene, &options, x, y, which)
         .map_err(|error| Failure::Usage(error.to_string()))?;
-    let text = if args.json {
-        serde_json::to_string_pretty(&tree.document())
-            .map_err(|e| Failure::Message(format!("cannot write the tree as JSON: {e}")))?
-            + "\n"
+    if args.json {
+        write_json_stdout(&tree.document())
     } else {
         let swatches = std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none();
-        format_text(&tree, TextOptions { swatches })
-    };
-    write_stdout(&text)
+        write_stdout(&format_text(&tree, TextOptions { swatches }))
+    }
 }

@@ -35,6 +35,15 @@ pub fn format_text(tree: &RayTree, options: TextOptions) -> String {
         tree.max_depth,
         num(tree.min_weight)
     );
+    if tree.unrecorded > 0 {
+        let _ = writeln!(
+            out,
+            "cut at the ray-tree budget of {} nodes: {} not recorded (traced, and in the \
+             colours); look for `not recorded` below",
+            tree.node_budget,
+            plural_u64(tree.unrecorded, "more ray"),
+        );
+    }
     for sample in &tree.samples {
         out.push('\n');
         let _ = writeln!(
@@ -129,6 +138,12 @@ impl Printer {
                 lines.push(self.light_line(light));
             }
             lines.push(format!("local      {}", self.color(local.total)));
+        }
+        if node.unrecorded > 0 {
+            lines.push(format!(
+                "not recorded {} below this ray (the tree's node budget was reached)",
+                plural_u64(node.unrecorded, "ray")
+            ));
         }
         for skipped in &node.skipped {
             // A transmission lost to total internal reflection has no weight of its own: it
@@ -336,6 +351,10 @@ fn termination_text(termination: Termination) -> &'static str {
 }
 
 fn plural(n: u32, noun: &str) -> String {
+    plural_u64(u64::from(n), noun)
+}
+
+fn plural_u64(n: u64, noun: &str) -> String {
     if n == 1 {
         format!("1 {noun}")
     } else {
