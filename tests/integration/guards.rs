@@ -279,3 +279,34 @@ fn a_signal_during_the_write_removes_the_temporary_file() {
         assert!(!out.exists(), "no half image");
     }
 }
+
+#[test]
+fn a_render_over_the_memory_limit_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let scene = write(dir.path(), "small.scene", SMALL_SCENE);
+    let out = dir.path().join("big.png");
+    let heat_maps = dir.path().join("big-stats.exr");
+    // The most pixels allowed, with heat maps as floats: about 10 GiB.
+    let output = run_within(
+        &[
+            "render",
+            text(&scene),
+            "--width",
+            "32768",
+            "--height",
+            "4096",
+            "-o",
+            text(&out),
+            "--stats-image",
+            text(&heat_maps),
+        ],
+        Duration::from_secs(60),
+    );
+    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+    assert!(
+        stderr(&output).contains("more than the render memory limit of 8 GiB"),
+        "{}",
+        stderr(&output)
+    );
+    assert!(!out.exists() && !heat_maps.exists());
+}
