@@ -52,6 +52,7 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
     whitted_debugger::run(session).map_err(|error| match error {
         DebugError::NotATerminal => Failure::Usage(error.to_string()),
         DebugError::Terminal(_) => Failure::Message(error.to_string()),
+        DebugError::Signal(signal) => Failure::Signal(signal),
     })
 }
 

@@ -34,6 +34,9 @@ pub enum Event {
     FileChanged,
     /// The loop's timer: nothing arrived before the next deadline.
     Tick,
+    /// The process received this signal (SIGTERM, SIGHUP, SIGQUIT or SIGINT): give the
+    /// terminal back and stop.
+    Signal(i32),
 }
 
 /// The reload worker's answer: the new scene and its warning count, or its errors; and the

@@ -30,6 +30,8 @@ pub enum DebugError {
     NotATerminal,
     /// The terminal could not be set up, drawn to or read.
     Terminal(io::Error),
+    /// A signal stopped the debugger (the terminal was restored); its number.
+    Signal(i32),
 }
 
 impl fmt::Display for DebugError {
@@ -42,6 +44,7 @@ impl fmt::Display for DebugError {
                 )
             }
             DebugError::Terminal(error) => write!(f, "terminal error: {error}"),
+            DebugError::Signal(signal) => write!(f, "stopped by signal {signal}"),
         }
     }
 }
@@ -79,6 +82,7 @@ pub fn run(session: Session) -> Result<(), DebugError> {
     app.color_depth = ColorDepth::from_colorterm(std::env::var("COLORTERM").ok().as_deref());
 
     let (events, inbox) = mpsc::channel();
+    terminal::forward_signals(events.clone())?;
     spawn_input_thread(events.clone())?;
     let reloader = Reloader::start(session.recompile, events.clone())?;
     let mut watch = match FileWatch::start(events.clone()) {
@@ -189,6 +193,8 @@ fn event_loop(
                 Event::InputFailed(message) => {
                     return Err(DebugError::Terminal(io::Error::other(message)));
                 }
+                // Returning drops the terminal guard, which restores the terminal.
+                Event::Signal(signal) => return Err(DebugError::Signal(signal)),
                 Event::FileChanged => reload_at = Some(Instant::now() + RELOAD_DEBOUNCE),
                 Event::Tick => {}
                 Event::Reloaded(reloaded) => {
@@ -268,7 +274,11 @@ fn handle(app: &mut App, event: Event) -> Vec<Effect> {
             );
             Vec::new()
         }
-        Event::InputFailed(_) | Event::FileChanged | Event::Tick | Event::Reloaded(_) => Vec::new(),
+        Event::InputFailed(_)
+        | Event::FileChanged
+        | Event::Tick
+        | Event::Reloaded(_)
+        | Event::Signal(_) => Vec::new(),
     }
 }
 
