@@ -106,12 +106,7 @@ fn install_panic_hook() {
                 let _ = restore();
                 previous(info);
             } else {
-                let payload = info
-                    .payload()
-                    .downcast_ref::<&str>()
-                    .map(|s| s.to_string())
-                    .or_else(|| info.payload().downcast_ref::<String>().cloned())
-                    .unwrap_or_else(|| "unknown panic".to_string());
+                let payload = panic_text(info.payload());
                 let location = info
                     .location()
                     .map(|l| format!(" at {}:{}", l.file(), l.line()))
@@ -122,6 +117,15 @@ fn install_panic_hook() {
             }
         }));
     });
+}
+
+/// A panic's message, from its payload.
+pub fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".to_string())
 }
 
 /// The message of the latest panic on a worker thread, if any (taken: asked once).
