@@ -30,6 +30,8 @@ pub enum Event {
         message: String,
     },
     Reloaded(Reloaded),
+    /// A pixel's ray tree, recorded off the UI thread (or why not).
+    Traced(crate::trace_job::Traced),
     /// A watched scene file changed on disk.
     FileChanged,
     /// The loop's timer: nothing arrived before the next deadline.

@@ -108,6 +108,7 @@ pub fn run(session: Session) -> Result<(), DebugError> {
     if let Some((x, y)) = session.pixel {
         app.cursor = (x, y);
         app.trace_cursor();
+        runner.carry_out(&mut app, vec![Effect::Trace]);
     }
     event_loop(&mut guard, &mut app, &mut runner, &inbox, &mut watch)
 }
@@ -141,6 +142,14 @@ impl Runner {
                         Err(error) => {
                             app.apply_render_done(self.generation, None);
                             app.set_message(format!("cannot start rendering: {error}"), true);
+                        }
+                    }
+                }
+                Effect::Trace => {
+                    if let Some(job) = app.trace_job() {
+                        if let Err(error) = job.spawn(self.events.clone()) {
+                            app.cancel_trace();
+                            app.set_message(format!("cannot start tracing: {error}"), true);
                         }
                     }
                 }
@@ -219,7 +228,8 @@ fn event_loop(
             }
         }
         if app.traces != traces_before {
-            picked_at = Some(started);
+            // Timed from the key or click that asked for the tree, not from its arrival.
+            picked_at = Some(app.traced_request_at.take().unwrap_or(started));
         }
         if let Some(at) = reload_at {
             if Instant::now() >= at {
@@ -257,6 +267,10 @@ fn handle(app: &mut App, event: Event) -> Vec<Effect> {
         }
         Event::RenderTile { generation, tile } => {
             app.apply_tile(generation, &tile);
+            Vec::new()
+        }
+        Event::Traced(traced) => {
+            app.apply_trace(traced);
             Vec::new()
         }
         Event::RenderDone { generation, result } => {
