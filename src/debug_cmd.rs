@@ -17,7 +17,7 @@ struct DiskLoader;
 
 impl SourceLoader for DiskLoader {
     fn load(&mut self, path: &Path) -> std::io::Result<String> {
-        std::fs::read_to_string(path)
+        crate::scene_input::read_source(path)
     }
 }
 
@@ -29,7 +29,7 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
     crate::render_cmd::check_image_size(settings.width, settings.height)?;
     if let Some([x, y]) = args.pixel {
         if x >= settings.width || y >= settings.height {
-            return Err(Failure::Message(format!(
+            return Err(Failure::Usage(format!(
                 "pixel ({x}, {y}) is outside the {}x{} image (x must be 0 to {}, y 0 to {})",
                 settings.width,
                 settings.height,
@@ -52,6 +52,7 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
     whitted_debugger::run(session).map_err(|error| match error {
         DebugError::NotATerminal => Failure::Usage(error.to_string()),
         DebugError::Terminal(_) => Failure::Message(error.to_string()),
+        DebugError::Signal(signal) => Failure::Signal(signal),
     })
 }
 

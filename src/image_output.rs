@@ -3,7 +3,7 @@
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-use whitted_tracer::display::linear_to_srgb8_rgb;
+use whitted_tracer::display::{linear_to_srgb8_rgb, srgb_to_linear};
 
 use crate::cli::ImageFormat;
 
@@ -15,7 +15,15 @@ pub fn to_srgb8(pixels: &[[f32; 3]]) -> Vec<u8> {
         .collect()
 }
 
-/// Writes `pixels` (linear RGB, row-major, top first) to `path` in `format`.
+/// An image's pixels, row-major, top first.
+pub enum Pixels<'a> {
+    /// Linear RGB (a render).
+    Linear(&'a [[f32; 3]]),
+    /// 8-bit sRGB, three bytes per pixel (the heat maps), taken as they are by PNG and PPM.
+    Srgb8(Vec<u8>),
+}
+
+/// Writes `pixels` to `path` in `format`.
 ///
 /// The bytes go to a temporary file beside the target, which is renamed over it only when
 /// complete: a failed write never leaves half an image or clobbers the old one.
@@ -24,7 +32,7 @@ pub fn write_image(
     format: ImageFormat,
     width: u32,
     height: u32,
-    pixels: &[[f32; 3]],
+    pixels: Pixels<'_>,
 ) -> Result<(), String> {
     let dir = match path.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
@@ -41,6 +49,8 @@ pub fn write_image(
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
     let mut temp = builder.tempfile_in(dir).map_err(|e| describe(&e))?;
+    // Dropped after the rename or the temporary file's own removal, both below.
+    let _registered = crate::interrupt::register(temp.path());
     encode(temp.as_file_mut(), format, width, height, pixels).map_err(|e| describe(&e))?;
     temp.as_file().sync_all().map_err(|e| describe(&e))?;
     temp.persist(path).map_err(|e| describe(&e.error))?;
@@ -52,20 +62,34 @@ fn encode(
     format: ImageFormat,
     width: u32,
     height: u32,
-    pixels: &[[f32; 3]],
+    pixels: Pixels<'_>,
 ) -> Result<(), String> {
     let mut writer = BufWriter::new(file);
+    // Only the buffer the format needs is made, one at a time: at the largest image size
+    // every copy costs gigabytes.
+    let srgb8 = |pixels: Pixels<'_>| match pixels {
+        Pixels::Linear(linear) => to_srgb8(linear),
+        Pixels::Srgb8(bytes) => bytes,
+    };
+    let floats = |pixels: Pixels<'_>| -> Vec<f32> {
+        match pixels {
+            Pixels::Linear(linear) => linear.iter().flatten().copied().collect(),
+            Pixels::Srgb8(bytes) => bytes
+                .iter()
+                .map(|&b| srgb_to_linear(f32::from(b) / 255.0))
+                .collect(),
+        }
+    };
     match format {
         ImageFormat::Png => {
-            let image = image::RgbImage::from_raw(width, height, to_srgb8(pixels))
+            let image = image::RgbImage::from_raw(width, height, srgb8(pixels))
                 .ok_or("the image has the wrong number of pixels")?;
             image
                 .write_to(&mut writer, image::ImageFormat::Png)
                 .map_err(|e| e.to_string())?;
         }
         ImageFormat::Exr | ImageFormat::Hdr => {
-            let floats: Vec<f32> = pixels.iter().flatten().copied().collect();
-            let image = image::Rgb32FImage::from_raw(width, height, floats)
+            let image = image::Rgb32FImage::from_raw(width, height, floats(pixels))
                 .ok_or("the image has the wrong number of pixels")?;
             let kind = if format == ImageFormat::Exr {
                 image::ImageFormat::OpenExr
@@ -79,7 +103,7 @@ fn encode(
         ImageFormat::Ppm => {
             write!(writer, "P6\n{width} {height}\n255\n").map_err(|e| e.to_string())?;
             writer
-                .write_all(&to_srgb8(pixels))
+                .write_all(&srgb8(pixels))
                 .map_err(|e| e.to_string())?;
         }
     }
@@ -89,6 +113,14 @@ fn encode(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn srgb_bytes_survive_the_linear_round_trip_of_the_float_formats() {
+        for byte in 0..=255u8 {
+            let linear = srgb_to_linear(f32::from(byte) / 255.0);
+            assert_eq!(linear_to_srgb8_rgb([linear; 3]), [byte; 3]);
+        }
+    }
 
     #[test]
     fn pixels_become_three_srgb_bytes_each() {
@@ -108,12 +140,12 @@ mod tests {
             ("a.hdr", ImageFormat::Hdr),
         ] {
             let path = dir.path().join(name);
-            write_image(&path, format, 3, 2, &pixels).unwrap();
+            write_image(&path, format, 3, 2, Pixels::Linear(&pixels)).unwrap();
             let decoded = image::open(&path).unwrap();
             assert_eq!((decoded.width(), decoded.height()), (3, 2), "{name}");
         }
         let ppm = dir.path().join("a.ppm");
-        write_image(&ppm, ImageFormat::Ppm, 3, 2, &pixels).unwrap();
+        write_image(&ppm, ImageFormat::Ppm, 3, 2, Pixels::Linear(&pixels)).unwrap();
         let bytes = std::fs::read(&ppm).unwrap();
         assert!(bytes.starts_with(b"P6\n3 2\n255\n"));
         assert_eq!(bytes.len(), 11 + 18);
@@ -121,7 +153,7 @@ mod tests {
         // A wrong pixel count fails before the rename: the old image stays intact.
         let png = dir.path().join("a.png");
         let before = std::fs::read(&png).unwrap();
-        assert!(write_image(&png, ImageFormat::Png, 4, 4, &pixels).is_err());
+        assert!(write_image(&png, ImageFormat::Png, 4, 4, Pixels::Linear(&pixels)).is_err());
         assert_eq!(std::fs::read(&png).unwrap(), before);
         let leftovers = std::fs::read_dir(dir.path())
             .unwrap()
@@ -142,7 +174,14 @@ mod tests {
         use std::os::unix::fs::PermissionsExt;
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("p.png");
-        write_image(&path, ImageFormat::Png, 1, 1, &[[0.5, 0.5, 0.5]]).unwrap();
+        write_image(
+            &path,
+            ImageFormat::Png,
+            1,
+            1,
+            Pixels::Linear(&[[0.5, 0.5, 0.5]]),
+        )
+        .unwrap();
         let mode = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
         assert_ne!(
             mode & 0o044,

@@ -6,6 +6,7 @@
 mod cli;
 mod debug_cmd;
 mod image_output;
+mod interrupt;
 mod render_cmd;
 mod scene_input;
 mod stats_image;
@@ -26,6 +27,8 @@ pub enum Failure {
     Message(String),
     /// Bad usage that clap could not catch (e.g. a pixel outside the image).
     Usage(String),
+    /// Stopped by this signal after cleaning up: exit as a shell expects (128 + its number).
+    Signal(i32),
 }
 
 impl From<std::io::Error> for Failure {
@@ -54,5 +57,6 @@ fn main() -> ExitCode {
             let _ = writeln!(std::io::stderr(), "error: {message}");
             ExitCode::from(2)
         }
+        Err(Failure::Signal(signal)) => ExitCode::from(128u8.saturating_add(signal as u8)),
     }
 }

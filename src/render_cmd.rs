@@ -5,11 +5,12 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use whitted_ir::Settings;
+use whitted_ir::limits::MAX_PIXELS;
+use whitted_ir::{Settings, SourceMap};
 use whitted_tracer::{PreparedScene, RenderObserver, RenderOptions, RenderStats, TileResult};
 
 use crate::cli::{ImageFormat, RenderArgs, RenderOverrides, StatsFormat};
-use crate::image_output::write_image;
+use crate::image_output::{write_image, Pixels};
 use crate::scene_input::{load_scene, write_stdout};
 use crate::stats_image::StatsImage;
 use crate::Failure;
@@ -38,11 +39,8 @@ pub fn render_options(settings: &Settings, overrides: &RenderOverrides) -> Rende
     options
 }
 
-/// The most pixels one image may have: 2^27 (about 11,585 x 11,585), 1.5 GiB of linear RGB.
-/// Larger sizes are almost always a typo (`--width 64000`) and would exhaust memory.
-pub const MAX_PIXELS: u64 = 1 << 27;
-
-/// Refuses image sizes that cannot be held in memory, before any work starts.
+/// Refuses image sizes that cannot be held in memory, before any work starts: larger sizes
+/// are almost always a typo (`--width 64000`).
 pub fn check_image_size(width: u32, height: u32) -> Result<(), Failure> {
     let pixels = u64::from(width) * u64::from(height);
     if pixels > MAX_PIXELS {
@@ -53,6 +51,62 @@ pub fn check_image_size(width: u32, height: u32) -> Result<(), Failure> {
     Ok(())
 }
 
+/// What one render will need in memory, estimated before any work so that a render too big
+/// for the machine is refused with a message rather than killed half-way.
+struct MemoryEstimate {
+    pixels: u64,
+    output: ImageFormat,
+    /// The format of `--stats-image`, when asked for.
+    stats_image: Option<ImageFormat>,
+    objects: u64,
+}
+
+/// Bytes per object of the prepared scene (shapes, inverse transforms, BVH nodes), beyond
+/// the compiled scene already in memory; generous for spheres, about right for CSG.
+const PREPARED_BYTES_PER_OBJECT: u64 = 256;
+
+impl MemoryEstimate {
+    /// Bytes per pixel for encoding in `format`: the 8-bit formats make 3 bytes of sRGB, the
+    /// float formats a copy of 12 bytes of floats and the encoder's own buffer of as much.
+    fn encoding(format: ImageFormat) -> u64 {
+        match format {
+            ImageFormat::Png | ImageFormat::Ppm => 3,
+            ImageFormat::Exr | ImageFormat::Hdr => 24,
+        }
+    }
+
+    /// The peak: while rendering and writing the image, the image (12 bytes of linear RGB
+    /// per pixel) and the per-pixel statistics (12) are held with the encoded image; then,
+    /// for `--stats-image`, the statistics and the heat maps (3 panels of 3 sRGB bytes), and
+    /// then the heat maps with their encoding.
+    fn bytes(&self) -> u64 {
+        let stats = if self.stats_image.is_some() { 12 } else { 0 };
+        let render = 12 + stats + Self::encoding(self.output);
+        let heat_maps = self
+            .stats_image
+            .map_or(0, |format| (12 + 9).max(9 + 3 * Self::encoding(format)));
+        self.pixels
+            .saturating_mul(render.max(heat_maps))
+            .saturating_add(self.objects.saturating_mul(PREPARED_BYTES_PER_OBJECT))
+    }
+
+    fn check(&self) -> Result<(), Failure> {
+        let bytes = self.bytes();
+        let limit = whitted_ir::limits::MAX_RENDER_MEMORY_BYTES;
+        if bytes > limit {
+            let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+            return Err(Failure::Message(format!(
+                "this render would need about {:.1} GiB of memory, more than the render memory \
+                 limit of {:.0} GiB: make the image smaller, or write 8-bit images (.png, .ppm) \
+                 rather than .exr or .hdr",
+                gib(bytes),
+                gib(limit)
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// `scenes/whitted.scene` renders to `whitted.png` in the current directory by default.
 fn default_output(scene: &Path) -> PathBuf {
     let stem = scene.file_stem().map(|s| s.to_string_lossy().into_owned());
@@ -60,6 +114,57 @@ fn default_output(scene: &Path) -> PathBuf {
         "{}.png",
         stem.unwrap_or_else(|| "render".to_string())
     ))
+}
+
+/// Refuses an output that is the scene or one of the files it imports: rendering
+/// `s.ppm -o s.ppm` would replace the scene with its picture.
+fn refuse_outputs_over_sources(
+    scene: &Path,
+    sources: &SourceMap,
+    output: &Path,
+) -> Result<(), Failure> {
+    let imports = sources.files().map(|(_, file)| PathBuf::from(&file.path));
+    for source in std::iter::once(scene.to_path_buf()).chain(imports) {
+        if same_file(output, &source) {
+            let role = if source == scene {
+                "the scene"
+            } else {
+                "a file the scene imports"
+            };
+            return Err(Failure::Usage(format!(
+                "the output {} is {role} ({}): choose another output with -o",
+                output.display(),
+                source.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Whether two paths name the same file: the same device and inode when both exist (this
+/// sees through links and `..`), otherwise the same canonical folder and file name.
+fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+            return a.dev() == b.dev() && a.ino() == b.ino();
+        }
+    }
+    match (canonical_location(a), canonical_location(b)) {
+        (Some(a), Some(b)) => a == b,
+        _ => a == b,
+    }
+}
+
+/// The canonical folder of `path` joined with its file name (the file itself need not exist).
+fn canonical_location(path: &Path) -> Option<PathBuf> {
+    let name = path.file_name()?;
+    let folder = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    Some(std::fs::canonicalize(folder).ok()?.join(name))
 }
 
 pub fn render(args: &RenderArgs) -> Result<(), Failure> {
@@ -82,12 +187,36 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         }
     }
 
+    if let Some(stats_image) = &args.stats_image {
+        if same_file(stats_image, &output) {
+            return Err(Failure::Usage(format!(
+                "--stats-image {} is the same file as the output {}: the heat maps would replace the render",
+                stats_image.display(),
+                output.display()
+            )));
+        }
+    }
+    crate::interrupt::install();
+
     let loaded = load_scene(&args.scene, args.quiet)?;
     let compile_seconds = started.elapsed().as_secs_f64();
-    let prepared = PreparedScene::new(&loaded.scene);
-
+    refuse_outputs_over_sources(&args.scene.scene, &loaded.scene.sources, &output)?;
+    if let Some(stats_image) = &args.stats_image {
+        refuse_outputs_over_sources(&args.scene.scene, &loaded.scene.sources, stats_image)?;
+    }
     let options = render_options(&loaded.scene.settings, &args.overrides);
     check_image_size(options.width, options.height)?;
+    let estimate = MemoryEstimate {
+        pixels: u64::from(options.width) * u64::from(options.height),
+        output: format,
+        stats_image: args
+            .stats_image
+            .as_ref()
+            .map(|path| ImageFormat::from_path(path).unwrap_or(ImageFormat::Png)),
+        objects: loaded.scene.objects.len() as u64,
+    };
+    estimate.check()?;
+    let prepared = PreparedScene::new(&loaded.scene);
 
     let threads = match args.threads {
         Some(n) => n as usize,
@@ -126,17 +255,28 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         ));
     };
 
-    write_image(&output, format, image.width, image.height, &image.pixels)
-        .map_err(Failure::Message)?;
-    if let (Some(path), Some(pixel_stats)) = (&args.stats_image, &pixel_stats) {
-        let heat_maps = StatsImage::new(image.width, image.height, pixel_stats, &options);
+    let (width, height) = (image.width, image.height);
+    write_image(
+        &output,
+        format,
+        width,
+        height,
+        Pixels::Linear(&image.pixels),
+    )
+    .map_err(Failure::Message)?;
+    // Each buffer goes as soon as it is no longer needed: at the largest sizes they are
+    // gigabytes each (see `MemoryEstimate`).
+    drop(image);
+    if let (Some(path), Some(pixel_stats)) = (&args.stats_image, pixel_stats) {
+        let heat_maps = StatsImage::new(width, height, &pixel_stats, &options);
+        drop(pixel_stats);
         let format = ImageFormat::from_path(path).unwrap_or(ImageFormat::Png);
         write_image(
             path,
             format,
             heat_maps.width,
             heat_maps.height,
-            &heat_maps.pixels,
+            Pixels::Srgb8(heat_maps.srgb),
         )
         .map_err(Failure::Message)?;
     }
@@ -161,8 +301,8 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         eprintln!(
             "wrote {} ({}x{}) in {:.2} s",
             output.display(),
-            image.width,
-            image.height,
+            width,
+            height,
             summary.wall_seconds
         );
     }
@@ -239,5 +379,69 @@ impl Summary<'_> {
             "rays_per_second": self.stats.rays_per_second(),
             "wall_seconds": self.wall_seconds,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MAX: u64 = whitted_ir::limits::MAX_PIXELS;
+
+    fn estimate(pixels: u64, output: ImageFormat, stats: Option<ImageFormat>) -> u64 {
+        MemoryEstimate {
+            pixels,
+            output,
+            stats_image: stats,
+            objects: 0,
+        }
+        .bytes()
+    }
+
+    #[test]
+    fn the_memory_estimate_counts_each_phase_by_hand() {
+        use ImageFormat::{Exr, Png};
+        // A plain PNG: 12 bytes of floats and 3 of sRGB per pixel.
+        assert_eq!(estimate(100, Png, None), 100 * 15);
+        // An EXR: the floats, their copy and the encoder's.
+        assert_eq!(estimate(100, Exr, None), 100 * 36);
+        // With heat maps as PNG: the render with its statistics is the peak (12 + 12 + 3).
+        assert_eq!(estimate(100, Png, Some(Png)), 100 * 27);
+        // Heat maps as EXR: 9 sRGB bytes and 3 panels of 24 bytes of encoding.
+        assert_eq!(estimate(100, Png, Some(Exr)), 100 * 81);
+        // Objects count on top.
+        let with_objects = MemoryEstimate {
+            pixels: 100,
+            output: Png,
+            stats_image: None,
+            objects: 1000,
+        };
+        assert_eq!(
+            with_objects.bytes(),
+            100 * 15 + 1000 * PREPARED_BYTES_PER_OBJECT
+        );
+    }
+
+    #[test]
+    fn the_largest_images_fit_unless_their_heat_maps_are_float_images() {
+        use ImageFormat::{Exr, Hdr, Png, Ppm};
+        for output in [Png, Ppm, Exr, Hdr] {
+            for stats in [None, Some(Png), Some(Ppm)] {
+                let estimate = MemoryEstimate {
+                    pixels: MAX,
+                    output,
+                    stats_image: stats,
+                    objects: whitted_ir::limits::MAX_OBJECTS as u64,
+                };
+                assert!(estimate.check().is_ok(), "{output:?} {stats:?}");
+            }
+            let estimate = MemoryEstimate {
+                pixels: MAX,
+                output,
+                stats_image: Some(Exr),
+                objects: 0,
+            };
+            assert!(estimate.check().is_err(), "{output:?} with EXR heat maps");
+        }
     }
 }

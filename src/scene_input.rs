@@ -15,7 +15,71 @@ struct FileLoader;
 
 impl SourceLoader for FileLoader {
     fn load(&mut self, path: &Path) -> std::io::Result<String> {
-        std::fs::read_to_string(path)
+        read_source(path)
+    }
+}
+
+/// Reads one scene file as text, refusing what is not a regular file (a device such as
+/// `/dev/zero` never ends, a FIFO blocks) and stopping at the source size limit rather than
+/// reading until memory runs out.
+pub fn read_source(path: &Path) -> std::io::Result<String> {
+    use std::io::{Error, ErrorKind, Read};
+    let limit = whitted_ir::limits::MAX_SOURCE_BYTES;
+    let not_regular = |kind: &str| {
+        Error::new(
+            ErrorKind::InvalidInput,
+            format!("it is {kind}, not a regular file"),
+        )
+    };
+    // Look before opening: opening a FIFO for reading blocks until a writer appears.
+    let kind = std::fs::metadata(path)?.file_type();
+    if !kind.is_file() {
+        return Err(not_regular(file_kind(kind)));
+    }
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    // The file may have been swapped for a FIFO since; never block on the open.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    let kind = file.metadata()?.file_type();
+    if !kind.is_file() {
+        return Err(not_regular(file_kind(kind)));
+    }
+    let mut bytes = Vec::new();
+    file.take(limit as u64 + 1).read_to_end(&mut bytes)?;
+    if bytes.len() > limit {
+        return Err(Error::new(
+            ErrorKind::InvalidData,
+            format!("it has more than {limit} bytes, the source size limit"),
+        ));
+    }
+    String::from_utf8(bytes)
+        .map_err(|_| Error::new(ErrorKind::InvalidData, "stream did not contain valid UTF-8"))
+}
+
+/// Names the kind of a file that is not a regular one, for error messages.
+fn file_kind(kind: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return "a FIFO";
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return "a device";
+        }
+        if kind.is_socket() {
+            return "a socket";
+        }
+    }
+    if kind.is_dir() {
+        "a directory"
+    } else {
+        "a special file"
     }
 }
 
@@ -102,13 +166,26 @@ pub fn check(args: &SceneArgs) -> Result<(), Failure> {
 /// `whitted ir`: the compiled IR as text or JSON on stdout.
 pub fn ir(args: &IrArgs) -> Result<(), Failure> {
     let loaded = load_scene(&args.scene, false)?;
-    let text = if args.json {
-        let value = whitted_ir::to_json(&loaded.scene);
-        serde_json::to_string_pretty(&value).map_err(|e| Failure::Message(e.to_string()))? + "\n"
+    if args.json {
+        write_json_stdout(&whitted_ir::json_document(&loaded.scene))
     } else {
-        whitted_ir::print(&loaded.scene)
-    };
-    write_stdout(&text)
+        write_stdout(&whitted_ir::print(&loaded.scene))
+    }
+}
+
+/// Writes `value` as pretty JSON and a newline to stdout as it is serialised, never holding
+/// the whole text (a million objects would take gigabytes); a closed pipe is success.
+pub fn write_json_stdout<T: serde::Serialize>(value: &T) -> Result<(), Failure> {
+    let mut writer = std::io::BufWriter::new(std::io::stdout().lock());
+    let written = serde_json::to_writer_pretty(&mut writer, value)
+        .map_err(std::io::Error::from)
+        .and_then(|()| writer.write_all(b"\n"))
+        .and_then(|()| writer.flush());
+    match written {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(Failure::Message(format!("cannot write to stdout: {e}"))),
+    }
 }
 
 /// Writes to stdout, treating a closed pipe (`| head`) as success rather than a crash.

@@ -9,7 +9,7 @@ use whitted_tracer::PreparedScene;
 
 use crate::cli::TraceArgs;
 use crate::render_cmd::render_options;
-use crate::scene_input::{load_scene, write_stdout};
+use crate::scene_input::{load_scene, write_json_stdout, write_stdout};
 use crate::Failure;
 
 pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
@@ -21,17 +21,15 @@ pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
         None => SampleChoice::All,
     };
     // Check the request before the BVH build, which is the slow part on big scenes.
-    check_request(&options, x, y, which).map_err(|error| Failure::Message(error.to_string()))?;
+    // A pixel or sample that does not exist is a usage error (exit 2), like a malformed one.
+    check_request(&options, x, y, which).map_err(|error| Failure::Usage(error.to_string()))?;
     let prepared = PreparedScene::new(&loaded.scene);
     let tree = trace_pixel(&prepared, &loaded.scene, &options, x, y, which)
-        .map_err(|error| Failure::Message(error.to_string()))?;
-    let text = if args.json {
-        serde_json::to_string_pretty(&tree.document())
-            .map_err(|e| Failure::Message(format!("cannot write the tree as JSON: {e}")))?
-            + "\n"
+        .map_err(|error| Failure::Usage(error.to_string()))?;
+    if args.json {
+        write_json_stdout(&tree.document())
     } else {
         let swatches = std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none();
-        format_text(&tree, TextOptions { swatches })
-    };
-    write_stdout(&text)
+        write_stdout(&format_text(&tree, TextOptions { swatches }))
+    }
 }

@@ -32,7 +32,7 @@ fn without_a_terminal_it_says_so_and_exits_2() {
 #[test]
 fn a_pixel_outside_the_image_is_an_error() {
     let output = debug(&["scenes/whitted.scene", "--pixel", "640,10"]);
-    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(output.status.code(), Some(2));
     assert!(
         stderr(&output).contains("pixel (640, 10) is outside the 640x480 image"),
         "{}",

@@ -318,3 +318,45 @@ fn editing_the_scene_reloads_it_and_errors_keep_the_last_good_image() {
         s.contains("debugger exited with 0")
     });
 }
+
+#[test]
+fn a_signal_from_outside_gives_the_terminal_back() {
+    let scene = repository().join("scenes/whitted.scene");
+    for (signal, code) in [("TERM", 143), ("HUP", 129), ("QUIT", 131), ("INT", 130)] {
+        let dir = tempfile::tempdir().expect("a temporary directory");
+        // The inner shell writes its process id, then becomes the debugger.
+        let command = format!(
+            "sh -c 'echo $$ > whitted.pid; exec \"{}\" debug \"{}\"'",
+            whitted(),
+            scene.display()
+        );
+        let tmux = Tmux::start(&format!("signal-{signal}"), dir.path(), &command, 120, 40);
+        tmux.wait_for("the finished image", |s| s.contains("rendered in"));
+        assert_eq!(tmux.pane_flag("alternate_on"), "1");
+        assert_eq!(tmux.pane_flag("mouse_any_flag"), "1", "mouse capture is on");
+        let pid = std::fs::read_to_string(dir.path().join("whitted.pid")).expect("the pid file");
+        let killed = Command::new("kill")
+            .arg(format!("-{signal}"))
+            .arg(pid.trim())
+            .status()
+            .expect("kill runs");
+        assert!(killed.success());
+        let exited = format!("debugger exited with {code}");
+        tmux.wait_for(&exited, |s| s.contains(&exited));
+        assert_eq!(
+            tmux.pane_flag("alternate_on"),
+            "0",
+            "SIG{signal}: the alternate screen was left"
+        );
+        assert_eq!(
+            tmux.pane_flag("mouse_any_flag"),
+            "0",
+            "SIG{signal}: mouse capture is off"
+        );
+        assert_eq!(
+            tmux.pane_flag("cursor_flag"),
+            "1",
+            "SIG{signal}: the cursor is shown again"
+        );
+    }
+}

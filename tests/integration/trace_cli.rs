@@ -212,7 +212,7 @@ fn bad_requests_are_one_clear_line() {
     let cases: [(&[&str], i32, &str); 5] = [
         (
             &["trace", "scenes/whitted.scene", "--pixel", "640,10"],
-            1,
+            2,
             "error: pixel (640, 10) is outside the 640x480 image (x must be 0 to 639, y 0 to 479)",
         ),
         (
@@ -226,7 +226,7 @@ fn bad_requests_are_one_clear_line() {
                 "--height",
                 "8",
             ],
-            1,
+            2,
             "error: pixel (10, 10) is outside the 8x8 image (x must be 0 to 7, y 0 to 7)",
         ),
         (
@@ -238,7 +238,7 @@ fn bad_requests_are_one_clear_line() {
                 "--sample",
                 "1",
             ],
-            1,
+            2,
             "error: there is no sample 1: the image has 1 sample per pixel (sample 0)",
         ),
         (
@@ -250,7 +250,7 @@ fn bad_requests_are_one_clear_line() {
                 "--sample",
                 "16",
             ],
-            1,
+            2,
             "error: there is no sample 16: the image has 16 samples per pixel (0 to 15)",
         ),
         (

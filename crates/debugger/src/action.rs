@@ -36,6 +36,8 @@ impl Focus {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Action {
     Quit,
+    /// Esc: cancels the trace under way, or quits when there is none.
+    Cancel,
     ToggleHelp,
     /// Moves the image cursor by pixels.
     MoveCursor {
@@ -107,7 +109,7 @@ pub const KEY_HELP: &[(&str, &str, &str)] = &[
     ("Anywhere", "r", "reload (automatic on save)"),
     ("Anywhere", "e", "write the ray tree as JSON"),
     ("Anywhere", "?", "this help"),
-    ("Anywhere", "q, Esc", "quit"),
+    ("Anywhere", "q, Esc", "quit (Esc: cancel a trace)"),
 ];
 
 /// The action for a key, given which pane has focus and whether the help is open (then any
@@ -129,7 +131,8 @@ pub fn action_for_key(key: KeyEvent, focus: Focus, help_open: bool) -> Option<Ac
         return pan_for(key.code);
     }
     let global = match key.code {
-        KeyCode::Char('q') | KeyCode::Esc => Some(Action::Quit),
+        KeyCode::Char('q') => Some(Action::Quit),
+        KeyCode::Esc => Some(Action::Cancel),
         KeyCode::Char('?') => Some(Action::ToggleHelp),
         KeyCode::Tab => Some(Action::FocusNext),
         KeyCode::BackTab => Some(Action::FocusPrevious),
@@ -278,7 +281,7 @@ mod tests {
             );
             assert_eq!(
                 action_for_key(key(KeyCode::Esc), focus, false),
-                Some(Action::Quit)
+                Some(Action::Cancel)
             );
             assert_eq!(
                 action_for_key(key(KeyCode::Char('e')), focus, false),

@@ -4,12 +4,12 @@
 //! results); drawing reads it and never changes it.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use ratatui::layout::Rect;
 use whitted_ir::{Diagnostic, SourceMap, ValidScene};
-use whitted_tracer::ray_tree::{trace_pixel, SampleChoice};
 use whitted_tracer::{PixelStats, PreparedScene, RenderOptions, RenderStats, TileResult};
 
 use crate::action::Focus;
@@ -17,6 +17,7 @@ use crate::framebuffer::Framebuffer;
 use crate::heat_map::{HeatMap, HeatMapKind};
 use crate::image_view::{ColorDepth, Viewport};
 use crate::layout::{self, Panes};
+use crate::trace_job::{TraceFailure, TraceJob, Traced};
 use crate::tree_view::TreeView;
 
 /// A scene ready to render and trace: the IR (names, spans, sources) and its prepared form.
@@ -104,6 +105,20 @@ pub enum Effect {
     StartRender,
     /// Write `contents` to `path`, then report through [`App::apply_export`].
     Export { path: PathBuf, contents: String },
+    /// Start the trace [`App::trace_job`] describes (on a worker thread).
+    Trace,
+}
+
+/// A trace under way on a worker thread.
+#[derive(Clone, Debug)]
+pub struct Tracing {
+    pub generation: u64,
+    pub pixel: (u32, u32),
+    pub cancel: Arc<AtomicBool>,
+    /// When it was asked for, so that the event loop can time it to the screen.
+    pub requested_at: Instant,
+    /// A re-trace after a reload keeps the old tree's selection and open nodes.
+    pub retrace: bool,
 }
 
 pub struct App {
@@ -136,6 +151,14 @@ pub struct App {
     pub should_quit: bool,
     /// How many pixels have been traced: the event loop sees a new pick by its change.
     pub traces: u64,
+    /// The trace under way, if any (Esc cancels it).
+    pub tracing: Option<Tracing>,
+    /// Trace requests so far: numbers them, and tells `update` that one was made.
+    pub trace_requests: u64,
+    /// When the latest finished trace was asked for (taken by the event loop).
+    pub traced_request_at: Option<Instant>,
+    /// The node budget of recorded trees: `limits::MAX_RAY_TREE_NODES`.
+    pub node_budget: usize,
 }
 
 impl App {
@@ -168,6 +191,10 @@ impl App {
             export_dir,
             should_quit: false,
             traces: 0,
+            tracing: None,
+            trace_requests: 0,
+            traced_request_at: None,
+            node_budget: whitted_ir::limits::MAX_RAY_TREE_NODES,
         }
     }
 
@@ -208,32 +235,98 @@ impl App {
         });
     }
 
-    /// Records the ray tree of the pixel under the cursor (every sample of it).
+    /// Asks for the ray tree of the pixel under the cursor (every sample of it): the event
+    /// loop runs [`App::trace_job`] on a worker and hands the answer to
+    /// [`App::apply_trace`]. A trace still under way is cancelled.
     pub fn trace_cursor(&mut self) {
-        let (x, y) = self.cursor;
-        let started = Instant::now();
-        let traced = trace_pixel(
-            &self.loaded.prepared,
-            &self.loaded.scene,
-            &self.options,
-            x,
-            y,
-            SampleChoice::All,
-        );
-        let trace_time = started.elapsed();
-        match traced {
-            Ok(tree) => {
-                let mut view = TreeView::new(tree);
+        self.request_trace(self.cursor, false);
+    }
+
+    fn request_trace(&mut self, pixel: (u32, u32), retrace: bool) {
+        self.cancel_trace();
+        self.trace_requests += 1;
+        self.tracing = Some(Tracing {
+            generation: self.trace_requests,
+            pixel,
+            cancel: Arc::new(AtomicBool::new(false)),
+            requested_at: Instant::now(),
+            retrace,
+        });
+    }
+
+    /// Cancels the trace under way; whether there was one.
+    pub fn cancel_trace(&mut self) -> bool {
+        match self.tracing.take() {
+            Some(tracing) => {
+                tracing.cancel.store(true, Ordering::Relaxed);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The work of the trace under way, for a worker thread.
+    pub fn trace_job(&self) -> Option<TraceJob> {
+        let tracing = self.tracing.as_ref()?;
+        Some(TraceJob {
+            generation: tracing.generation,
+            loaded: self.loaded.clone(),
+            options: self.options.clone(),
+            pixel: tracing.pixel,
+            cancel: Arc::clone(&tracing.cancel),
+            node_budget: self.node_budget,
+        })
+    }
+
+    /// A trace's answer: the new tree, or a message. Answers to cancelled or superseded
+    /// requests are dropped.
+    pub fn apply_trace(&mut self, traced: Traced) {
+        let Some(tracing) = self.tracing.take_if(|t| t.generation == traced.generation) else {
+            return;
+        };
+        let (x, y) = traced.pixel;
+        match traced.result {
+            Ok((tree, trace_time)) => {
+                let mut view = match self.picked.take() {
+                    Some(previous) if tracing.retrace => TreeView::new_like(tree, &previous.tree),
+                    _ => {
+                        self.inspector_scroll = 0;
+                        TreeView::new(tree)
+                    }
+                };
                 view.keep_selection_in_view(self.tree_rows());
+                if view.tree().unrecorded > 0 {
+                    self.set_message(
+                        format!(
+                            "the tree of ({x}, {y}) was cut at {} nodes: {} more rays were traced but not recorded",
+                            view.tree().node_budget,
+                            view.tree().unrecorded
+                        ),
+                        false,
+                    );
+                }
                 self.picked = Some(Picked {
                     tree: view,
                     trace_time,
                     on_screen_after: None,
                 });
-                self.inspector_scroll = 0;
                 self.traces += 1;
+                self.traced_request_at = Some(tracing.requested_at);
             }
-            Err(error) => self.set_message(error.to_string(), true),
+            Err(TraceFailure::Cancelled) => {
+                self.set_message(format!("cancelled the trace of ({x}, {y})"), false);
+            }
+            Err(TraceFailure::Refused(message)) => {
+                // A re-traced pixel that left the image (a smaller reload) has no tree now.
+                if tracing.retrace {
+                    self.picked = None;
+                }
+                self.set_message(message, true);
+            }
+            Err(TraceFailure::Crashed(message)) => self.set_message(
+                format!("the tracer crashed on ({x}, {y}) (a bug in whitted): {message}"),
+                true,
+            ),
         }
     }
 
@@ -328,43 +421,26 @@ impl App {
                 }
                 self.pixel_stats = None;
                 self.heat_map = None;
-                self.retrace_picked();
+                let retrace = self.retrace_picked();
                 let note = match warnings {
                     0 => String::new(),
                     1 => " (1 warning)".to_string(),
                     n => format!(" ({n} warnings)"),
                 };
                 self.set_message(format!("reloaded {}{note}", self.scene_name), false);
-                vec![Effect::StartRender]
+                let mut effects = vec![Effect::StartRender];
+                effects.extend(retrace);
+                effects
             }
         }
     }
 
-    /// Traces the picked pixel again in the current scene, keeping the tree's selection and
-    /// open nodes where the new tree has the same shape.
-    fn retrace_picked(&mut self) {
-        let Some(previous) = self.picked.take() else {
-            return;
-        };
-        let [x, y] = previous.tree.tree().pixel;
-        let started = Instant::now();
-        let traced = trace_pixel(
-            &self.loaded.prepared,
-            &self.loaded.scene,
-            &self.options,
-            x,
-            y,
-            SampleChoice::All,
-        );
-        if let Ok(tree) = traced {
-            let mut view = TreeView::new_like(tree, &previous.tree);
-            view.keep_selection_in_view(self.tree_rows());
-            self.picked = Some(Picked {
-                tree: view,
-                trace_time: started.elapsed(),
-                on_screen_after: None,
-            });
-        }
+    /// Asks to trace the picked pixel again in the current scene; the new tree keeps the
+    /// old one's selection and open nodes where it has the same shape.
+    fn retrace_picked(&mut self) -> Option<Effect> {
+        let [x, y] = self.picked.as_ref()?.tree.tree().pixel;
+        self.request_trace((x, y), true);
+        Some(Effect::Trace)
     }
 
     /// The result of writing an export.
@@ -394,7 +470,7 @@ impl App {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_scene::{whitted_scene, GLASS_PIXEL};
+    use crate::test_scene::{finish_trace, whitted_scene, GLASS_PIXEL};
     use whitted_ir::{Diagnostic, Severity};
     use whitted_tracer::RayKind;
 
@@ -455,6 +531,7 @@ mod tests {
         let mut app = app();
         app.cursor = GLASS_PIXEL;
         app.trace_cursor();
+        finish_trace(&mut app);
         if let Some(picked) = &mut app.picked {
             let transmitted = (0..picked.tree.len())
                 .find(|&id| {
@@ -469,9 +546,10 @@ mod tests {
         let selected = app.picked.as_ref().map(|p| p.tree.selected());
         app.reloading = true;
         let effects = app.apply_reload(Ok((LoadedScene::new(whitted_scene()), 0)));
-        assert_eq!(effects, vec![Effect::StartRender]);
+        assert_eq!(effects, vec![Effect::StartRender, Effect::Trace]);
         assert!(!app.reloading);
         assert!(app.errors.is_none());
+        finish_trace(&mut app);
         assert_eq!(app.picked.as_ref().map(|p| p.tree.selected()), selected);
         assert_eq!(
             app.message.as_ref().unwrap().text,
@@ -528,7 +606,77 @@ mod tests {
         let mut app = app();
         app.cursor = (9999, 0);
         app.trace_cursor();
+        finish_trace(&mut app);
         assert!(app.picked.is_none());
         assert!(app.message.as_ref().unwrap().is_error);
+    }
+
+    #[test]
+    fn esc_cancels_a_runaway_trace_off_the_ui_thread_and_the_debugger_goes_on() {
+        let mut app = App::new(
+            "hall.scene".into(),
+            LoadedScene::new(crate::test_scene::hall_of_mirrors()),
+            Rect::new(0, 0, 120, 40),
+            "/tmp".into(),
+        );
+        app.cursor = GLASS_PIXEL;
+        let effects = crate::update::update(&mut app, crate::action::Action::TraceCursor);
+        assert_eq!(effects, vec![Effect::Trace]);
+        let job = app.trace_job().expect("a trace to run");
+        let (sender, receiver) = std::sync::mpsc::channel();
+        job.spawn(sender).expect("a trace thread");
+        // The UI thread is free meanwhile: Esc cancels the trace instead of quitting.
+        crate::update::update(&mut app, crate::action::Action::Cancel);
+        assert!(!app.should_quit);
+        assert!(app.tracing.is_none());
+        let traced = match receiver.recv_timeout(Duration::from_secs(120)) {
+            Ok(crate::event::Event::Traced(traced)) => traced,
+            _ => panic!("the cancelled trace did not stop"),
+        };
+        assert_eq!(traced.result.as_ref().err(), Some(&TraceFailure::Cancelled));
+        app.apply_trace(traced);
+        assert!(app.picked.is_none(), "a cancelled trace leaves no tree");
+        // With no trace under way, Esc quits.
+        crate::update::update(&mut app, crate::action::Action::Cancel);
+        assert!(app.should_quit);
+    }
+
+    #[test]
+    fn a_tree_over_its_budget_is_shown_cut_with_a_message() {
+        let mut app = App::new(
+            "hall.scene".into(),
+            LoadedScene::new(whitted_scene()),
+            Rect::new(0, 0, 120, 40),
+            "/tmp".into(),
+        );
+        app.node_budget = 5;
+        app.cursor = GLASS_PIXEL;
+        app.trace_cursor();
+        finish_trace(&mut app);
+        let picked = app.picked.as_ref().expect("a tree");
+        assert!(picked.tree.tree().unrecorded > 0);
+        let message = app.message.as_ref().expect("a message");
+        assert!(message.text.contains("was cut at 5 nodes"), "{message:?}");
+    }
+
+    #[test]
+    fn an_answer_to_a_superseded_trace_is_dropped() {
+        let mut app = app();
+        app.cursor = GLASS_PIXEL;
+        app.trace_cursor();
+        let old = app.trace_job().expect("a job");
+        app.cursor = (10, 10);
+        app.trace_cursor();
+        assert!(
+            old.cancel.load(Ordering::Relaxed),
+            "the old trace is cancelled"
+        );
+        app.apply_trace(old.run());
+        assert!(app.picked.is_none());
+        finish_trace(&mut app);
+        assert_eq!(
+            app.picked.as_ref().map(|p| p.tree.tree().pixel),
+            Some([10, 10])
+        );
     }
 }

@@ -30,10 +30,15 @@ pub enum Event {
         message: String,
     },
     Reloaded(Reloaded),
+    /// A pixel's ray tree, recorded off the UI thread (or why not).
+    Traced(crate::trace_job::Traced),
     /// A watched scene file changed on disk.
     FileChanged,
     /// The loop's timer: nothing arrived before the next deadline.
     Tick,
+    /// The process received this signal (SIGTERM, SIGHUP, SIGQUIT or SIGINT): give the
+    /// terminal back and stop.
+    Signal(i32),
 }
 
 /// The reload worker's answer: the new scene and its warning count, or its errors; and the

@@ -91,6 +91,7 @@ mod tests {
         );
         app.cursor = GLASS_PIXEL;
         app.trace_cursor();
+        crate::test_scene::finish_trace(&mut app);
         app
     }
 
@@ -134,6 +135,7 @@ mod tests {
             for x in (150..330).step_by(8) {
                 app.cursor = (x, y);
                 app.trace_cursor();
+                crate::test_scene::finish_trace(&mut app);
                 let tree = &mut app.picked.as_mut().unwrap().tree;
                 let root = tree.node(0).unwrap();
                 let on_mirror = root

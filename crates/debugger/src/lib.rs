@@ -21,6 +21,7 @@ mod render_job;
 mod run;
 mod session;
 mod terminal;
+pub mod trace_job;
 pub mod tree_view;
 pub mod ui;
 pub mod update;

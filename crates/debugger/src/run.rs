@@ -30,6 +30,8 @@ pub enum DebugError {
     NotATerminal,
     /// The terminal could not be set up, drawn to or read.
     Terminal(io::Error),
+    /// A signal stopped the debugger (the terminal was restored); its number.
+    Signal(i32),
 }
 
 impl fmt::Display for DebugError {
@@ -42,6 +44,7 @@ impl fmt::Display for DebugError {
                 )
             }
             DebugError::Terminal(error) => write!(f, "terminal error: {error}"),
+            DebugError::Signal(signal) => write!(f, "stopped by signal {signal}"),
         }
     }
 }
@@ -79,6 +82,7 @@ pub fn run(session: Session) -> Result<(), DebugError> {
     app.color_depth = ColorDepth::from_colorterm(std::env::var("COLORTERM").ok().as_deref());
 
     let (events, inbox) = mpsc::channel();
+    terminal::forward_signals(events.clone())?;
     spawn_input_thread(events.clone())?;
     let reloader = Reloader::start(session.recompile, events.clone())?;
     let mut watch = match FileWatch::start(events.clone()) {
@@ -104,6 +108,7 @@ pub fn run(session: Session) -> Result<(), DebugError> {
     if let Some((x, y)) = session.pixel {
         app.cursor = (x, y);
         app.trace_cursor();
+        runner.carry_out(&mut app, vec![Effect::Trace]);
     }
     event_loop(&mut guard, &mut app, &mut runner, &inbox, &mut watch)
 }
@@ -137,6 +142,14 @@ impl Runner {
                         Err(error) => {
                             app.apply_render_done(self.generation, None);
                             app.set_message(format!("cannot start rendering: {error}"), true);
+                        }
+                    }
+                }
+                Effect::Trace => {
+                    if let Some(job) = app.trace_job() {
+                        if let Err(error) = job.spawn(self.events.clone()) {
+                            app.cancel_trace();
+                            app.set_message(format!("cannot start tracing: {error}"), true);
                         }
                     }
                 }
@@ -189,6 +202,8 @@ fn event_loop(
                 Event::InputFailed(message) => {
                     return Err(DebugError::Terminal(io::Error::other(message)));
                 }
+                // Returning drops the terminal guard, which restores the terminal.
+                Event::Signal(signal) => return Err(DebugError::Signal(signal)),
                 Event::FileChanged => reload_at = Some(Instant::now() + RELOAD_DEBOUNCE),
                 Event::Tick => {}
                 Event::Reloaded(reloaded) => {
@@ -213,7 +228,8 @@ fn event_loop(
             }
         }
         if app.traces != traces_before {
-            picked_at = Some(started);
+            // Timed from the key or click that asked for the tree, not from its arrival.
+            picked_at = Some(app.traced_request_at.take().unwrap_or(started));
         }
         if let Some(at) = reload_at {
             if Instant::now() >= at {
@@ -253,6 +269,10 @@ fn handle(app: &mut App, event: Event) -> Vec<Effect> {
             app.apply_tile(generation, &tile);
             Vec::new()
         }
+        Event::Traced(traced) => {
+            app.apply_trace(traced);
+            Vec::new()
+        }
         Event::RenderDone { generation, result } => {
             app.apply_render_done(generation, result);
             Vec::new()
@@ -268,7 +288,11 @@ fn handle(app: &mut App, event: Event) -> Vec<Effect> {
             );
             Vec::new()
         }
-        Event::InputFailed(_) | Event::FileChanged | Event::Tick | Event::Reloaded(_) => Vec::new(),
+        Event::InputFailed(_)
+        | Event::FileChanged
+        | Event::Tick
+        | Event::Reloaded(_)
+        | Event::Signal(_) => Vec::new(),
     }
 }
 

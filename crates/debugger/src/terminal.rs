@@ -5,11 +5,18 @@
 //! A panic on a worker thread must not restore the terminal under a UI that keeps running,
 //! nor print into the alternate screen where nobody would read it: the hook keeps its
 //! message for the worker to report instead (see [`take_worker_panic`]).
+//!
+//! SIGTERM, SIGHUP, SIGQUIT and SIGINT (from outside: in raw mode Ctrl-C is a key) would end
+//! the process with the terminal raw, on the alternate screen, with mouse capture on:
+//! [`forward_signals`] turns them into events so that the UI thread restores the terminal
+//! and stops.
 
 use std::io::{self, IsTerminal, Stdout};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::Sender;
 use std::sync::{Mutex, Once, OnceLock};
 use std::thread::{self, ThreadId};
+use std::time::Duration;
 
 use ratatui::backend::CrosstermBackend;
 use ratatui::crossterm::event::{DisableMouseCapture, EnableMouseCapture};
@@ -18,6 +25,14 @@ use ratatui::crossterm::terminal::{
     disable_raw_mode, enable_raw_mode, EnterAlternateScreen, LeaveAlternateScreen,
 };
 use ratatui::Terminal;
+use signal_hook::consts::{SIGHUP, SIGINT, SIGQUIT, SIGTERM};
+use signal_hook::iterator::Signals;
+
+use crate::event::Event;
+
+/// How long the UI thread has to give the terminal back after a signal before the signal
+/// thread does it itself (the UI thread may be busy) and lets the signal take its course.
+const SIGNAL_GRACE: Duration = Duration::from_secs(2);
 
 pub type Tui = Terminal<CrosstermBackend<Stdout>>;
 
@@ -91,12 +106,7 @@ fn install_panic_hook() {
                 let _ = restore();
                 previous(info);
             } else {
-                let payload = info
-                    .payload()
-                    .downcast_ref::<&str>()
-                    .map(|s| s.to_string())
-                    .or_else(|| info.payload().downcast_ref::<String>().cloned())
-                    .unwrap_or_else(|| "unknown panic".to_string());
+                let payload = panic_text(info.payload());
                 let location = info
                     .location()
                     .map(|l| format!(" at {}:{}", l.file(), l.line()))
@@ -109,7 +119,35 @@ fn install_panic_hook() {
     });
 }
 
+/// A panic's message, from its payload.
+pub fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".to_string())
+}
+
 /// The message of the latest panic on a worker thread, if any (taken: asked once).
 pub fn take_worker_panic() -> Option<String> {
     WORKER_PANIC.lock().ok().and_then(|mut slot| slot.take())
+}
+
+/// Sends SIGTERM, SIGHUP, SIGQUIT and SIGINT to the event loop as [`Event::Signal`]. Should
+/// the loop not stop within [`SIGNAL_GRACE`], this thread restores the terminal and ends the
+/// process as the signal would have.
+pub fn forward_signals(events: Sender<Event>) -> io::Result<()> {
+    let mut signals = Signals::new([SIGTERM, SIGHUP, SIGQUIT, SIGINT])?;
+    thread::Builder::new()
+        .name("signals".into())
+        .spawn(move || {
+            if let Some(signal) = signals.forever().next() {
+                let _ = events.send(Event::Signal(signal));
+                thread::sleep(SIGNAL_GRACE);
+                let _ = restore();
+                signals.handle().close();
+                let _ = signal_hook::low_level::emulate_default_handler(signal);
+            }
+        })?;
+    Ok(())
 }

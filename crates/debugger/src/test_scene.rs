@@ -217,3 +217,53 @@ pub fn glass_pixel_tree() -> RayTree {
     )
     .expect("the pixel is inside the image")
 }
+
+/// Runs the trace the app asked for on this thread and hands it the answer, as the event
+/// loop does with a worker thread.
+pub fn finish_trace(app: &mut crate::app::App) {
+    if let Some(job) = app.trace_job() {
+        let traced = job.run();
+        app.apply_trace(traced);
+    }
+}
+
+/// Whitted's scene inside a box of mirrors with the deepest recursion and no minimum weight:
+/// every path bounces for ever and splits at the glass, so one pixel's trace runs away (the
+/// tree is cut at its budget, but the rays go on being traced until cancelled).
+pub fn hall_of_mirrors() -> ValidScene {
+    let mut scene = whitted_scene().into_inner();
+    scene.settings.max_depth = whitted_ir::limits::MAX_DEPTH;
+    scene.settings.min_weight = 0.0;
+    let span = scene.camera_span;
+    let mirror = scene.materials.append(
+        Material {
+            name: Some("wall mirror".into()),
+            reflective: gray(0.95),
+            diffuse: gray(0.05),
+            ..Material::default()
+        },
+        span,
+    );
+    let walls = [
+        (DVec3::NEG_Y, -4.0),
+        (DVec3::X, -4.0),
+        (DVec3::NEG_X, -4.0),
+        (DVec3::Z, -8.0),
+        (DVec3::NEG_Z, -8.0),
+    ];
+    for (normal, offset) in walls {
+        let handle = scene.objects.append(
+            Object {
+                name: None,
+                kind: ObjectKind::Shape {
+                    shape: Shape::Plane { normal, offset },
+                },
+                world_from_object: DMat4::IDENTITY,
+                material: mirror,
+            },
+            span,
+        );
+        scene.roots.push(handle);
+    }
+    validate(scene).expect("the hall of mirrors is valid")
+}

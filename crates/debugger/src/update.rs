@@ -14,8 +14,25 @@ pub fn update(app: &mut App, action: Action) -> Vec<Effect> {
     // A message answers the previous action; the next one replaces or clears it. Scene
     // errors stay in their own pane until a reload succeeds.
     app.message = None;
+    let requests = app.trace_requests;
+    let mut effects = apply(app, action);
+    if app.trace_requests != requests {
+        effects.push(Effect::Trace);
+    }
+    effects
+}
+
+fn apply(app: &mut App, action: Action) -> Vec<Effect> {
     match action {
         Action::Quit => app.should_quit = true,
+        // Esc stops a runaway trace first; with none under way it quits.
+        Action::Cancel => {
+            if app.cancel_trace() {
+                app.set_message("cancelled the trace", false);
+            } else {
+                app.should_quit = true;
+            }
+        }
         Action::ToggleHelp => app.help_open = !app.help_open,
         Action::MoveCursor { dx, dy } => move_cursor(app, dx, dy),
         Action::TraceCursor => app.trace_cursor(),
@@ -250,7 +267,8 @@ mod tests {
     fn picked_app() -> App {
         let mut app = app();
         app.cursor = GLASS_PIXEL;
-        update(&mut app, Action::TraceCursor);
+        assert_eq!(update(&mut app, Action::TraceCursor), vec![Effect::Trace]);
+        crate::test_scene::finish_trace(&mut app);
         app
     }
 
@@ -293,6 +311,7 @@ mod tests {
                 row: image.y + image.height / 2,
             },
         );
+        crate::test_scene::finish_trace(&mut app);
         assert_eq!(app.focus, Focus::Image);
         let picked = app.picked.as_ref().expect("a tree");
         assert_eq!(picked.tree.tree().pixel, [app.cursor.0, app.cursor.1]);

@@ -14,7 +14,7 @@ mod validate;
 
 pub use arena::{Arena, Handle};
 pub use diagnostic::{Diagnostic, Label, Severity};
-pub use json::to_json;
+pub use json::{document as json_document, to_json, IrDocument};
 pub use print::print;
 pub use scene::{
     Attenuation, Camera, Color, CsgOp, Fresnel, Light, LightKind, Material, Object, ObjectKind,

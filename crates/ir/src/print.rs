@@ -1,5 +1,6 @@
 //! A readable text dump of the IR (`whitted ir`): one line per node, children indented,
-//! each with the source location that made it.
+//! each with the source location that made it. Names are printed quoted and escaped
+//! (`{:?}`), so that a control character in a name cannot reach the user's terminal raw.
 
 use std::fmt::Write;
 
@@ -45,7 +46,7 @@ pub fn print(scene: &Scene) -> String {
         let name = light
             .name
             .as_deref()
-            .map(|n| format!(" \"{n}\""))
+            .map(|n| format!(" {n:?}"))
             .unwrap_or_default();
         let kind = match &light.kind {
             LightKind::Point {
@@ -114,7 +115,7 @@ pub fn print(scene: &Scene) -> String {
 fn material_name(m: &Material) -> String {
     m.name
         .as_deref()
-        .map(|n| format!(" \"{n}\""))
+        .map(|n| format!(" {n:?}"))
         .unwrap_or_default()
 }
 
@@ -132,7 +133,7 @@ fn print_object(scene: &Scene, handle: Handle<Object>, depth: usize, out: &mut S
     let name = object
         .name
         .as_deref()
-        .map(|n| format!(" \"{n}\""))
+        .map(|n| format!(" {n:?}"))
         .unwrap_or_default();
     let what = match &object.kind {
         ObjectKind::Shape { shape } => shape_text(shape),

@@ -255,6 +255,13 @@ pub trait Recorder {
     /// blocked a shadow ray; the colours it computes are the same either way.
     const RECORDS: bool = true;
 
+    /// Whether the trace should stop early (a cancelled trace in the debugger): secondary
+    /// rays are then no longer started, so the colours are no longer the render's.
+    #[inline(always)]
+    fn should_stop(&self) -> bool {
+        false
+    }
+
     #[inline(always)]
     fn ray_started(&mut self, _ray: &RayStart) {}
     #[inline(always)]

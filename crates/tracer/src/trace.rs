@@ -353,6 +353,9 @@ impl<'a> Tracer<'a> {
         outcome: &mut Outcome,
         rec: &mut R,
     ) -> Option<Vec3A> {
+        if rec.should_stop() {
+            return None;
+        }
         let coefficient = match child.kind {
             RayKind::Transmitted => split.transmit,
             _ => split.reflect,

@@ -47,6 +47,7 @@ fn rendered_app(width: u16, height: u16) -> App {
 fn pick_glass_pixel(app: &mut App) {
     app.cursor = GLASS_PIXEL;
     update(app, Action::TraceCursor);
+    crate::test_scene::finish_trace(app);
     if let Some(picked) = &mut app.picked {
         picked.trace_time = Duration::from_micros(60);
     }

@@ -65,7 +65,16 @@ pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
         rank: 1,
         spans: cursor,
     });
-    if let Some(picked) = &app.picked {
+    if let Some(tracing) = &app.tracing {
+        let (x, y) = tracing.pixel;
+        parts.push(Part {
+            rank: 0,
+            spans: vec![Span::styled(
+                format!("tracing ({x}, {y}), Esc cancels"),
+                Style::new().fg(Color::Yellow),
+            )],
+        });
+    } else if let Some(picked) = &app.picked {
         parts.push(Part {
             rank: 3,
             spans: vec![Span::raw(match picked.on_screen_after {

@@ -17,6 +17,8 @@ pub struct RayTreeDocument<'a> {
     pub samples_per_pixel: u32,
     pub max_depth: u32,
     pub min_weight: f32,
+    pub node_budget: usize,
+    pub unrecorded: u64,
     /// The index of the sample `root` belongs to.
     pub root_sample: Option<u32>,
     pub root: Option<&'a RayNode>,
@@ -35,6 +37,8 @@ impl RayTree {
             samples_per_pixel: self.samples_per_pixel,
             max_depth: self.max_depth,
             min_weight: self.min_weight,
+            node_budget: self.node_budget,
+            unrecorded: self.unrecorded,
             root_sample: first.map(|s| s.index),
             root: first.map(|s| &s.root),
             samples: &self.samples,

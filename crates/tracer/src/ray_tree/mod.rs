@@ -18,6 +18,6 @@ pub use model::{
     ObjectRef, RayNode, RayTree, SampleChoice, SampleTree, ShadowInfo, ShadowOutcome, SkippedInfo,
     Visibility, RAY_TREE_JSON_VERSION,
 };
-pub use pixel::{check_request, trace_pixel, TraceError};
+pub use pixel::{check_request, trace_pixel, trace_pixel_request, TraceError, TraceRequest};
 pub use text::{format_text, TextOptions};
 pub use tree_recorder::TreeRecorder;

@@ -26,6 +26,11 @@ pub struct RayTree {
     /// The limits the tree was traced with.
     pub max_depth: u32,
     pub min_weight: f32,
+    /// The most nodes the tree may hold (`ray tree nodes` in docs/language.md).
+    pub node_budget: usize,
+    /// Rays traced but not recorded because the tree reached `node_budget` (the sum of every
+    /// node's `unrecorded`); 0 when the tree is complete.
+    pub unrecorded: u64,
     /// Every sample recorded: all of the pixel's samples, or just the one asked for.
     pub samples: Vec<SampleTree>,
 }
@@ -74,6 +79,9 @@ pub struct RayNode {
     /// Why recursion stopped here. Shadow rays never recurse: `miss` when they reach the
     /// light (clear or filtered), `absorbed` when a blocker stops them.
     pub termination: Termination,
+    /// Rays traced below this one (children and their subtrees) that are not in
+    /// `children`: the tree reached its node budget here. 0 in a tree that was not cut.
+    pub unrecorded: u64,
     /// Reflected or transmitted rays the material asked for but that were not traced.
     pub skipped: Vec<SkippedInfo>,
     /// Shadow rays first (in light order), then the reflected ray, then the transmitted one.

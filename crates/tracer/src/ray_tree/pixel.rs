@@ -2,6 +2,7 @@
 //! the pixel's colour averaged exactly as `render` averages it.
 
 use std::fmt;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use whitted_ir::Scene;
 
@@ -24,11 +25,14 @@ pub enum TraceError {
         sample: u32,
         samples_per_pixel: u32,
     },
+    /// The caller cancelled the trace before it finished.
+    Cancelled,
 }
 
 impl fmt::Display for TraceError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
+            TraceError::Cancelled => write!(f, "the trace was cancelled"),
             TraceError::PixelOutOfRange {
                 x,
                 y,
@@ -96,6 +100,7 @@ pub fn check_request(
 /// exactly as `render` computes it, bit for bit.
 ///
 /// `scene` must be the scene `prepared` was made from: it supplies names and locations.
+/// The tree holds at most [`whitted_ir::limits::MAX_RAY_TREE_NODES`] nodes.
 pub fn trace_pixel(
     prepared: &PreparedScene,
     scene: &Scene,
@@ -104,9 +109,46 @@ pub fn trace_pixel(
     y: u32,
     which: SampleChoice,
 ) -> Result<RayTree, TraceError> {
+    let request = TraceRequest {
+        x,
+        y,
+        which,
+        node_budget: whitted_ir::limits::MAX_RAY_TREE_NODES,
+        cancel: None,
+    };
+    trace_pixel_request(prepared, scene, options, &request)
+}
+
+/// One pixel to trace, with the tree's node budget and an optional cancel flag.
+#[derive(Clone, Copy, Debug)]
+pub struct TraceRequest<'c> {
+    pub x: u32,
+    pub y: u32,
+    pub which: SampleChoice,
+    /// The most nodes to record; past it the tree is cut (see `RayNode::unrecorded`).
+    pub node_budget: usize,
+    /// When set (from another thread) the trace stops soon and returns `Cancelled`.
+    pub cancel: Option<&'c AtomicBool>,
+}
+
+/// [`trace_pixel`] with a chosen node budget and a way to cancel.
+pub fn trace_pixel_request(
+    prepared: &PreparedScene,
+    scene: &Scene,
+    options: &RenderOptions,
+    request: &TraceRequest<'_>,
+) -> Result<RayTree, TraceError> {
+    let TraceRequest {
+        x,
+        y,
+        which,
+        node_budget,
+        cancel,
+    } = *request;
     check_request(options, x, y, which)?;
+    let cancelled = || cancel.is_some_and(|c| c.load(Ordering::Relaxed));
     let samples_per_pixel = options.samples();
-    let mut recorder = TreeRecorder::new(scene);
+    let mut recorder = TreeRecorder::with_budget(scene, node_budget, cancel);
     let mut accumulator = PixelAccumulator::new();
     let mut samples = Vec::new();
     for index in 0..samples_per_pixel {
@@ -125,6 +167,9 @@ pub fn trace_pixel(
             trace_pixel_with(prepared, options, x, y, index, &mut NoRecord)
         };
         accumulator.add(color);
+        if cancelled() {
+            return Err(TraceError::Cancelled);
+        }
     }
     Ok(RayTree {
         pixel: [x, y],
@@ -133,6 +178,8 @@ pub fn trace_pixel(
         samples_per_pixel,
         max_depth: options.depth_limit(),
         min_weight: options.min_weight,
+        node_budget,
+        unrecorded: recorder.unrecorded(),
         samples,
     })
 }

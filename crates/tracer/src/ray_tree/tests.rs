@@ -45,19 +45,113 @@ fn check_node(node: &RayNode) {
         }
         check_node(child);
     }
+    // A tree cut at its node budget (`unrecorded > 0`) may lack shadow rays and secondary
+    // rays that were traced.
+    let cut = node.unrecorded > 0;
     if let Some(local) = &node.local {
         for light in &local.lights {
             match light.shadow_child {
                 Some(i) => assert_eq!(node.children[i].kind, RayKind::Shadow),
-                None => assert_eq!(light.visibility, Visibility::NotFacing),
+                None => assert!(cut || light.visibility == Visibility::NotFacing),
             }
         }
     }
     let traced = node.children.iter().any(|c| c.kind != RayKind::Shadow);
+    if !cut {
+        assert_eq!(
+            traced,
+            node.termination == Termination::NotEnded,
+            "{node:?}"
+        );
+    } else if traced {
+        assert_eq!(node.termination, Termination::NotEnded, "{node:?}");
+    }
+}
+
+/// The sum of `unrecorded` over a subtree.
+fn unrecorded_below(node: &RayNode) -> u64 {
+    node.unrecorded + node.children.iter().map(unrecorded_below).sum::<u64>()
+}
+
+#[test]
+fn a_tree_over_its_node_budget_is_cut_says_where_and_keeps_the_pixel_colour() {
+    let (valid, prepared) = prepared(whitted_classic());
+    let mut options = options(16, 12, 2, 12);
+    // No minimum weight: the glass sphere's rays split at every level.
+    options.min_weight = 0.0;
+    let request = |x, y, node_budget| TraceRequest {
+        x,
+        y,
+        which: SampleChoice::All,
+        node_budget,
+        cancel: None,
+    };
+    let nodes = |tree: &RayTree| {
+        tree.samples
+            .iter()
+            .map(|s| s.root.ray_count())
+            .sum::<usize>()
+    };
+    // The busiest pixel, by its complete tree.
+    let (x, y, full) = (0..12)
+        .flat_map(|y| (0..16).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let tree = trace_pixel_request(&prepared, &valid, &options, &request(x, y, usize::MAX))
+                .expect("a valid pixel");
+            (x, y, tree)
+        })
+        .max_by_key(|(_, _, tree)| nodes(tree))
+        .expect("pixels");
+    let all = nodes(&full);
+    assert!(all > 60, "the busiest pixel has only {all} rays");
+    assert_eq!(full.unrecorded, 0);
+    for budget in [1, 2, 7, 50, all - 1, all] {
+        let cut = trace_pixel_request(&prepared, &valid, &options, &request(x, y, budget))
+            .expect("a valid pixel");
+        let kept = nodes(&cut);
+        // Camera rays, the samples' roots (2 here), are always kept.
+        assert!(kept <= budget + 2, "budget {budget}: {kept} nodes kept");
+        // Every traced ray is either kept or counted where it was left out.
+        assert_eq!(kept as u64 + cut.unrecorded, all as u64, "budget {budget}");
+        let counted: u64 = cut.samples.iter().map(|s| unrecorded_below(&s.root)).sum();
+        assert_eq!(counted, cut.unrecorded, "budget {budget}");
+        assert_eq!(cut.node_budget, budget);
+        // Tracing went on past the budget: the colours are the complete tree's.
+        assert_eq!(bits(cut.color), bits(full.color), "budget {budget}");
+        for (a, b) in cut.samples.iter().zip(&full.samples) {
+            assert_eq!(bits(a.root.color), bits(b.root.color), "budget {budget}");
+        }
+        for sample in &cut.samples {
+            check_node(&sample.root);
+        }
+        let text = format_text(&cut, TextOptions::default());
+        if budget < all {
+            assert!(
+                text.contains(&format!("cut at the ray-tree budget of {budget} nodes")),
+                "{text}"
+            );
+            assert!(text.contains("not recorded"), "{text}");
+        } else {
+            assert!(!text.contains("not recorded"), "{text}");
+        }
+    }
+}
+
+#[test]
+fn a_cancelled_trace_stops_and_says_so() {
+    let (valid, prepared) = prepared(whitted_classic());
+    let options = options(16, 12, 1, 5);
+    let cancel = std::sync::atomic::AtomicBool::new(true);
+    let request = TraceRequest {
+        x: 8,
+        y: 6,
+        which: SampleChoice::All,
+        node_budget: 100,
+        cancel: Some(&cancel),
+    };
     assert_eq!(
-        traced,
-        node.termination == Termination::NotEnded,
-        "{node:?}"
+        trace_pixel_request(&prepared, &valid, &options, &request),
+        Err(TraceError::Cancelled)
     );
 }
 

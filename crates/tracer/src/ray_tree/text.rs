@@ -35,6 +35,15 @@ pub fn format_text(tree: &RayTree, options: TextOptions) -> String {
         tree.max_depth,
         num(tree.min_weight)
     );
+    if tree.unrecorded > 0 {
+        let _ = writeln!(
+            out,
+            "cut at the ray-tree budget of {} nodes: {} not recorded (traced, and in the \
+             colours); look for `not recorded` below",
+            tree.node_budget,
+            plural_u64(tree.unrecorded, "more ray"),
+        );
+    }
     for sample in &tree.samples {
         out.push('\n');
         let _ = writeln!(
@@ -82,12 +91,12 @@ impl Printer {
         if let Some(shadow) = &node.shadow {
             return format!(
                 "{kind} to {}: {}",
-                shadow.light.label,
+                printable(&shadow.light.label),
                 self.shadow_outcome(shadow)
             );
         }
         let target = match &node.hit {
-            Some(hit) => format!("hit {} at t {}", hit.object.label, num(hit.t)),
+            Some(hit) => format!("hit {} at t {}", printable(&hit.object.label), num(hit.t)),
             None => "miss".to_string(),
         };
         format!(
@@ -130,6 +139,12 @@ impl Printer {
             }
             lines.push(format!("local      {}", self.color(local.total)));
         }
+        if node.unrecorded > 0 {
+            lines.push(format!(
+                "not recorded {} below this ray (the tree's node budget was reached)",
+                plural_u64(node.unrecorded, "ray")
+            ));
+        }
         for skipped in &node.skipped {
             // A transmission lost to total internal reflection has no weight of its own: it
             // went to the reflected ray.
@@ -162,7 +177,7 @@ impl Printer {
             format!("object     {}", object_text(&hit.object)),
         ];
         if hit.leaf.handle != hit.object.handle {
-            let path: Vec<&str> = hit.csg_path.iter().map(|o| o.label.as_str()).collect();
+            let path: Vec<String> = hit.csg_path.iter().map(|o| printable(&o.label)).collect();
             lines.push(format!(
                 "leaf       {} via {}",
                 object_text(&hit.leaf),
@@ -171,18 +186,18 @@ impl Printer {
         }
         let material = &hit.material;
         if hit.resolved_material.handle == material.handle {
-            lines.push(format!(
+            lines.push(printable(&format!(
                 "material   {} ({})",
                 material.label, material.location
-            ));
+            )));
         } else {
-            lines.push(format!(
+            lines.push(printable(&format!(
                 "material   {} ({}), here {} ({})",
                 material.label,
                 material.location,
                 hit.resolved_material.label,
                 hit.resolved_material.location
-            ));
+            )));
         }
         if hit.absorption != [1.0; 3] {
             lines.push(format!("absorption {}", self.color(hit.absorption)));
@@ -214,7 +229,7 @@ impl Printer {
             (ShadowOutcome::Blocked, Some(blocker)) => {
                 format!(
                     "blocked by {} at t {}",
-                    blocker.object.label,
+                    printable(&blocker.object.label),
                     num(blocker.t)
                 )
             }
@@ -245,8 +260,15 @@ impl Printer {
 
 fn shadow_details(shadow: &ShadowInfo) -> Vec<String> {
     let mut lines = vec![match shadow.max_t {
-        Some(t) => format!("light      {} at distance {}", shadow.light.label, num(t)),
-        None => format!("light      {} (directional)", shadow.light.label),
+        Some(t) => format!(
+            "light      {} at distance {}",
+            printable(&shadow.light.label),
+            num(t)
+        ),
+        None => format!(
+            "light      {} (directional)",
+            printable(&shadow.light.label)
+        ),
     }];
     if let Some(blocker) = &shadow.blocker {
         lines.push(format!("blocker    {}", object_text(&blocker.object)));
@@ -277,21 +299,35 @@ fn interface_text(interface: &InterfaceInfo) -> String {
 }
 
 fn object_text(object: &ObjectRef) -> String {
-    match &object.name {
+    printable(&match &object.name {
         Some(name) => format!(
             "{name} ({} #{}, {})",
             object.kind, object.handle, object.location
         ),
         None => format!("{} ({})", object.label, object.location),
-    }
+    })
 }
 
 /// `light sun`, or `light #0` for an unnamed light.
 fn light_text(light: &LightRef) -> String {
-    match &light.name {
+    printable(&match &light.name {
         Some(name) => format!("light {name}"),
         None => light.label.clone(),
+    })
+}
+
+/// Names (and file names) come from the scene: their control characters are escaped
+/// (`\u{1b}`) so that an ESC in a name cannot send commands to the user's terminal.
+fn printable(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
     }
+    out
 }
 
 fn visibility_text(visibility: Visibility) -> &'static str {
@@ -315,6 +351,10 @@ fn termination_text(termination: Termination) -> &'static str {
 }
 
 fn plural(n: u32, noun: &str) -> String {
+    plural_u64(u64::from(n), noun)
+}
+
+fn plural_u64(n: u64, noun: &str) -> String {
     if n == 1 {
         format!("1 {noun}")
     } else {

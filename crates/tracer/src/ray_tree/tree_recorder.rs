@@ -3,6 +3,13 @@
 //!
 //! Rays nest: a stack holds the rays started but not yet finished; a finished ray becomes
 //! the last child of the ray below it, or the tree's root when the stack is empty.
+//!
+//! A tree holds at most `budget` nodes plus one camera ray per sample (a hall of mirrors with
+//! no minimum weight has millions of rays). Past the budget the tracer goes on, so every colour stays exact, but
+//! new rays are only counted: each recorded ray says in `unrecorded` how many rays below it
+//! were traced and not kept, which is where the tree was cut.
+
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::Vec3A;
 use whitted_ir::Scene;
@@ -26,16 +33,59 @@ pub struct TreeRecorder<'s> {
     /// `LocalIllumination::total` is bit-identical to what the tracer added).
     local_sums: Vec<Vec3A>,
     root: Option<RayNode>,
+    /// The most nodes to keep, and how many were kept so far (over every camera ray).
+    budget: usize,
+    recorded: usize,
+    /// Rays started and not yet finished that are not recorded (past the budget).
+    dropped_open: usize,
+    /// Rays traced but not recorded, over every camera ray.
+    unrecorded: u64,
+    /// Set by another thread to stop the trace early (see [`Recorder::should_stop`]).
+    cancel: Option<&'s AtomicBool>,
 }
 
 impl<'s> TreeRecorder<'s> {
+    /// A recorder with the default budget, [`whitted_ir::limits::MAX_RAY_TREE_NODES`].
     pub fn new(scene: &'s Scene) -> TreeRecorder<'s> {
+        TreeRecorder::with_budget(scene, whitted_ir::limits::MAX_RAY_TREE_NODES, None)
+    }
+
+    /// A recorder that keeps at most `budget` nodes and stops the trace when `cancel` is set.
+    pub fn with_budget(
+        scene: &'s Scene,
+        budget: usize,
+        cancel: Option<&'s AtomicBool>,
+    ) -> TreeRecorder<'s> {
         TreeRecorder {
             scene,
             open: Vec::new(),
             local_sums: Vec::new(),
             root: None,
+            budget,
+            recorded: 0,
+            dropped_open: 0,
+            unrecorded: 0,
+            cancel,
         }
+    }
+
+    /// Rays traced but not recorded because the budget was reached, over every camera ray.
+    pub fn unrecorded(&self) -> u64 {
+        self.unrecorded
+    }
+
+    /// Whether the budget has room for one more node; if not, counts the ray as unrecorded
+    /// on the nearest recorded ray.
+    fn admit(&mut self) -> bool {
+        if self.dropped_open == 0 && self.recorded < self.budget {
+            self.recorded += 1;
+            return true;
+        }
+        self.unrecorded += 1;
+        if let Some(node) = self.open.last_mut() {
+            node.unrecorded += 1;
+        }
+        false
     }
 
     /// The finished camera ray's tree, once the tracer has returned; the recorder is then
@@ -47,6 +97,14 @@ impl<'s> TreeRecorder<'s> {
 
 impl Recorder for TreeRecorder<'_> {
     fn ray_started(&mut self, ray: &RayStart) {
+        // Camera rays are the samples' roots and always kept, so that every sample says
+        // where its tree was cut.
+        if ray.kind == RayKind::Camera {
+            self.recorded += 1;
+        } else if !self.admit() {
+            self.dropped_open += 1;
+            return;
+        }
         self.open.push(RayNode {
             kind: ray.kind,
             depth: ray.depth,
@@ -62,11 +120,19 @@ impl Recorder for TreeRecorder<'_> {
             termination: Termination::NotEnded,
             skipped: Vec::new(),
             children: Vec::new(),
+            unrecorded: 0,
         });
         self.local_sums.push(Vec3A::ZERO);
     }
 
+    fn should_stop(&self) -> bool {
+        self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+
     fn surface_hit(&mut self, hit: &SurfaceHit) {
+        if self.dropped_open > 0 {
+            return;
+        }
         let scene = self.scene;
         let Some(node) = self.open.last_mut() else {
             return;
@@ -87,6 +153,9 @@ impl Recorder for TreeRecorder<'_> {
     }
 
     fn ambient(&mut self, ambient: Vec3A) {
+        if self.dropped_open > 0 {
+            return;
+        }
         let (Some(node), Some(sum)) = (self.open.last_mut(), self.local_sums.last_mut()) else {
             return;
         };
@@ -99,6 +168,12 @@ impl Recorder for TreeRecorder<'_> {
     }
 
     fn light_sampled(&mut self, sample: &LightSample) {
+        // The light's terms are part of the recorded ray's colour and are kept; only its
+        // shadow ray is a node of its own, and needs room in the budget (or is counted).
+        let keep_shadow_ray = sample.shadow_ray.is_none() || self.admit();
+        if self.dropped_open > 0 {
+            return;
+        }
         let scene = self.scene;
         let (Some(node), Some(sum)) = (self.open.last_mut(), self.local_sums.last_mut()) else {
             return;
@@ -142,30 +217,33 @@ impl Recorder for TreeRecorder<'_> {
                             Termination::Miss,
                         ),
                     };
-                shadow_child = Some(node.children.len());
-                node.children.push(RayNode {
-                    kind: RayKind::Shadow,
-                    depth: node.depth,
-                    origin: shadow_ray.origin.to_array(),
-                    direction: shadow_ray.direction.to_array(),
-                    weight: node.weight,
-                    coefficient: [1.0; 3],
-                    interface: None,
-                    hit: None,
-                    local: None,
-                    shadow: Some(ShadowInfo {
-                        light: light.clone(),
-                        max_t: finite(shadow_ray.max_t),
-                        result,
-                        blocker,
-                        transmittance,
-                        filters,
-                    }),
-                    color: passed.to_array(),
-                    termination,
-                    skipped: Vec::new(),
-                    children: Vec::new(),
-                });
+                if keep_shadow_ray {
+                    shadow_child = Some(node.children.len());
+                    node.children.push(RayNode {
+                        kind: RayKind::Shadow,
+                        depth: node.depth,
+                        origin: shadow_ray.origin.to_array(),
+                        direction: shadow_ray.direction.to_array(),
+                        weight: node.weight,
+                        coefficient: [1.0; 3],
+                        interface: None,
+                        hit: None,
+                        local: None,
+                        shadow: Some(ShadowInfo {
+                            light: light.clone(),
+                            max_t: finite(shadow_ray.max_t),
+                            result,
+                            blocker,
+                            transmittance,
+                            filters,
+                        }),
+                        color: passed.to_array(),
+                        termination,
+                        skipped: Vec::new(),
+                        children: Vec::new(),
+                        unrecorded: 0,
+                    });
+                }
                 match result {
                     ShadowOutcome::Unblocked => Visibility::Lit,
                     ShadowOutcome::Blocked => Visibility::Blocked,
@@ -199,6 +277,9 @@ impl Recorder for TreeRecorder<'_> {
     }
 
     fn secondary_skipped(&mut self, skipped: &SkippedRay) {
+        if self.dropped_open > 0 {
+            return;
+        }
         if let Some(node) = self.open.last_mut() {
             node.skipped.push(SkippedInfo {
                 kind: skipped.kind,
@@ -211,6 +292,10 @@ impl Recorder for TreeRecorder<'_> {
     }
 
     fn ray_finished(&mut self, color: Vec3A, termination: Termination) {
+        if self.dropped_open > 0 {
+            self.dropped_open -= 1;
+            return;
+        }
         let Some(mut node) = self.open.pop() else {
             return;
         };
