@@ -16,8 +16,13 @@ use crate::Failure;
 struct DiskLoader;
 
 impl SourceLoader for DiskLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
-        std::fs::read_to_string(path)
+    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
+        std::fs::read(path)
+    }
+
+    /// Through symbolic links, so that a linked folder that loops is an import cycle.
+    fn identify(&mut self, path: &Path) -> std::path::PathBuf {
+        std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
     }
 }
 

@@ -3,48 +3,168 @@
 
 use std::ops::Range;
 
+use std::collections::HashMap;
+
 use ariadne::{CharSet, Color, Config, IndexType, Label, Report, ReportKind};
-use whitted_ir::{Diagnostic, Severity, SourceMap, Span};
+use whitted_ir::{Diagnostic, FileId, Severity, SourceMap, Span};
 
 /// Renders diagnostics the way rustc does (ariadne): `error: message`, `--> file:line:col`,
 /// the source line(s) with the span underlined and labelled, secondary labels, `= hint: ...`.
 /// `color` = ANSI colours or plain text (tests and non-terminals use plain).
+///
+/// Control characters in the source, in file names and in messages (an ESC in a string or an
+/// object's name) are shown escaped, as `\u{1b}`, so that no diagnostic can move the cursor
+/// or recolour the terminal. Each file's text is prepared once, however many diagnostics
+/// point into it.
 pub fn render_diagnostics(sources: &SourceMap, diagnostics: &[Diagnostic], color: bool) -> String {
+    let mut files = Files::default();
     let mut out = String::new();
     for diagnostic in diagnostics {
-        out.push_str(&render_one(sources, diagnostic, color));
+        out.push_str(&render_one(sources, &mut files, diagnostic, color));
     }
     out
 }
 
-/// The name ariadne shows for a file: its path (unique within a compilation).
-fn file_name(sources: &SourceMap, span: Span) -> Option<String> {
-    sources.get(span.file).map(|f| f.path.clone())
+// How many times a file's text was prepared for ariadne, over all renders on this thread:
+// tests count it to prove the work per file is done once, not once per diagnostic.
+#[cfg(test)]
+thread_local! {
+    pub(crate) static PREPARED_FILES: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
 }
 
-/// A span clamped to its file's text, so no bad span can upset the renderer.
-fn clamp(sources: &SourceMap, span: Span) -> Option<(String, Range<usize>)> {
-    let file = sources.get(span.file)?;
-    let len = file.text.len();
-    let mut start = (span.start as usize).min(len);
-    let mut end = (span.end as usize).clamp(start, len);
-    while !file.text.is_char_boundary(start) {
-        start -= 1;
-    }
-    while !file.text.is_char_boundary(end) {
-        end += 1;
-    }
-    Some((file.path.clone(), start..end))
+/// A file's text with control characters escaped, and where the escapes moved its bytes.
+struct Escaped {
+    /// The name ariadne shows (the path, escaped).
+    name: String,
+    /// Byte offsets (in the original text) of each escaped character, with the bytes the
+    /// escapes before and including it added.
+    shifts: Vec<(usize, usize)>,
 }
 
-fn render_one(sources: &SourceMap, diagnostic: &Diagnostic, color: bool) -> String {
+impl Escaped {
+    /// An original byte offset in the escaped text.
+    fn map(&self, offset: usize) -> usize {
+        let before = self.shifts.partition_point(|&(at, _)| at < offset);
+        match before {
+            0 => offset,
+            n => offset + self.shifts[n - 1].1,
+        }
+    }
+}
+
+/// The files prepared so far, and ariadne's line index of each.
+#[derive(Default)]
+struct Files {
+    escaped: HashMap<FileId, Escaped>,
+    ariadne: HashMap<String, ariadne::Source<String>>,
+}
+
+impl Files {
+    fn prepare(&mut self, sources: &SourceMap, file: FileId) -> Option<&Escaped> {
+        if !self.escaped.contains_key(&file) {
+            let source = sources.get(file)?;
+            #[cfg(test)]
+            PREPARED_FILES.with(|n| n.set(n.get() + 1));
+            let mut text = String::with_capacity(source.text.len());
+            let mut shifts = Vec::new();
+            let mut added = 0;
+            let mut chars = source.text.char_indices().peekable();
+            while let Some((at, c)) = chars.next() {
+                let keep =
+                    !needs_escape(c) || (c == '\r' && matches!(chars.peek(), Some((_, '\n'))));
+                if keep {
+                    text.push(c);
+                } else {
+                    let escape = escape_char(c);
+                    added += escape.len() - c.len_utf8();
+                    text.push_str(&escape);
+                    shifts.push((at, added));
+                }
+            }
+            let name = escape_text(&source.path);
+            self.ariadne
+                .entry(name.clone())
+                .or_insert_with(|| ariadne::Source::from(text));
+            self.escaped.insert(file, Escaped { name, shifts });
+        }
+        self.escaped.get(&file)
+    }
+
+    /// A span clamped to its file's text and moved into the escaped text.
+    fn clamp(&mut self, sources: &SourceMap, span: Span) -> Option<(String, Range<usize>)> {
+        let file = sources.get(span.file)?;
+        let text = file.text.clone();
+        let len = text.len();
+        let mut start = (span.start as usize).min(len);
+        let mut end = (span.end as usize).clamp(start, len);
+        while !text.is_char_boundary(start) {
+            start -= 1;
+        }
+        while !text.is_char_boundary(end) {
+            end += 1;
+        }
+        let escaped = self.prepare(sources, span.file)?;
+        Some((escaped.name.clone(), escaped.map(start)..escaped.map(end)))
+    }
+}
+
+impl ariadne::Cache<String> for &mut Files {
+    type Storage = String;
+
+    fn fetch(&mut self, id: &String) -> Result<&ariadne::Source<String>, impl std::fmt::Debug> {
+        self.ariadne
+            .get(id)
+            .ok_or_else(|| format!("no source `{id}`"))
+    }
+
+    fn display<'a>(&self, id: &'a String) -> Option<impl std::fmt::Display + 'a> {
+        Some(id)
+    }
+}
+
+/// Characters a terminal would act on rather than show: C0 and C1 controls (ESC, CR,
+/// backspace, CSI, ...) and the line and paragraph separators. Newlines and tabs stay.
+fn needs_escape(c: char) -> bool {
+    (c.is_control() && c != '\n' && c != '\t') || c == '\u{2028}' || c == '\u{2029}'
+}
+
+fn escape_char(c: char) -> String {
+    format!("\\u{{{:x}}}", c as u32)
+}
+
+/// `text` with every character a terminal would act on written as `\u{..}`.
+pub(crate) fn escape_text(text: &str) -> String {
+    if !text
+        .chars()
+        .any(|c| needs_escape(c) || c == '\n' || c == '\t')
+    {
+        return text.to_string();
+    }
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        // In a one-line message a newline or tab is as misleading as any other control.
+        if needs_escape(c) || c == '\n' || c == '\t' {
+            out.push_str(&escape_char(c));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+fn render_one(
+    sources: &SourceMap,
+    files: &mut Files,
+    diagnostic: &Diagnostic,
+    color: bool,
+) -> String {
     // rustc's lower-case words, in ariadne's layout.
     let (kind, label_color) = match diagnostic.severity {
         Severity::Error => (ReportKind::Custom("error", Color::Red), Color::Red),
         Severity::Warning => (ReportKind::Custom("warning", Color::Yellow), Color::Yellow),
         Severity::Note => (ReportKind::Custom("note", Color::Cyan), Color::Cyan),
     };
-    let primary = diagnostic.span.and_then(|span| clamp(sources, span));
+    let primary = diagnostic.span.and_then(|span| files.clamp(sources, span));
     let Some(primary) = primary else {
         return render_without_source(diagnostic, color);
     };
@@ -59,13 +179,13 @@ fn render_one(sources: &SourceMap, diagnostic: &Diagnostic, color: bool) -> Stri
         .with_compact(false);
     let mut report = Report::build(kind, primary.clone())
         .with_config(config)
-        .with_message(&diagnostic.message);
+        .with_message(escape_text(&diagnostic.message));
     // ariadne underlines only labels with a message.
-    let text = diagnostic.label.as_deref().unwrap_or("here");
+    let text = escape_text(diagnostic.label.as_deref().unwrap_or("here"));
     let mut labels = vec![(primary.clone(), text, label_color)];
     for secondary in &diagnostic.secondary {
-        if let Some(span) = clamp(sources, secondary.span) {
-            labels.push((span, secondary.message.as_str(), Color::Blue));
+        if let Some(span) = files.clamp(sources, secondary.span) {
+            labels.push((span, escape_text(&secondary.message), Color::Blue));
         }
     }
     // ariadne starts a new snippet whenever a label is above the previous one; in file and
@@ -79,24 +199,10 @@ fn render_one(sources: &SourceMap, diagnostic: &Diagnostic, color: bool) -> Stri
         report = report.with_label(label);
     }
     for hint in &diagnostic.hints {
-        report = report.with_help(hint);
-    }
-    let mut files: Vec<(String, String)> = Vec::new();
-    let spans = diagnostic
-        .span
-        .iter()
-        .chain(diagnostic.secondary.iter().map(|l| &l.span));
-    for span in spans {
-        if let Some(name) = file_name(sources, *span) {
-            if !files.iter().any(|(n, _)| *n == name) {
-                if let Some(file) = sources.get(span.file) {
-                    files.push((name, file.text.to_string()));
-                }
-            }
-        }
+        report = report.with_help(escape_text(hint));
     }
     let mut buffer = Vec::new();
-    match report.finish().write(ariadne::sources(files), &mut buffer) {
+    match report.finish().write(&mut *files, &mut buffer) {
         Ok(()) => {
             let text = String::from_utf8_lossy(&buffer).into_owned();
             // ariadne colours a custom report kind even with colour off.
@@ -136,12 +242,15 @@ fn render_without_source(diagnostic: &Diagnostic, color: bool) -> String {
         Severity::Note => ("note", "36"),
     };
     let mut out = if color {
-        format!("\x1b[{code}m{word}:\x1b[0m {}\n", diagnostic.message)
+        format!(
+            "\x1b[{code}m{word}:\x1b[0m {}\n",
+            escape_text(&diagnostic.message)
+        )
     } else {
-        format!("{word}: {}\n", diagnostic.message)
+        format!("{word}: {}\n", escape_text(&diagnostic.message))
     };
     for hint in &diagnostic.hints {
-        out.push_str(&format!("    Help: {hint}\n"));
+        out.push_str(&format!("    Help: {}\n", escape_text(hint)));
     }
     out
 }
