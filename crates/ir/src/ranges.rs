@@ -337,3 +337,180 @@ impl Ranges<'_> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::DMat4;
+
+    use crate::arena::Handle;
+    use crate::scene::*;
+    use crate::source::{FileId, Span};
+    use crate::validate::validate;
+
+    fn span(n: usize) -> Span {
+        Span::new(FileId(0), n, n + 1)
+    }
+
+    fn base() -> Scene {
+        let mut scene = Scene::default();
+        let material = scene.materials.append(Material::default(), span(0));
+        let object = scene.objects.append(
+            Object {
+                name: None,
+                kind: ObjectKind::Shape {
+                    shape: Shape::Sphere {
+                        center: glam::DVec3::ZERO,
+                        radius: 1.0,
+                    },
+                },
+                world_from_object: DMat4::IDENTITY,
+                material,
+            },
+            span(1),
+        );
+        scene.roots.push(object);
+        scene.lights.append(
+            Light {
+                name: None,
+                color: Color::WHITE,
+                kind: LightKind::Point {
+                    position: glam::DVec3::new(0.0, 5.0, 0.0),
+                    attenuation: Attenuation::NONE,
+                },
+            },
+            span(2),
+        );
+        scene
+    }
+
+    /// Each field with a way to set it to a value.
+    type Setter = fn(&mut Scene, f64);
+
+    fn fields() -> Vec<(&'static str, Setter)> {
+        vec![
+            ("light's `color`", |s, v| {
+                s.lights[Handle::from_index(0)].color = Color::new(v, 1.0, 1.0)
+            }),
+            ("light's `position`", |s, v| {
+                if let LightKind::Point { position, .. } = &mut s.lights[Handle::from_index(0)].kind
+                {
+                    position.x = v;
+                }
+            }),
+            ("light's `attenuation` term", |s, v| {
+                if let LightKind::Point { attenuation, .. } =
+                    &mut s.lights[Handle::from_index(0)].kind
+                {
+                    attenuation.quadratic = v;
+                }
+            }),
+            ("material's `diffuse`", |s, v| {
+                s.materials[Handle::from_index(0)].diffuse = Color::new(v, 0.0, 0.0)
+            }),
+            ("material's `specular`", |s, v| {
+                s.materials[Handle::from_index(0)].specular = Color::gray(v)
+            }),
+            ("material's `reflective`", |s, v| {
+                s.materials[Handle::from_index(0)].reflective = Color::gray(v)
+            }),
+            ("material's `transmissive`", |s, v| {
+                s.materials[Handle::from_index(0)].transmissive = Color::gray(v)
+            }),
+            ("material's `absorption`", |s, v| {
+                s.materials[Handle::from_index(0)].absorption = Color::gray(v)
+            }),
+            ("material's `shininess`", |s, v| {
+                s.materials[Handle::from_index(0)].shininess = v
+            }),
+            ("material's `ior`", |s, v| {
+                s.materials[Handle::from_index(0)].ior = v
+            }),
+            ("sphere's `radius`", |s, v| {
+                if let ObjectKind::Shape {
+                    shape: Shape::Sphere { radius, .. },
+                } = &mut s.objects[Handle::from_index(0)].kind
+                {
+                    *radius = v;
+                }
+            }),
+            ("sphere's `center`", |s, v| {
+                if let ObjectKind::Shape {
+                    shape: Shape::Sphere { center, .. },
+                } = &mut s.objects[Handle::from_index(0)].kind
+                {
+                    center.y = v;
+                }
+            }),
+            ("object's transform", |s, v| {
+                s.objects[Handle::from_index(0)].world_from_object.w_axis.x = v
+            }),
+            ("camera's `eye`", |s, v| s.camera.eye.x = v),
+        ]
+    }
+
+    fn messages(scene: Scene) -> Vec<String> {
+        match validate(scene) {
+            Ok(_) => Vec::new(),
+            Err(invalid) => invalid.diagnostics.into_iter().map(|d| d.message).collect(),
+        }
+    }
+
+    #[test]
+    fn numbers_past_f32_are_refused_for_every_field_with_its_name() {
+        // Issue 9 item 6: a light colour 1e39 or an ior 1e308 passed validation and made
+        // inf/NaN pixels. Edge values: past f32 (both signs), f64's largest, and tiny ones.
+        let huge = [f64::from(f32::MAX) * 2.0, 1e39, -1e39, f64::MAX, 1e308];
+        for (name, set) in fields() {
+            for value in huge {
+                let mut scene = base();
+                set(&mut scene, value);
+                let messages = messages(scene);
+                // Negative colours and sizes are already refused as negative.
+                let named = messages
+                    .iter()
+                    .any(|m| m.contains(name) && m.contains("limit"));
+                assert!(
+                    named || (value < 0.0 && !messages.is_empty()),
+                    "{name} = {value:e} gave {messages:?}"
+                );
+            }
+            // A plain value passes.
+            let mut scene = base();
+            set(&mut scene, 0.5);
+            assert_eq!(messages(scene), Vec::<String>::new(), "{name} = 0.5");
+        }
+        // Tiny sizes round to nothing in f32: refused, with the limit named.
+        for value in [5e-324, 1e-310, 1e-40] {
+            let mut scene = base();
+            if let ObjectKind::Shape {
+                shape: Shape::Sphere { radius, .. },
+            } = &mut scene.objects[Handle::from_index(0)].kind
+            {
+                *radius = value;
+            }
+            let messages = messages(scene);
+            assert!(
+                messages.iter().any(|m| m.contains("smallest size limit")),
+                "radius {value:e}: {messages:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn world_space_extent_counts_after_the_transform() {
+        let mut scene = base();
+        scene.objects[Handle::from_index(0)].world_from_object =
+            DMat4::from_scale(glam::DVec3::splat(1e6));
+        if let ObjectKind::Shape {
+            shape: Shape::Sphere { radius, .. },
+        } = &mut scene.objects[Handle::from_index(0)].kind
+        {
+            *radius = 1e4;
+        }
+        let messages = messages(scene);
+        assert!(
+            messages.iter().any(|m| m.contains("extent in world space")),
+            "{messages:?}"
+        );
+    }
+}

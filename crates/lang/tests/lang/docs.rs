@@ -96,7 +96,8 @@ fn the_rendered_error_in_the_docs_is_what_the_compiler_prints() {
 
 /// The Limits table as `whitted_ir::limits::ALL` says it should read.
 fn limits_table() -> String {
-    let mut table = String::from("| Limit | Value | What it bounds |\n|-------|-------|----------------|\n");
+    let mut table =
+        String::from("| Limit | Value | What it bounds |\n|-------|-------|----------------|\n");
     for limit in whitted_ir::limits::ALL {
         table.push_str(&format!(
             "| {} | {} | {} |\n",
@@ -109,7 +110,8 @@ fn limits_table() -> String {
 #[test]
 fn the_limits_section_lists_every_limit_once_with_its_value() {
     let markdown = language_md();
-    let begin = "<!-- limits:begin (generated from whitted_ir::limits::ALL; a test checks it) -->\n";
+    let begin =
+        "<!-- limits:begin (generated from whitted_ir::limits::ALL; a test checks it) -->\n";
     let end = "<!-- limits:end -->";
     let (Some(start), Some(stop)) = (markdown.find(begin), markdown.find(end)) else {
         panic!("docs/language.md has no limits table between `{begin}` and `{end}`");
@@ -132,14 +134,13 @@ fn the_limits_section_lists_every_limit_once_with_its_value() {
             if plain.len() < 4 && !written.contains('e') {
                 continue;
             }
-            let found = elsewhere
-                .match_indices(written)
-                .find(|&(at, _)| {
-                    let before = elsewhere[..at].chars().next_back();
-                    let after = elsewhere[at + written.len()..].chars().next();
-                    let digit = |c: Option<char>| c.is_some_and(|c| c.is_ascii_digit() || c == '.' || c == ',');
-                    !digit(before) && !digit(after)
-                });
+            let found = elsewhere.match_indices(written).find(|&(at, _)| {
+                let before = elsewhere[..at].chars().next_back();
+                let after = elsewhere[at + written.len()..].chars().next();
+                let digit =
+                    |c: Option<char>| c.is_some_and(|c| c.is_ascii_digit() || c == '.' || c == ',');
+                !digit(before) && !digit(after)
+            });
             assert!(
                 found.is_none(),
                 "docs/language.md writes the {} limit's value {written} outside the Limits table",
