@@ -18,6 +18,21 @@ use whitted_ir::{Diagnostic, FileId, Severity, SourceMap, Span};
 /// point into it.
 pub fn render_diagnostics(sources: &SourceMap, diagnostics: &[Diagnostic], color: bool) -> String {
     let mut files = Files::default();
+    // Long lines are shown only around the places diagnostics point at.
+    for diagnostic in diagnostics {
+        let spans = diagnostic
+            .span
+            .iter()
+            .chain(diagnostic.secondary.iter().map(|l| &l.span));
+        for span in spans {
+            let places = files.places.entry(span.file).or_default();
+            places.push(span.start as usize);
+            places.push(span.end as usize);
+        }
+    }
+    for places in files.places.values_mut() {
+        places.sort_unstable();
+    }
     let mut out = String::new();
     for diagnostic in diagnostics {
         out.push_str(&render_one(sources, &mut files, diagnostic, color));
@@ -32,22 +47,30 @@ thread_local! {
     pub(crate) static PREPARED_FILES: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
 }
 
-/// A file's text with control characters escaped, and where the escapes moved its bytes.
+/// Lines longer than this many bytes are shown only around the places diagnostics point at
+/// (a one-line 64 MiB expression would otherwise be printed whole).
+const LONG_LINE: usize = 400;
+
+/// Bytes kept on each side of a place in a long line.
+const CONTEXT: usize = 80;
+
+/// A file's text as ariadne shows it: control characters escaped, long lines cut down to the
+/// parts around the places diagnostics point at. `deltas` says how offsets moved.
 struct Escaped {
     /// The name ariadne shows (the path, escaped).
     name: String,
-    /// Byte offsets (in the original text) of each escaped character, with the bytes the
-    /// escapes before and including it added.
-    shifts: Vec<(usize, usize)>,
+    /// From each original offset on (until the next entry), the shown offset is the original
+    /// plus this.
+    deltas: Vec<(usize, isize)>,
 }
 
 impl Escaped {
-    /// An original byte offset in the escaped text.
+    /// An original byte offset in the shown text.
     fn map(&self, offset: usize) -> usize {
-        let before = self.shifts.partition_point(|&(at, _)| at < offset);
+        let before = self.deltas.partition_point(|&(at, _)| at <= offset);
         match before {
             0 => offset,
-            n => offset + self.shifts[n - 1].1,
+            n => offset.saturating_add_signed(self.deltas[n - 1].1),
         }
     }
 }
@@ -55,42 +78,83 @@ impl Escaped {
 /// The files prepared so far, and ariadne's line index of each.
 #[derive(Default)]
 struct Files {
+    /// Sorted offsets that diagnostics point at, per file: long lines keep these parts.
+    places: HashMap<FileId, Vec<usize>>,
     escaped: HashMap<FileId, Escaped>,
     ariadne: HashMap<String, ariadne::Source<String>>,
 }
 
 impl Files {
+    /// Whether byte `at` of a long line is near a place a diagnostic points at.
+    fn near_place(&self, file: FileId, at: usize) -> bool {
+        let Some(places) = self.places.get(&file) else {
+            return false;
+        };
+        let first = places.partition_point(|&p| p + CONTEXT < at);
+        places.get(first).is_some_and(|&p| p <= at + CONTEXT)
+    }
+
     fn prepare(&mut self, sources: &SourceMap, file: FileId) -> Option<&Escaped> {
         if !self.escaped.contains_key(&file) {
             let source = sources.get(file)?;
             #[cfg(test)]
             PREPARED_FILES.with(|n| n.set(n.get() + 1));
-            let mut text = String::with_capacity(source.text.len());
-            let mut shifts = Vec::new();
-            let mut added = 0;
-            let mut chars = source.text.char_indices().peekable();
-            while let Some((at, c)) = chars.next() {
-                let keep =
-                    !needs_escape(c) || (c == '\r' && matches!(chars.peek(), Some((_, '\n'))));
-                if keep {
-                    text.push(c);
-                } else {
-                    let escape = escape_char(c);
-                    added += escape.len() - c.len_utf8();
-                    text.push_str(&escape);
-                    shifts.push((at, added));
+            let original: &str = &source.text;
+            let mut text = String::with_capacity(original.len().min(1 << 20));
+            let mut deltas = Vec::new();
+            let mut delta: isize = 0;
+            let mut line_start = 0;
+            while line_start < original.len() {
+                let line_end = original[line_start..]
+                    .find('\n')
+                    .map_or(original.len(), |i| line_start + i + 1);
+                let long = line_end - line_start > LONG_LINE;
+                let mut eliding = false;
+                let mut chars = original[line_start..line_end].char_indices().peekable();
+                while let Some((i, c)) = chars.next() {
+                    let at = line_start + i;
+                    if long && c != '\n' && !self.near_place(file, at) {
+                        // Offsets inside an elided run point at nothing shown; no entry.
+                        if !eliding {
+                            text.push('…');
+                            eliding = true;
+                        }
+                        continue;
+                    }
+                    eliding = false;
+                    let here = text.len() as isize - at as isize;
+                    if here != delta {
+                        delta = here;
+                        deltas.push((at, delta));
+                    }
+                    let crlf = c == '\r' && matches!(chars.peek(), Some((_, '\n')));
+                    if !needs_escape(c) || crlf {
+                        text.push(c);
+                    } else {
+                        text.push_str(&escape_char(c));
+                    }
+                    let moved = text.len() as isize - (at + c.len_utf8()) as isize;
+                    if moved != delta {
+                        delta = moved;
+                        deltas.push((at + c.len_utf8(), delta));
+                    }
                 }
+                line_start = line_end;
+            }
+            let here = text.len() as isize - original.len() as isize;
+            if here != delta {
+                deltas.push((original.len(), here));
             }
             let name = escape_text(&source.path);
             self.ariadne
                 .entry(name.clone())
                 .or_insert_with(|| ariadne::Source::from(text));
-            self.escaped.insert(file, Escaped { name, shifts });
+            self.escaped.insert(file, Escaped { name, deltas });
         }
         self.escaped.get(&file)
     }
 
-    /// A span clamped to its file's text and moved into the escaped text.
+    /// A span clamped to its file's text and moved into the shown text.
     fn clamp(&mut self, sources: &SourceMap, span: Span) -> Option<(String, Range<usize>)> {
         let file = sources.get(span.file)?;
         let text = file.text.clone();
@@ -104,7 +168,8 @@ impl Files {
             end += 1;
         }
         let escaped = self.prepare(sources, span.file)?;
-        Some((escaped.name.clone(), escaped.map(start)..escaped.map(end)))
+        let (start, end) = (escaped.map(start), escaped.map(end));
+        Some((escaped.name.clone(), start..end.max(start)))
     }
 }
 

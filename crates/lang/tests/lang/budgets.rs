@@ -328,3 +328,29 @@ fn strip_colours(text: &str) -> String {
     }
     out
 }
+
+#[test]
+fn a_long_line_is_shown_only_around_the_error() {
+    // A one-line 4 MB sum used to be printed whole under its error; 64 MiB would be too.
+    let input = format!("sphere {{ radius 1{} }}", " + 1".repeat(1_000_000));
+    let compilation = compile(&input);
+    let text = render_diagnostics(&compilation.sources, &compilation.diagnostics, false);
+    assert!(text.len() < 2_000, "{} bytes", text.len());
+    assert!(text.contains("test.scene:1:16403 ]"), "{text}");
+    assert!(text.contains("…"), "{text}");
+    // The underline sits under the `+` it names: same column in the shown line.
+    let lines: Vec<&str> = text.lines().collect();
+    let row = lines
+        .iter()
+        .position(|l| l.starts_with(" 1 |"))
+        .expect("the source line");
+    let marker = lines[row + 1];
+    // Past the gutter (`   |`), the one-character span is marked with `|`.
+    let column = marker
+        .chars()
+        .skip(4)
+        .position(|c| c == '|')
+        .expect("a marker")
+        + 4;
+    assert_eq!(lines[row].chars().nth(column), Some('+'), "{text}");
+}
