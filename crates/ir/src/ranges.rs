@@ -314,6 +314,36 @@ impl Ranges<'_> {
                 None
             }
         };
+        // The tracer intersects most shapes in their own unit space: the inverse of the shape's
+        // size under the transform. Its smallest size in world space bounds those coordinates.
+        let smallest = match shape {
+            Shape::Sphere { radius, .. } | Shape::Disk { radius, .. } => Some(*radius),
+            Shape::Box { min, max } => Some((*max - *min).min_element() / 2.0),
+            Shape::Cylinder {
+                base, apex, radius, ..
+            } => Some(radius.min((*apex - *base).length())),
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                apex_radius,
+                ..
+            } => Some(base_radius.max(*apex_radius).min((*apex - *base).length())),
+            Shape::Plane { .. } | Shape::Triangle { .. } | Shape::Quadric { .. } => None,
+        };
+        if let Some(size) = smallest.filter(|s| *s >= MIN_SIZE && m.is_finite()) {
+            let inverse = m.inverse().to_cols_array();
+            let largest = [0, 1, 2, 4, 5, 6, 8, 9, 10]
+                .iter()
+                .map(|&i| inverse[i].abs())
+                .fold(0.0, f64::max);
+            let world = size / largest;
+            if largest.is_finite() && world < MIN_SIZE {
+                let what = format!("{}'s smallest size in world space", shape.kind_name());
+                let rule = format!("below the smallest size limit ({MIN_SIZE:e})");
+                self.out_of_range(&what, world, rule, span);
+            }
+        }
         if let Some((lo, hi)) = local_box {
             if lo.is_finite() && hi.is_finite() && m.is_finite() {
                 for i in 0..8 {
@@ -494,6 +524,28 @@ mod tests {
                 "radius {value:e}: {messages:?}"
             );
         }
+    }
+
+    #[test]
+    fn world_space_size_counts_after_the_transform() {
+        // Radius 1e-6 under a scale of 1e-4 on one axis: 1e-10 across in world space, where
+        // the ray's coordinates in the sphere's own space would square to infinity in f32.
+        let mut scene = base();
+        scene.objects[Handle::from_index(0)].world_from_object =
+            DMat4::from_scale(glam::DVec3::new(1e-4, 1e2, 1e2));
+        if let ObjectKind::Shape {
+            shape: Shape::Sphere { radius, .. },
+        } = &mut scene.objects[Handle::from_index(0)].kind
+        {
+            *radius = 1e-6;
+        }
+        let messages = messages(scene);
+        assert!(
+            messages
+                .iter()
+                .any(|m| m.contains("smallest size in world space")),
+            "{messages:?}"
+        );
     }
 
     #[test]
