@@ -85,21 +85,15 @@ struct Files {
 }
 
 impl Files {
-    /// Whether byte `at` of a long line is near a place a diagnostic points at.
-    fn near_place(&self, file: FileId, at: usize) -> bool {
-        let Some(places) = self.places.get(&file) else {
-            return false;
-        };
-        let first = places.partition_point(|&p| p + CONTEXT < at);
-        places.get(first).is_some_and(|&p| p <= at + CONTEXT)
-    }
-
     fn prepare(&mut self, sources: &SourceMap, file: FileId) -> Option<&Escaped> {
         if !self.escaped.contains_key(&file) {
             let source = sources.get(file)?;
             #[cfg(test)]
             PREPARED_FILES.with(|n| n.set(n.get() + 1));
             let original: &str = &source.text;
+            let places = self.places.remove(&file).unwrap_or_default();
+            // Offsets only grow, so the first place not yet behind us moves forward only.
+            let mut next_place = 0;
             let mut text = String::with_capacity(original.len().min(1 << 20));
             let mut deltas = Vec::new();
             let mut delta: isize = 0;
@@ -113,7 +107,11 @@ impl Files {
                 let mut chars = original[line_start..line_end].char_indices().peekable();
                 while let Some((i, c)) = chars.next() {
                     let at = line_start + i;
-                    if long && c != '\n' && !self.near_place(file, at) {
+                    while places.get(next_place).is_some_and(|&p| p + CONTEXT < at) {
+                        next_place += 1;
+                    }
+                    let near = places.get(next_place).is_some_and(|&p| p <= at + CONTEXT);
+                    if long && c != '\n' && !near {
                         // Offsets inside an elided run point at nothing shown; no entry.
                         if !eliding {
                             text.push('…');
