@@ -271,7 +271,7 @@ fn render_one(
             // ariadne counts columns in the escaped line; the header shows the file's own.
             if let Some(span) = diagnostic.span {
                 if let Some(lc) = sources.line_col(span) {
-                    let shown = format!("{}:", primary.0);
+                    let shown = format!(" {}:", primary.0);
                     if let Some(at) = text.find(&shown) {
                         let rest = at + shown.len();
                         let end = text[rest..].find(' ').map_or(text.len(), |e| rest + e);
