@@ -17,8 +17,8 @@ use whitted_tracer::{trace_pixel_with, NoRecord, PreparedScene, RenderOptions};
 struct DiskLoader;
 
 impl SourceLoader for DiskLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
-        std::fs::read_to_string(path)
+    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
+        std::fs::read(path)
     }
 }
 

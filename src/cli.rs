@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use whitted_ir::limits;
 
 #[derive(Parser)]
 #[command(
@@ -84,16 +85,16 @@ pub struct RenderArgs {
 #[derive(Args, Clone, Debug, Default)]
 pub struct RenderOverrides {
     /// Image width in pixels (overrides the scene's settings).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(limits::MAX_IMAGE_SIDE)))]
     pub width: Option<u32>,
     /// Image height in pixels (overrides the scene's settings).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(limits::MAX_IMAGE_SIDE)))]
     pub height: Option<u32>,
     /// Samples per pixel, on a stratified pattern (overrides the scene's settings).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(limits::MAX_SAMPLES_PER_PIXEL)))]
     pub spp: Option<u32>,
     /// Maximum recursion depth; the camera ray is depth 0 (overrides the scene's settings).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=64))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=i64::from(limits::MAX_DEPTH)))]
     pub max_depth: Option<u32>,
 }
 

@@ -16,8 +16,13 @@ use crate::Failure;
 struct DiskLoader;
 
 impl SourceLoader for DiskLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
+    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
         crate::scene_input::read_source(path)
+    }
+
+    /// Through symbolic links, so that a linked folder that loops is an import cycle.
+    fn identify(&mut self, path: &Path) -> std::path::PathBuf {
+        std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
     }
 }
 

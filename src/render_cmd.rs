@@ -5,8 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use whitted_ir::limits::MAX_PIXELS;
-use whitted_ir::{Settings, SourceMap};
+use whitted_ir::{limits, Settings, SourceMap};
 use whitted_tracer::{PreparedScene, RenderObserver, RenderOptions, RenderStats, TileResult};
 
 use crate::cli::{ImageFormat, RenderArgs, RenderOverrides, StatsFormat};
@@ -39,13 +38,15 @@ pub fn render_options(settings: &Settings, overrides: &RenderOverrides) -> Rende
     options
 }
 
-/// Refuses image sizes that cannot be held in memory, before any work starts: larger sizes
-/// are almost always a typo (`--width 64000`).
+/// Refuses image sizes that cannot be held in memory, before any work starts: at most
+/// [`limits::MAX_PIXELS`] (about 11,585 x 11,585, 1.5 GiB of linear RGB). Larger sizes are
+/// almost always a typo (`--width 30000 --height 30000`) and would exhaust memory.
 pub fn check_image_size(width: u32, height: u32) -> Result<(), Failure> {
     let pixels = u64::from(width) * u64::from(height);
-    if pixels > MAX_PIXELS {
+    if pixels > limits::MAX_PIXELS {
         return Err(Failure::Message(format!(
-            "a {width}x{height} image has {pixels} pixels, more than the limit of {MAX_PIXELS} (about 11585x11585)"
+            "a {width}x{height} image has {pixels} pixels, more than the pixels limit ({}, about 11585x11585)",
+            limits::MAX_PIXELS
         )));
     }
     Ok(())

@@ -14,15 +14,20 @@ use crate::Failure;
 struct FileLoader;
 
 impl SourceLoader for FileLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
+    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
         read_source(path)
+    }
+
+    /// Through symbolic links, so that a linked folder that loops is an import cycle.
+    fn identify(&mut self, path: &Path) -> std::path::PathBuf {
+        std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
     }
 }
 
-/// Reads one scene file as text, refusing what is not a regular file (a device such as
-/// `/dev/zero` never ends, a FIFO blocks) and stopping at the source size limit rather than
-/// reading until memory runs out.
-pub fn read_source(path: &Path) -> std::io::Result<String> {
+/// Reads one scene file's bytes (the language decodes them and locates bad UTF-8), refusing
+/// what is not a regular file (a device such as `/dev/zero` never ends, a FIFO blocks) and
+/// stopping at the source size limit rather than reading until memory runs out.
+pub fn read_source(path: &Path) -> std::io::Result<Vec<u8>> {
     use std::io::{Error, ErrorKind, Read};
     let limit = whitted_ir::limits::MAX_SOURCE_BYTES;
     let not_regular = |kind: &str| {
@@ -57,8 +62,7 @@ pub fn read_source(path: &Path) -> std::io::Result<String> {
             format!("it has more than {limit} bytes, the source size limit"),
         ));
     }
-    String::from_utf8(bytes)
-        .map_err(|_| Error::new(ErrorKind::InvalidData, "stream did not contain valid UTF-8"))
+    Ok(bytes)
 }
 
 /// Names the kind of a file that is not a regular one, for error messages.

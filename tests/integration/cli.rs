@@ -286,17 +286,35 @@ fn an_image_too_large_for_memory_is_refused_before_rendering() {
         "render",
         "scenes/whitted.scene",
         "--width",
-        "60000",
+        "30000",
         "--height",
-        "60000",
+        "30000",
         "-o",
         out.to_str().unwrap(),
     ]);
     assert_eq!(output.status.code(), Some(1));
     assert!(
-        stderr(&output).contains("more than the limit"),
+        stderr(&output).contains("more than the pixels limit (134217728"),
         "{}",
         stderr(&output)
     );
+    // A side past the image side limit is a usage error that names the flag and the range.
+    let output = run(&["render", "scenes/whitted.scene", "--width", "60000"]);
+    assert_eq!(output.status.code(), Some(2));
+    let message = stderr(&output);
+    assert!(
+        message.contains("--width") && message.contains("1..=32768"),
+        "{message}"
+    );
+    let output = run(&[
+        "trace",
+        "scenes/whitted.scene",
+        "--pixel",
+        "0,0",
+        "--max-depth",
+        "257",
+    ]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(stderr(&output).contains("0..=256"), "{}", stderr(&output));
     assert!(!out.exists());
 }

@@ -4,6 +4,7 @@
 mod cli;
 mod debug_cli;
 mod debug_tmux;
+mod extremes;
 mod guards;
 mod json_schema;
 mod ray_trees;

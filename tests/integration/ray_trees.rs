@@ -15,8 +15,8 @@ use whitted_tracer::{render, NoObserver, PreparedScene, RayKind, RenderOptions, 
 struct FileLoader;
 
 impl SourceLoader for FileLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
-        std::fs::read_to_string(path)
+    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
+        std::fs::read(path)
     }
 }
 

@@ -8,6 +8,7 @@ mod diagnostic;
 mod json;
 pub mod limits;
 mod print;
+mod ranges;
 mod scene;
 mod source;
 mod validate;

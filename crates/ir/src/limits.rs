@@ -21,6 +21,10 @@ pub const MAX_NESTING: usize = 256;
 /// Nested imports (a file importing a file importing ...).
 pub const MAX_IMPORT_DEPTH: usize = 64;
 
+/// Files one compilation reads (the root and every distinct import), so that imports
+/// through a symbolic-link loop cannot fan out without end.
+pub const MAX_IMPORTS: usize = 10_000;
+
 /// Source text over every file of a compilation, in bytes; reads stop at this size.
 pub const MAX_SOURCE_BYTES: usize = 64 * 1024 * 1024;
 
@@ -48,86 +52,175 @@ pub const MAX_RAY_TREE_NODES: usize = 100_000;
 /// Estimated memory of one render (image buffers, statistics, scene), refused up front.
 pub const MAX_RENDER_MEMORY_BYTES: u64 = 8 * 1024 * 1024 * 1024;
 
+/// The largest magnitude of a coordinate, size, distance, direction, transform entry or
+/// quadric coefficient, in the scene file and in world space after transforms. The tracer
+/// works in f32, where at 1e9 neighbouring numbers are already 64 units apart.
+pub const MAX_COORDINATE: f64 = 1e9;
+
+/// The smallest size (radius, box side, pattern scale, view height, epsilon). With
+/// [`MAX_COORDINATE`], a ray's coordinates in a shape's own space stay below 1e18, whose
+/// square is still finite in f32.
+pub const MIN_SIZE: f64 = 1e-9;
+
+/// The largest colour component: light colours, ambient and background light, and the
+/// ambient, diffuse and specular coefficients, shininess and absorption. Intensity times
+/// coefficient over every light and every level of recursion then stays finite in f32.
+pub const MAX_INTENSITY: f64 = 1e6;
+
+/// The largest reflective or transmissive coefficient: a surface that returned more than
+/// arrives would multiply the light at every bounce (and every filtered shadow) until it
+/// overflowed.
+pub const MAX_REFLECTANCE: f64 = 1.0;
+
+/// The smallest index of refraction.
+pub const MIN_IOR: f64 = 1e-3;
+
+/// The largest index of refraction.
+pub const MAX_IOR: f64 = 1e3;
+
+/// A limit's value: a count of things, or a bound on a number in the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Value {
+    Count(u64),
+    Number(f64),
+}
+
+impl std::fmt::Display for Value {
+    /// Counts with thousands separators (`5,000,000`), numbers in scientific notation
+    /// (`1e9`, `1e-9`), or plainly when they are small whole numbers (`1`).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Value::Count(n) => {
+                let digits = n.to_string();
+                let mut out = String::new();
+                for (i, c) in digits.chars().enumerate() {
+                    if i > 0 && (digits.len() - i) % 3 == 0 {
+                        out.push(',');
+                    }
+                    out.push(c);
+                }
+                f.write_str(&out)
+            }
+            Value::Number(x) if x.fract() == 0.0 && x.abs() < 1e4 => write!(f, "{x}"),
+            Value::Number(x) => write!(f, "{x:e}"),
+        }
+    }
+}
+
 /// One limit as the docs list it.
 #[derive(Clone, Copy, Debug)]
 pub struct Limit {
     /// The name used in error messages and in the docs.
     pub name: &'static str,
     /// The value as the docs write it.
-    pub value: u64,
+    pub value: Value,
+    /// What is limited, as a phrase for the docs' table.
     pub what: &'static str,
+}
+
+const fn count(name: &'static str, value: u64, what: &'static str) -> Limit {
+    Limit {
+        name,
+        value: Value::Count(value),
+        what,
+    }
+}
+
+const fn number(name: &'static str, value: f64, what: &'static str) -> Limit {
+    Limit {
+        name,
+        value: Value::Number(value),
+        what,
+    }
 }
 
 /// Every limit, in the order docs/language.md lists them.
 pub const ALL: &[Limit] = &[
-    Limit {
-        name: "objects",
-        value: MAX_OBJECTS as u64,
-        what: "objects in a scene",
-    },
-    Limit {
-        name: "evaluation steps",
-        value: MAX_EVALUATION_STEPS,
-        what: "loop iterations and function calls in one compilation",
-    },
-    Limit {
-        name: "call depth",
-        value: MAX_CALL_DEPTH as u64,
-        what: "nested function calls",
-    },
-    Limit {
-        name: "nesting",
-        value: MAX_NESTING as u64,
-        what: "nested brackets",
-    },
-    Limit {
-        name: "import depth",
-        value: MAX_IMPORT_DEPTH as u64,
-        what: "nested imports",
-    },
-    Limit {
-        name: "source size",
-        value: MAX_SOURCE_BYTES as u64,
-        what: "bytes of source text over every file",
-    },
-    Limit {
-        name: "lights",
-        value: MAX_LIGHTS as u64,
-        what: "lights in a scene",
-    },
-    Limit {
-        name: "materials",
-        value: MAX_MATERIALS as u64,
-        what: "materials in a scene",
-    },
-    Limit {
-        name: "image side",
-        value: MAX_IMAGE_SIDE as u64,
-        what: "image width or height",
-    },
-    Limit {
-        name: "pixels",
-        value: MAX_PIXELS,
-        what: "pixels in an image",
-    },
-    Limit {
-        name: "samples per pixel",
-        value: MAX_SAMPLES_PER_PIXEL as u64,
-        what: "anti-aliasing samples per pixel",
-    },
-    Limit {
-        name: "max depth",
-        value: MAX_DEPTH as u64,
-        what: "recursion depth of the tracer",
-    },
-    Limit {
-        name: "ray tree nodes",
-        value: MAX_RAY_TREE_NODES as u64,
-        what: "nodes in one recorded ray tree",
-    },
-    Limit {
-        name: "render memory",
-        value: MAX_RENDER_MEMORY_BYTES,
-        what: "estimated bytes of memory for one render",
-    },
+    count("objects", MAX_OBJECTS as u64, "objects in a scene (shapes, CSG nodes, groups)"),
+    count(
+        "evaluation steps",
+        MAX_EVALUATION_STEPS,
+        "loop iterations and function calls in one compilation",
+    ),
+    count("call depth", MAX_CALL_DEPTH as u64, "nested function calls"),
+    count("nesting", MAX_NESTING as u64, "nested brackets `(` and `{`"),
+    count("import depth", MAX_IMPORT_DEPTH as u64, "nested imports"),
+    count("imports", MAX_IMPORTS as u64, "files read in one compilation"),
+    count(
+        "source size",
+        MAX_SOURCE_BYTES as u64,
+        "bytes of source text over every file",
+    ),
+    count("lights", MAX_LIGHTS as u64, "lights in a scene"),
+    count("materials", MAX_MATERIALS as u64, "materials in a scene"),
+    count("image side", MAX_IMAGE_SIDE as u64, "image width or height, in pixels"),
+    count("pixels", MAX_PIXELS, "pixels in an image (width times height)"),
+    count(
+        "samples per pixel",
+        MAX_SAMPLES_PER_PIXEL as u64,
+        "anti-aliasing samples per pixel",
+    ),
+    count("max depth", MAX_DEPTH as u64, "recursion depth of the tracer (`max_depth`)"),
+    count(
+        "ray tree nodes",
+        MAX_RAY_TREE_NODES as u64,
+        "nodes in one recorded ray tree",
+    ),
+    count(
+        "render memory",
+        MAX_RENDER_MEMORY_BYTES,
+        "estimated bytes of memory for one render",
+    ),
+    number(
+        "largest coordinate",
+        MAX_COORDINATE,
+        "magnitude of a coordinate, size, direction, transform entry or coefficient, also in world space",
+    ),
+    number(
+        "smallest size",
+        MIN_SIZE,
+        "radius, box side, pattern scale, view height or epsilon",
+    ),
+    number(
+        "largest intensity",
+        MAX_INTENSITY,
+        "light colour, ambient, background, and a material's ambient, diffuse, specular, shininess, absorption",
+    ),
+    number(
+        "largest reflectance",
+        MAX_REFLECTANCE,
+        "a material's reflective or transmissive coefficient",
+    ),
+    number("smallest ior", MIN_IOR, "index of refraction"),
+    number("largest ior", MAX_IOR, "index of refraction"),
 ];
+
+/// The limit called `name` (for messages): `the evaluation steps limit (100,000,000)`.
+pub fn describe(name: &str) -> String {
+    match ALL.iter().find(|l| l.name == name) {
+        Some(limit) => format!("the {} limit ({})", limit.name, limit.value),
+        None => format!("the {name} limit"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_print_as_the_docs_write_them() {
+        assert_eq!(Value::Count(5_000_000).to_string(), "5,000,000");
+        assert_eq!(Value::Count(256).to_string(), "256");
+        assert_eq!(Value::Count(1000).to_string(), "1,000");
+        assert_eq!(Value::Number(1e9).to_string(), "1e9");
+        assert_eq!(Value::Number(1e-9).to_string(), "1e-9");
+        assert_eq!(Value::Number(1.0).to_string(), "1");
+    }
+
+    #[test]
+    fn names_are_unique() {
+        for (i, a) in ALL.iter().enumerate() {
+            assert!(ALL[i + 1..].iter().all(|b| b.name != a.name), "{}", a.name);
+        }
+    }
+}

@@ -223,3 +223,31 @@ fn matrix_suffix(m: &DMat4) -> String {
         .collect();
     format!(" transform {}", rows.join(" "))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Light, LightKind};
+
+    #[test]
+    fn names_with_control_characters_are_printed_escaped() {
+        // Issue 10: `whitted ir` printed an ESC from a light's name raw to the terminal.
+        let mut scene = Scene::default();
+        scene.lights.append(
+            Light {
+                name: Some("red\u{1b}[31m\u{7}ça".to_string()),
+                color: crate::Color::WHITE,
+                kind: LightKind::Directional {
+                    direction: glam::DVec3::NEG_Y,
+                },
+            },
+            crate::Span::detached(),
+        );
+        let text = print(&scene);
+        assert!(
+            !text.contains('\u{1b}') && !text.contains('\u{7}'),
+            "{text:?}"
+        );
+        assert!(text.contains("\"red\\u{1b}[31m\\u{7}ça\""), "{text}");
+    }
+}

@@ -55,6 +55,7 @@ pub fn validate(scene: Scene) -> Result<ValidScene, Box<InvalidScene>> {
     for (handle, object, span) in scene.objects.iter_with_spans() {
         checker.object(&scene, handle, object, span);
     }
+    crate::ranges::check(&scene, &mut checker.errors);
     for &root in &scene.roots {
         if !scene.objects.contains(root) {
             checker.errors.push(Diagnostic::new(

@@ -40,7 +40,7 @@ pub fn compile_file(
     on_big_stack(loader, move |loader, max_depth| {
         let display = path.to_string_lossy().into_owned();
         match loader.load(&path) {
-            Ok(text) => compile_root(&path, display, text, loader, options, max_depth),
+            Ok(bytes) => compile_root(&path, display, bytes, loader, options, max_depth),
             Err(error) => Compilation {
                 sources: SourceMap::new(),
                 scene: None,
@@ -61,24 +61,58 @@ pub fn compile_source(
     loader: &mut dyn SourceLoader,
     options: &CompileOptions,
 ) -> Compilation {
+    compile_bytes(name, text.as_bytes(), loader, options)
+}
+
+/// Like [`compile_source`], for contents that may not be UTF-8.
+pub fn compile_bytes(
+    name: &str,
+    bytes: &[u8],
+    loader: &mut dyn SourceLoader,
+    options: &CompileOptions,
+) -> Compilation {
     let path = normalize(Path::new(name));
-    let text = text.to_string();
+    let bytes = bytes.to_vec();
     on_big_stack(loader, move |loader, max_depth| {
-        compile_root(&path, name.to_string(), text, loader, options, max_depth)
+        compile_root(&path, name.to_string(), bytes, loader, options, max_depth)
     })
+}
+
+/// What the compile thread asks the caller's thread for.
+enum Request {
+    Load(PathBuf),
+    Identify(PathBuf),
+}
+
+enum Reply {
+    Loaded(std::io::Result<Vec<u8>>),
+    Identified(PathBuf),
 }
 
 /// A loader that forwards requests to the caller's thread.
 struct ChannelLoader {
-    requests: mpsc::Sender<PathBuf>,
-    replies: mpsc::Receiver<std::io::Result<String>>,
+    requests: mpsc::Sender<Request>,
+    replies: mpsc::Receiver<Reply>,
 }
 
 impl SourceLoader for ChannelLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
+    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
         let gone = || std::io::Error::other("the loader is no longer available");
-        self.requests.send(path.to_path_buf()).map_err(|_| gone())?;
-        self.replies.recv().map_err(|_| gone())?
+        self.requests
+            .send(Request::Load(path.to_path_buf()))
+            .map_err(|_| gone())?;
+        match self.replies.recv() {
+            Ok(Reply::Loaded(result)) => result,
+            _ => Err(gone()),
+        }
+    }
+
+    fn identify(&mut self, path: &Path) -> PathBuf {
+        let sent = self.requests.send(Request::Identify(path.to_path_buf()));
+        match (sent, self.replies.recv()) {
+            (Ok(()), Ok(Reply::Identified(identity))) => identity,
+            _ => path.to_path_buf(),
+        }
     }
 }
 
@@ -88,7 +122,7 @@ fn on_big_stack<F>(loader: &mut dyn SourceLoader, work: F) -> Compilation
 where
     F: FnOnce(&mut dyn SourceLoader, usize) -> Compilation + Send,
 {
-    let (request_tx, request_rx) = mpsc::channel::<PathBuf>();
+    let (request_tx, request_rx) = mpsc::channel::<Request>();
     let (reply_tx, reply_rx) = mpsc::channel();
     // The closure moves into whichever spawn succeeds; a failed spawn hands nothing back,
     // so the work is parked in an Option that the successful thread takes.
@@ -128,8 +162,12 @@ where
             }
         };
         // Serve file requests until the compile thread drops its sender.
-        for path in request_rx {
-            if reply_tx.send(loader.load(&path)).is_err() {
+        for request in request_rx {
+            let reply = match request {
+                Request::Load(path) => Reply::Loaded(loader.load(&path)),
+                Request::Identify(path) => Reply::Identified(loader.identify(&path)),
+            };
+            if reply_tx.send(reply).is_err() {
                 break;
             }
         }
@@ -178,26 +216,66 @@ struct Loading<'a> {
     program: Program,
     interner: Interner,
     diagnostics: Vec<Diagnostic>,
-    /// Files by normalized path, so a file imported twice is loaded once.
+    /// Files by identity (the loader's canonical path), so a file imported twice, or through
+    /// two paths, is loaded once.
     loaded: HashMap<PathBuf, FileIndex>,
-    /// The chain of files being loaded, for cycle detection.
-    stack: Vec<PathBuf>,
+    /// The chain of files being loaded, for cycle detection: (identity, path as written).
+    stack: Vec<(PathBuf, PathBuf)>,
     total_bytes: usize,
+    /// Set once the imports limit is reported, so later imports fail quietly.
+    imports_exhausted: bool,
     /// Bracket nesting and syntax-tree depth allowed, within what the stack can take.
     max_nesting: usize,
     max_tree_depth: usize,
 }
 
+/// Bytes as text. Text that is not UTF-8 is kept with replacement characters (so that an
+/// error can show its line) along with the offset and value of the first bad byte.
+fn decode(bytes: Vec<u8>) -> (String, Option<(usize, u8)>) {
+    match String::from_utf8(bytes) {
+        Ok(text) => (text, None),
+        Err(error) => {
+            let at = error.utf8_error().valid_up_to();
+            let bytes = error.into_bytes();
+            let bad = bytes.get(at).copied().unwrap_or(0);
+            (
+                String::from_utf8_lossy(&bytes).into_owned(),
+                Some((at, bad)),
+            )
+        }
+    }
+}
+
 impl Loading<'_> {
-    fn add_file(&mut self, path: PathBuf, display: String, text: String) -> FileIndex {
-        self.total_bytes += text.len();
-        let file = self.sources.add(SourceFile::new(display, text));
+    fn add_file(
+        &mut self,
+        path: PathBuf,
+        identity: PathBuf,
+        display: String,
+        bytes: Vec<u8>,
+    ) -> FileIndex {
+        self.total_bytes += bytes.len();
+        let (text, bad_byte) = decode(bytes);
+        let file = self.sources.add(SourceFile::new(display.clone(), text));
         let index = file.0 as usize;
         self.program.files.push(FileAst {
             items: Vec::new(),
             frame_size: 0,
         });
-        self.loaded.insert(path.clone(), index);
+        self.loaded.insert(identity.clone(), index);
+        if let Some((at, byte)) = bad_byte {
+            // Up to the bad byte the text is unchanged, so the offset is the same in it; the
+            // replacement character there is three bytes long.
+            self.diagnostics.push(
+                Diagnostic::error(
+                    format!("`{display}` is not UTF-8 text: byte 0x{byte:02x} here is not part of a character"),
+                    Span::new(file, at, at + '\u{fffd}'.len_utf8()),
+                )
+                .with_label(format!("byte {at} of the file"))
+                .with_hint("save the file as UTF-8 (scene files are text)"),
+            );
+            return index;
+        }
         let text = match self.sources.get(file) {
             Some(source) => source.text.clone(),
             None => return index,
@@ -218,7 +296,7 @@ impl Loading<'_> {
                 return index;
             }
         };
-        self.stack.push(path.clone());
+        self.stack.push((identity, path.clone()));
         for item in &mut items {
             if let ItemKind::Import { path: import, file } = &mut item.kind {
                 *file = self.import(&path, &import.value, import.span);
@@ -231,25 +309,53 @@ impl Loading<'_> {
 
     fn import(&mut self, importer: &Path, name: &str, span: Span) -> Option<FileIndex> {
         let target = normalize(&importer.parent().unwrap_or(Path::new("")).join(name));
-        if let Some(position) = self.stack.iter().position(|p| *p == target) {
+        let identity = self.loader.identify(&target);
+        if let Some(position) = self.stack.iter().position(|(id, _)| *id == identity) {
             let chain: Vec<String> = self.stack[position..]
                 .iter()
+                .map(|(_, path)| path)
                 .chain(std::iter::once(&target))
                 .map(|p| format!("`{}`", p.display()))
                 .collect();
+            let mut diagnostic = Diagnostic::error(
+                format!("import cycle: `{name}` imports this file again"),
+                span,
+            )
+            .with_label("closes the cycle")
+            .with_hint(format!("the chain is {}", chain.join(" → ")));
+            if identity != target {
+                diagnostic = diagnostic.with_hint(format!(
+                    "`{}` is `{}` (through a symbolic link)",
+                    target.display(),
+                    identity.display()
+                ));
+            }
             self.diagnostics.push(
-                Diagnostic::error(
-                    format!("import cycle: `{name}` imports this file again"),
-                    span,
-                )
-                .with_label("closes the cycle")
-                .with_hint(format!("the chain is {}", chain.join(" → ")))
-                .with_hint("move what both files need into a third file that imports neither"),
+                diagnostic
+                    .with_hint("move what both files need into a third file that imports neither"),
             );
             return None;
         }
-        if let Some(&index) = self.loaded.get(&target) {
+        if let Some(&index) = self.loaded.get(&identity) {
             return Some(index);
+        }
+        if self.imports_exhausted {
+            return None;
+        }
+        if self.loaded.len() >= self.limits.max_imports {
+            self.imports_exhausted = true;
+            self.diagnostics.push(
+                Diagnostic::error(
+                    format!(
+                        "the imports limit ({} files in one compilation) was reached by this import",
+                        self.limits.max_imports
+                    ),
+                    span,
+                )
+                .with_label("one file too many")
+                .with_hint("see \"Limits\" in docs/language.md"),
+            );
+            return None;
         }
         // The stack holds the importing chain; its length is this import's depth.
         if self.stack.len() > self.limits.max_import_depth {
@@ -265,8 +371,8 @@ impl Loading<'_> {
             );
             return None;
         }
-        let text = match self.loader.load(&target) {
-            Ok(text) => text,
+        let bytes = match self.loader.load(&target) {
+            Ok(bytes) => bytes,
             Err(error) => {
                 self.diagnostics.push(
                     Diagnostic::error(format!("cannot import `{name}`: {error}"), span)
@@ -276,7 +382,7 @@ impl Loading<'_> {
                 return None;
             }
         };
-        if self.total_bytes.saturating_add(text.len()) > self.limits.max_source_bytes {
+        if self.total_bytes.saturating_add(bytes.len()) > self.limits.max_source_bytes {
             self.diagnostics.push(
                 Diagnostic::error(
                     format!(
@@ -285,12 +391,12 @@ impl Loading<'_> {
                     ),
                     span,
                 )
-                .with_label(format!("`{name}` has {} bytes", text.len())),
+                .with_label(format!("`{name}` has {} bytes", bytes.len())),
             );
             return None;
         }
         let display = target.to_string_lossy().into_owned();
-        Some(self.add_file(target, display, text))
+        Some(self.add_file(target, identity, display, bytes))
     }
 }
 
@@ -301,7 +407,7 @@ fn has_error(diagnostics: &[Diagnostic]) -> bool {
 fn compile_root(
     path: &Path,
     display: String,
-    text: String,
+    bytes: Vec<u8>,
     loader: &mut dyn SourceLoader,
     options: &CompileOptions,
     max_evaluation_depth: usize,
@@ -320,6 +426,7 @@ fn compile_root(
         loaded: HashMap::new(),
         stack: Vec::new(),
         total_bytes: 0,
+        imports_exhausted: false,
         // Limits raised far past their defaults stay within what this thread's stack can
         // take: every recursive pass is bounded by the tree depth.
         max_tree_depth: limits
@@ -328,8 +435,8 @@ fn compile_root(
             .min(max_evaluation_depth),
         max_nesting: limits.max_nesting.min(max_evaluation_depth / 2),
     };
-    if text.len() > limits.max_source_bytes {
-        let size = text.len();
+    if bytes.len() > limits.max_source_bytes {
+        let size = bytes.len();
         loading.sources.add(SourceFile::new(display.clone(), ""));
         return finish(
             loading.sources,
@@ -344,7 +451,8 @@ fn compile_root(
             )],
         );
     }
-    loading.add_file(path.to_path_buf(), display, text);
+    let identity = loading.loader.identify(path);
+    loading.add_file(path.to_path_buf(), identity, display, bytes);
     let defines = parse_defines(&mut loading, &options.defines);
 
     let Loading {
@@ -403,6 +511,8 @@ fn compile_root(
 fn parse_defines(loading: &mut Loading<'_>, defines: &[(String, String)]) -> Option<Vec<Define>> {
     let mut parsed = Vec::new();
     let mut ok = true;
+    // Each name with the span and value of its first `-D`.
+    let mut seen: HashMap<&str, (Span, &str)> = HashMap::new();
     for (name, value) in defines {
         let text = format!("{name}={value}");
         let file: FileId = loading
@@ -428,6 +538,20 @@ fn parse_defines(loading: &mut Loading<'_>, defines: &[(String, String)]) -> Opt
             ok = false;
             continue;
         }
+        if let Some(&(first, first_value)) = seen.get(name.as_str()) {
+            loading.diagnostics.push(
+                Diagnostic::error(
+                    format!("`-D {name}` is given twice: `-D {name}={first_value}` and `-D {name}={value}`"),
+                    name_span,
+                )
+                .with_label("given again here")
+                .with_secondary(first, "first given here")
+                .with_hint(format!("keep one `-D {name}=...`")),
+            );
+            ok = false;
+            continue;
+        }
+        seen.insert(name, (name_span, value));
         let mut cx = ParseContext::new(
             file,
             &mut loading.interner,

@@ -26,43 +26,63 @@ mod value;
 
 pub use whitted_ir::{Diagnostic, SourceMap};
 
-pub use compile::{compile_file, compile_source};
+pub use compile::{compile_bytes, compile_file, compile_source};
 pub use render::render_diagnostics;
 
-/// Supplies file text for the root file and for imports; the library never touches the disk.
+/// Supplies file contents for the root file and for imports; the library never touches the
+/// disk.
 pub trait SourceLoader {
-    /// `path` is already resolved (relative imports joined onto the importing file's directory).
-    fn load(&mut self, path: &std::path::Path) -> std::io::Result<String>;
+    /// The bytes of the file at `path`, which is already resolved (relative imports joined
+    /// onto the importing file's directory). The library decodes them, so that text that is
+    /// not UTF-8 gets an error pointing at the first bad byte.
+    fn load(&mut self, path: &std::path::Path) -> std::io::Result<Vec<u8>>;
+
+    /// What makes two paths the same file (a canonical path through symbolic links), so
+    /// that a file reached by two paths is loaded once and a loop through a linked folder is
+    /// an import cycle. The default is the path itself.
+    fn identify(&mut self, path: &std::path::Path) -> std::path::PathBuf {
+        path.to_path_buf()
+    }
 }
 
 /// Bounds that keep bad input from hanging or exhausting the machine. Each is reported by
-/// name when reached.
+/// name when reached. The defaults are the constants of [`whitted_ir::limits`], the one home
+/// of every limit; tests and fuzzers lower them to reach them quickly.
 #[derive(Clone, Debug)]
 pub struct Limits {
-    /// Objects in the scene (shapes, CSG nodes and groups). A million spheres take about
-    /// 300 MB; the default allows a few million.
+    /// Objects in the scene (shapes, CSG nodes and groups).
     pub max_objects: usize,
-    /// Loop iterations in total, over every loop of a compilation.
-    pub max_loop_iterations: u64,
+    /// Evaluation steps in total: every loop iteration and every function call counts one.
+    pub max_evaluation_steps: u64,
     /// Nested calls of user functions.
     pub max_call_depth: usize,
     /// Nested brackets `(` and `{`. Expressions and blocks together may nest 16 times this.
     pub max_nesting: usize,
     /// Nested imports.
     pub max_import_depth: usize,
+    /// Files read in one compilation (each distinct file counts once).
+    pub max_imports: usize,
     /// Source text in total, over every file, in bytes.
     pub max_source_bytes: usize,
+    /// Lights in the scene.
+    pub max_lights: usize,
+    /// Materials in the scene, named and inline together.
+    pub max_materials: usize,
 }
 
 impl Default for Limits {
     fn default() -> Self {
+        use whitted_ir::limits;
         Limits {
-            max_objects: 5_000_000,
-            max_loop_iterations: 100_000_000,
-            max_call_depth: 256,
-            max_nesting: 256,
-            max_import_depth: 64,
-            max_source_bytes: 64 * 1024 * 1024,
+            max_objects: limits::MAX_OBJECTS,
+            max_evaluation_steps: limits::MAX_EVALUATION_STEPS,
+            max_call_depth: limits::MAX_CALL_DEPTH,
+            max_nesting: limits::MAX_NESTING,
+            max_import_depth: limits::MAX_IMPORT_DEPTH,
+            max_imports: limits::MAX_IMPORTS,
+            max_source_bytes: limits::MAX_SOURCE_BYTES,
+            max_lights: limits::MAX_LIGHTS,
+            max_materials: limits::MAX_MATERIALS,
         }
     }
 }

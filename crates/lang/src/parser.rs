@@ -57,7 +57,7 @@ pub fn parse_file(
     cx: &mut ParseContext<'_>,
     max_nesting: usize,
 ) -> Result<Vec<Item>, Diagnostic> {
-    let brackets = lexical::scan(text, cx.file, max_nesting)?;
+    let brackets = lexical::scan(text, cx.file, max_nesting, cx.max_expression_depth)?;
     let mut pairs = SceneParser::parse(Rule::file, text)
         .map_err(|error| syntax_error::translate(&error, text, cx.file, Some(&brackets)))?;
     let Some(file) = pairs.next() else {
@@ -90,7 +90,8 @@ pub fn parse_define_value(
         }
         d
     };
-    let brackets = lexical::scan(value, cx.file, max_nesting).map_err(shift)?;
+    let brackets =
+        lexical::scan(value, cx.file, max_nesting, cx.max_expression_depth).map_err(shift)?;
     let mut pairs = SceneParser::parse(Rule::define_value, value).map_err(|error| {
         shift(syntax_error::translate(
             &error,
@@ -887,12 +888,27 @@ let m = material : glass { ior 2 };
             let mut interner = Interner::default();
             let mut functions = Vec::new();
             let mut cx = ParseContext::new(FileId(0), &mut interner, &mut functions, 4096);
-            let result = parse_file(&input, &mut cx, 256);
-            assert!(result.is_ok());
-            assert_eq!(cx.errors.len(), 1, "{:?}", cx.errors);
-            assert!(cx.errors[0]
-                .message
-                .starts_with("this is nested too deeply"));
+            // The lexical pass counts the operators and refuses the run before pest sees it.
+            match parse_file(&input, &mut cx, 256) {
+                Err(error) => assert!(
+                    error.message.starts_with("this expression is too long"),
+                    "{}",
+                    error.message
+                ),
+                Ok(_) => panic!("a run of 100,000 operators was accepted"),
+            }
         }
+        // Just inside the count, the tree's depth bound still refuses what operators and
+        // brackets build together.
+        let mixed = format!("let a = {}1{};", "-(".repeat(200), ")".repeat(200));
+        let mut interner = Interner::default();
+        let mut functions = Vec::new();
+        let mut cx = ParseContext::new(FileId(0), &mut interner, &mut functions, 300);
+        let result = parse_file(&mixed, &mut cx, 256);
+        assert!(result.is_ok());
+        assert_eq!(cx.errors.len(), 1, "{:?}", cx.errors);
+        assert!(cx.errors[0]
+            .message
+            .starts_with("this is nested too deeply"));
     }
 }

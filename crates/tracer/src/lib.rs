@@ -35,7 +35,7 @@ pub use recorder::{
 };
 pub use render::{
     render, render_with_pixel_stats, trace_pixel_with, Image, NoObserver, PixelAccumulator,
-    RenderObserver, RenderOptions, RenderStats, TileResult, MAX_DEPTH_LIMIT, TILE_SIZE,
+    RenderObserver, RenderOptions, RenderStats, TileResult, TILE_SIZE,
 };
 pub use scene::PreparedScene;
 

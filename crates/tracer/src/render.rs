@@ -27,10 +27,6 @@ use crate::trace::{PathState, RayCounters, Tracer};
 /// Side of the square tiles that workers take one at a time.
 pub const TILE_SIZE: u32 = 16;
 
-/// The deepest recursion the tracer allows, whatever the options say: each level is a
-/// stack frame, and worker threads have finite stacks. Deeper requests are clamped.
-pub const MAX_DEPTH_LIMIT: u32 = 256;
-
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderOptions {
     pub width: u32,
@@ -38,7 +34,9 @@ pub struct RenderOptions {
     /// At least 1 (0 is treated as 1).
     pub samples_per_pixel: u32,
     /// Rays deeper than this are not traced; the camera ray has depth 0. Clamped to
-    /// [`MAX_DEPTH_LIMIT`].
+    /// [`whitted_ir::limits::MAX_DEPTH`]: each level is a stack frame and worker threads have
+    /// finite stacks (validation and the command line refuse deeper requests; options built
+    /// in code are clamped).
     pub max_depth: u32,
     /// A secondary ray whose path weight is below this on every channel is not traced.
     pub min_weight: f32,
@@ -60,7 +58,7 @@ impl RenderOptions {
     }
 
     pub(crate) fn depth_limit(&self) -> u32 {
-        self.max_depth.min(MAX_DEPTH_LIMIT)
+        self.max_depth.min(whitted_ir::limits::MAX_DEPTH)
     }
 }
 

@@ -15,7 +15,7 @@ use whitted_tracer::testing::{
 use whitted_tracer::{
     render, render_with_pixel_stats, trace_pixel_with, LightSample, NoObserver, NoRecord,
     PixelAccumulator, PixelStats, PreparedScene, RayStart, Recorder, RenderObserver, RenderOptions,
-    Termination, TileResult, Vec3A, MAX_DEPTH_LIMIT,
+    Termination, TileResult, Vec3A,
 };
 
 fn prepare(builder: SceneBuilder) -> PreparedScene {
@@ -335,7 +335,7 @@ fn excessive_depth_is_clamped_not_a_stack_overflow() {
     let (_, stats) = pool
         .install(|| render(&scene, &opts, &NoObserver))
         .unwrap_or_else(|| panic!("cancelled"));
-    assert_eq!(stats.deepest_ray, MAX_DEPTH_LIMIT);
+    assert_eq!(stats.deepest_ray, whitted_ir::limits::MAX_DEPTH);
 }
 
 #[test]

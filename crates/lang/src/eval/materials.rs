@@ -66,6 +66,7 @@ impl<'a> Evaluator<'a> {
                 }
             },
         };
+        self.check_material_budget(body.header, false)?;
         let errors_before = self.error_events;
         self.targets.push(Target::Material(MaterialBuilder {
             material,
@@ -115,6 +116,27 @@ impl<'a> Evaluator<'a> {
         }
     }
 
+    /// Stops evaluation when one more material would pass the materials limit: material
+    /// definitions evaluated (used or not) count, and so do materials in the IR.
+    fn check_material_budget(&mut self, span: Span, in_ir: bool) -> Eval<()> {
+        let limit = self.limits.max_materials;
+        let count = if in_ir {
+            self.scene.materials.len()
+        } else {
+            self.materials.len()
+        };
+        if count < limit {
+            return Ok(());
+        }
+        self.fatal(
+            Diagnostic::error(format!("the materials limit ({limit}) was reached"), span)
+                .with_label("one material too many")
+                .with_hint(
+                    "define a material once, before a loop, and use it by name inside; see \"Limits\" in docs/language.md",
+                ),
+        )
+    }
+
     /// The IR handle of a material, appending it (and its pattern's parts) on first use.
     pub(super) fn lower_material(&mut self, id: MaterialId) -> Eval<Handle<Material>> {
         let index = id as usize;
@@ -134,6 +156,7 @@ impl<'a> Evaluator<'a> {
 
     fn lower_material_inner(&mut self, index: usize) -> Eval<Handle<Material>> {
         let def = self.materials[index].clone();
+        self.check_material_budget(def.span, true)?;
         let mut material = def.material;
         if let Some(pattern_id) = def.pattern {
             let Some(pattern) = self.patterns.get(pattern_id as usize).cloned() else {
@@ -164,6 +187,7 @@ impl<'a> Evaluator<'a> {
         match part {
             PatternPart::Material(id) => self.lower_material(id),
             PatternPart::Color(color) => {
+                self.check_material_budget(span, true)?;
                 let derived = Material {
                     name: host.name.as_ref().map(|n| format!("{n}/{suffix}")),
                     diffuse: whitted_ir::Color::new(color.x, color.y, color.z),

@@ -105,7 +105,8 @@ pub(crate) struct Evaluator<'a> {
     call_depth: usize,
     depth: usize,
     max_depth: usize,
-    iterations: u64,
+    /// Evaluation steps so far: loop iterations (counted when a loop starts) and calls.
+    steps: u64,
     files_run: Vec<bool>,
     camera_span: Option<Span>,
     settings_set: Vec<(crate::schema::Prop, Span)>,
@@ -150,7 +151,7 @@ impl<'a> Evaluator<'a> {
             call_depth: 0,
             depth: 0,
             max_depth,
-            iterations: 0,
+            steps: 0,
             files_run: vec![false; program.files.len()],
             camera_span: None,
             settings_set: Vec::new(),
@@ -421,27 +422,28 @@ impl<'a> Evaluator<'a> {
         let last = self.whole_number(end, "a loop's end")?;
         let stop = if inclusive { last + 1 } else { last };
         let count = (stop - first).max(0) as u64;
-        let limit = self.limits.max_loop_iterations;
-        if self.iterations.saturating_add(count) > limit {
+        let limit = self.limits.max_evaluation_steps;
+        if self.steps.saturating_add(count) > limit {
+            // Refused before the first iteration, so that a loop of a billion costs nothing.
             let range = start.span.to(end.span);
             let mut diagnostic = Diagnostic::error(
                 format!(
-                    "this loop would run {count} times, past the limit of {limit} loop iterations in total"
+                    "this loop would run {count} times, past the evaluation steps limit ({limit} loop iterations and calls in total)"
                 ),
                 range,
             )
             .with_label(format!("{count} iterations"));
-            if self.iterations > 0 {
+            if self.steps > 0 {
                 diagnostic = diagnostic.with_hint(format!(
-                    "{} iterations have already run in other loops",
-                    self.iterations
+                    "{} steps (iterations and calls) have already run",
+                    self.steps
                 ));
             }
             return self.fatal(diagnostic.with_hint(
-                "the limit (`max_loop_iterations`) keeps a mistake from running forever",
+                "the limit keeps a mistake from running for days; see \"Limits\" in docs/language.md",
             ));
         }
-        self.iterations += count;
+        self.steps += count;
         for i in first..stop {
             self.set_slot(slot, Value::Number(i as f64));
             match self.items(&body.items)? {
@@ -541,6 +543,24 @@ impl<'a> Evaluator<'a> {
                 )),
             );
         }
+        if self.steps >= self.limits.max_evaluation_steps {
+            let name = self.name(call.callee.sym);
+            let limit = self.limits.max_evaluation_steps;
+            return self.fatal(
+                Diagnostic::error(
+                    format!(
+                        "the evaluation steps limit ({limit} loop iterations and calls in total) was reached when calling `{name}`"
+                    ),
+                    call.span,
+                )
+                .with_label("one step too many")
+                .with_secondary(function.name.span, "the function")
+                .with_hint(format!(
+                    "does `{name}` call itself more than once per call? The calls then double at every level"
+                )),
+            );
+        }
+        self.steps += 1;
         let base = self.stack.len();
         for arg in &call.args {
             match self.eval(arg) {
@@ -586,12 +606,12 @@ impl<'a> Evaluator<'a> {
         if self.scene.objects.len() >= self.limits.max_objects {
             return self.fatal(
                 Diagnostic::error(
-                    format!("the object limit ({}) was reached", self.limits.max_objects),
+                    format!("the objects limit ({}) was reached", self.limits.max_objects),
                     span,
                 )
                 .with_label("one object too many")
                 .with_hint(
-                    "the limit (`max_objects`) keeps a runaway loop from filling the memory",
+                    "the limit keeps a runaway loop from filling the memory; see \"Limits\" in docs/language.md",
                 ),
             );
         }

@@ -16,10 +16,7 @@ use crate::ast::*;
 use crate::schema::{Arity, LightTag, ObjectTag, Prop};
 use crate::value::Value;
 
-/// The largest image side and sample count the settings accept.
-const MAX_IMAGE_SIDE: f64 = 32768.0;
-const MAX_SAMPLES: f64 = 65536.0;
-const MAX_DEPTH: f64 = 1000.0;
+use whitted_ir::limits;
 
 /// A property's evaluated values: one, or a short list (vertices, coefficients, matrix).
 enum Values {
@@ -307,6 +304,14 @@ impl<'a> Evaluator<'a> {
         name: Option<&'a StrLit>,
         body: &'a Block,
     ) -> Eval<()> {
+        if self.scene.lights.len() >= self.limits.max_lights {
+            let limit = self.limits.max_lights;
+            return self.fatal(
+                Diagnostic::error(format!("the lights limit ({limit}) was reached"), header)
+                    .with_label("one light too many")
+                    .with_hint("every shading point visits every light; see \"Limits\" in docs/language.md"),
+            );
+        }
         let errors_before = self.error_events;
         self.targets.push(Target::Light(LightBuilder::new()));
         let result = self.items(&body.items);
@@ -551,6 +556,26 @@ impl<'a> Evaluator<'a> {
             );
         }
         Ok(Color::new(v.x, v.y, v.z))
+    }
+
+    /// A colour of light (background, ambient): at most the largest intensity limit.
+    fn light_color(&mut self, value: Value, span: Span, prop: Prop) -> Eval<Color> {
+        let color = self.as_color(value, span, prop)?;
+        let largest = color.components().into_iter().fold(0.0, f64::max);
+        if largest > limits::MAX_INTENSITY {
+            return self.fail(
+                Diagnostic::error(
+                    format!(
+                        "`{}` must be at most the largest intensity limit ({:e}), not {largest:e}",
+                        prop.name(),
+                        limits::MAX_INTENSITY
+                    ),
+                    span,
+                )
+                .with_label("too bright"),
+            );
+        }
+        Ok(color)
     }
 
     /// A number within `low..=high` (or `low < x` when `low_open`), with a message naming
@@ -849,28 +874,45 @@ impl<'a> Evaluator<'a> {
         let mut settings = s.clone();
         match prop {
             Prop::Width => {
-                settings.width =
-                    self.whole_in_range(value, value_span, prop, 1.0, MAX_IMAGE_SIDE)?
+                settings.width = self.whole_in_range(
+                    value,
+                    value_span,
+                    prop,
+                    1.0,
+                    limits::MAX_IMAGE_SIDE.into(),
+                )?
             }
             Prop::Height => {
-                settings.height =
-                    self.whole_in_range(value, value_span, prop, 1.0, MAX_IMAGE_SIDE)?
+                settings.height = self.whole_in_range(
+                    value,
+                    value_span,
+                    prop,
+                    1.0,
+                    limits::MAX_IMAGE_SIDE.into(),
+                )?
             }
             Prop::MaxDepth => {
-                settings.max_depth = self.whole_in_range(value, value_span, prop, 0.0, MAX_DEPTH)?
+                settings.max_depth =
+                    self.whole_in_range(value, value_span, prop, 0.0, limits::MAX_DEPTH.into())?
             }
             Prop::Samples => {
-                settings.samples_per_pixel =
-                    self.whole_in_range(value, value_span, prop, 1.0, MAX_SAMPLES)?
+                settings.samples_per_pixel = self.whole_in_range(
+                    value,
+                    value_span,
+                    prop,
+                    1.0,
+                    limits::MAX_SAMPLES_PER_PIXEL.into(),
+                )?
             }
             Prop::MinWeight => {
                 settings.min_weight = self.in_range(value, value_span, prop, 0.0, false, 1.0)?
             }
             Prop::Epsilon => {
-                settings.epsilon = self.in_range(value, value_span, prop, 0.0, true, 1.0)?
+                settings.epsilon =
+                    self.in_range(value, value_span, prop, limits::MIN_SIZE, false, 1.0)?
             }
-            Prop::Background => settings.background = self.as_color(value, value_span, prop)?,
-            Prop::Ambient => settings.ambient = self.as_color(value, value_span, prop)?,
+            Prop::Background => settings.background = self.light_color(value, value_span, prop)?,
+            Prop::Ambient => settings.ambient = self.light_color(value, value_span, prop)?,
             Prop::Shadows => {
                 settings.shadows = if word(property) == Some("filtered") {
                     ShadowMode::Filtered
@@ -879,6 +921,22 @@ impl<'a> Evaluator<'a> {
                 }
             }
             _ => {}
+        }
+        let pixels = u64::from(settings.width) * u64::from(settings.height);
+        if pixels > limits::MAX_PIXELS {
+            return self.fail(
+                Diagnostic::error(
+                    format!(
+                        "a {}x{} image has {pixels} pixels, past the pixels limit ({})",
+                        settings.width,
+                        settings.height,
+                        limits::MAX_PIXELS
+                    ),
+                    value_span,
+                )
+                .with_label("too many pixels with this")
+                .with_hint("about 11585x11585 at most; see \"Limits\" in docs/language.md"),
+            );
         }
         self.scene.settings = settings;
         Ok(())

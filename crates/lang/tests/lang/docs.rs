@@ -93,3 +93,59 @@ fn the_rendered_error_in_the_docs_is_what_the_compiler_prints() {
         .expect("the docs show a rendered error");
     assert_eq!(trim(&shown), trim(&rendered));
 }
+
+/// The Limits table as `whitted_ir::limits::ALL` says it should read.
+fn limits_table() -> String {
+    let mut table =
+        String::from("| Limit | Value | What it bounds |\n|-------|-------|----------------|\n");
+    for limit in whitted_ir::limits::ALL {
+        table.push_str(&format!(
+            "| {} | {} | {} |\n",
+            limit.name, limit.value, limit.what
+        ));
+    }
+    table
+}
+
+#[test]
+fn the_limits_section_lists_every_limit_once_with_its_value() {
+    let markdown = language_md();
+    let begin =
+        "<!-- limits:begin (generated from whitted_ir::limits::ALL; a test checks it) -->\n";
+    let end = "<!-- limits:end -->";
+    let (Some(start), Some(stop)) = (markdown.find(begin), markdown.find(end)) else {
+        panic!("docs/language.md has no limits table between `{begin}` and `{end}`");
+    };
+    let table = &markdown[start + begin.len()..stop];
+    assert_eq!(
+        table,
+        limits_table(),
+        "the limits table in docs/language.md is stale; replace it with:\n{}",
+        limits_table()
+    );
+    // Anywhere else, a limit's value would be a second copy that could go stale: the rest
+    // of the page refers to limits by name.
+    let elsewhere = format!("{}{}", &markdown[..start], &markdown[stop..]);
+    for limit in whitted_ir::limits::ALL {
+        let value = limit.value.to_string();
+        let plain = value.replace(',', "");
+        for written in [value.as_str(), plain.as_str()] {
+            // Small values (1, 256 as a colour channel) are too common to mean the limit.
+            if plain.len() < 4 && !written.contains('e') {
+                continue;
+            }
+            let found = elsewhere.match_indices(written).find(|&(at, _)| {
+                let before = elsewhere[..at].chars().next_back();
+                let after = elsewhere[at + written.len()..].chars().next();
+                let digit =
+                    |c: Option<char>| c.is_some_and(|c| c.is_ascii_digit() || c == '.' || c == ',');
+                !digit(before) && !digit(after)
+            });
+            assert!(
+                found.is_none(),
+                "docs/language.md writes the {} limit's value {written} outside the Limits table",
+                limit.name
+            );
+        }
+    }
+}

@@ -358,11 +358,14 @@ fn a_root_file_that_cannot_be_read_is_a_diagnostic_without_a_span() {
 fn limits_are_errors_that_name_the_limit() {
     let limits = Limits {
         max_objects: 5,
-        max_loop_iterations: 50,
+        max_evaluation_steps: 50,
         max_call_depth: 8,
         max_nesting: 6,
         max_import_depth: 2,
+        max_imports: 10,
         max_source_bytes: 200,
+        max_lights: 3,
+        max_materials: 4,
     };
     let options = CompileOptions {
         limits,

@@ -147,11 +147,14 @@ fn options() -> CompileOptions {
         defines: Vec::new(),
         limits: Limits {
             max_objects: 5_000,
-            max_loop_iterations: 20_000,
+            max_evaluation_steps: 20_000,
             max_call_depth: 64,
             max_nesting: 64,
             max_import_depth: 8,
+            max_imports: 100,
             max_source_bytes: 1 << 20,
+            max_lights: 100,
+            max_materials: 1_000,
         },
     }
 }

@@ -8,8 +8,8 @@ use whitted_lang::{compile_file, render_diagnostics, CompileOptions, SourceLoade
 struct DiskLoader;
 
 impl SourceLoader for DiskLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
-        std::fs::read_to_string(path)
+    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
+        std::fs::read(path)
     }
 }
 

@@ -25,10 +25,13 @@ impl MapLoader {
 }
 
 impl SourceLoader for MapLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
-        self.files.get(path).cloned().ok_or_else(|| {
-            std::io::Error::new(std::io::ErrorKind::NotFound, "No such file or directory")
-        })
+    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
+        self.files
+            .get(path)
+            .map(|text| text.clone().into_bytes())
+            .ok_or_else(|| {
+                std::io::Error::new(std::io::ErrorKind::NotFound, "No such file or directory")
+            })
     }
 }
 
