@@ -6,4 +6,5 @@ mod debug_cli;
 mod debug_tmux;
 mod json_schema;
 mod ray_trees;
+mod reshade;
 mod trace_cli;
