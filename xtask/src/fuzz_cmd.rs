@@ -44,6 +44,10 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
             .duration_since(std::time::UNIX_EPOCH)
             .map_or(1, |d| d.as_nanos() as u64)
     });
+    eprintln!(
+        "fuzz: seed {seed}; if the process aborts, the case it was running is in {}",
+        fuzz::current_case_file().display()
+    );
     let corpus = fuzz::corpus(&root);
     let step = (cases / 20).max(1);
     let summary = fuzz::run_cases(seed, cases, &corpus, |i| {

@@ -64,6 +64,12 @@ fn short_path(file: &str) -> &str {
     }
 }
 
+/// Where the case being run is written first, so that a case that aborts the process (a
+/// stack overflow, the allocator's hard cap) can be found afterwards.
+pub fn current_case_file() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fuzz-current.scene")
+}
+
 /// What a case came to.
 #[derive(Debug)]
 pub enum Verdict {
@@ -81,8 +87,12 @@ pub fn run_case(text: &str) -> Verdict {
     let worker_cancel = Arc::clone(&cancel);
     let owned = text.to_string();
     let before = memory::reset_peak();
+    // A stack overflow aborts the process: leave the case where it can be found.
+    let _ = std::fs::write(current_case_file(), text);
     let spawned = std::thread::Builder::new()
         .name("fuzz case".into())
+        // The stack of a main thread (8 MiB on Linux), where the CLI runs the same code.
+        .stack_size(8 << 20)
         .spawn(move || {
             let observer = case::Cancel(&worker_cancel);
             let result = catch_unwind(AssertUnwindSafe(|| case::run(&owned, &observer)));
