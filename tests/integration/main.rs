@@ -2,6 +2,7 @@
 //! together, the way a user does.
 
 mod cli;
+mod conventions;
 mod debug_cli;
 mod debug_tmux;
 mod json_schema;
