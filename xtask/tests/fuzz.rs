@@ -7,8 +7,8 @@ use xtask::fuzz::{self, memory::CountingAllocator};
 static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 /// Enough to reach every generator branch many times: about 30-50 ms a case in a debug
-/// build on a shared 2-core machine, so 25-40 s.
-const CASES: u64 = 800;
+/// build on a shared 2-core machine, so 20-40 s.
+const CASES: u64 = 600;
 const SEED: u64 = 0x5eed_f022;
 
 fn root() -> std::path::PathBuf {
