@@ -50,7 +50,13 @@ fn c(color: &whitted_ir::Color) -> DVec3 {
     DVec3::new(color.r, color.g, color.b)
 }
 
-/// The medium a ray travels in: one entry per solid it is inside, innermost last.
+/// The medium a ray travels in: one entry per solid it is inside, innermost last. Entering a
+/// solid's front face pushes its material, leaving through a back face pops; the ior pair at a
+/// surface is (the medium's ior, the next one's). This is the model of solids that overlap
+/// only by nesting. Nested media with priorities and coincident surfaces (a glass of water,
+/// being added on another branch) need this extended: the medium is then the
+/// highest-priority solid the point is inside, and a surface between two solids of which the
+/// higher-priority one does not change is no interface at all.
 #[derive(Clone, Debug, Default)]
 struct Media(Vec<Medium>);
 
