@@ -14,6 +14,7 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     let mut seed = None;
     let mut save = false;
     let mut replay_only = false;
+    let mut only_case = None;
     let mut args = args.iter();
     while let Some(arg) = args.next() {
         match arg.as_str() {
@@ -21,6 +22,7 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
             "--seed" => seed = Some(number(args.next(), "--seed")?),
             "--save" => save = true,
             "--replay" => replay_only = true,
+            "--case" => only_case = Some(number(args.next(), "--case")?),
             other => bail!(
                 "unknown argument `{other}` (expected --cases N, --seed S, --save or --replay)"
             ),
@@ -50,6 +52,28 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     );
     let corpus = fuzz::corpus(&root);
     let step = (cases / 20).max(1);
+    if let Some(index) = only_case {
+        let text = fuzz::case_text(seed, index, &corpus);
+        let mut summary = fuzz::Summary {
+            cases: 1,
+            ..fuzz::Summary::default()
+        };
+        match fuzz::run_case(&text) {
+            fuzz::Verdict::Passed(_) => eprintln!("case {index} of seed {seed} passes"),
+            fuzz::Verdict::Failed(f) => {
+                eprintln!("case {index} of seed {seed}: {}: {}", f.class, f.detail);
+                summary.failures.insert(f.class, (1, index, f.detail, text));
+            }
+            fuzz::Verdict::Hung => {
+                eprintln!("case {index} of seed {seed} hangs");
+                summary.hung.push((index, text));
+            }
+        }
+        if save {
+            save_new(&root, seed, &summary)?;
+        }
+        return Ok(());
+    }
     let summary = fuzz::run_cases(seed, cases, &corpus, |i| {
         if (i + 1) % step == 0 {
             eprint!("\r{} / {cases}", i + 1);

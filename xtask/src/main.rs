@@ -24,7 +24,8 @@ commands:
            --scenes DIR --refs DIR for your own folders)
   bench    release build, then time the benchmark scenes (prints Mrays/s)
   fuzz     the whole-pipeline fuzzer: --cases N (1000), --seed S (from the clock),
-           --save (shrink new failures into tests/fuzz-regressions/), --replay";
+           --case K (only case K of the seed), --save (shrink new failures into
+           tests/fuzz-regressions/), --replay (only the regression inputs)";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();

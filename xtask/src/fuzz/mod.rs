@@ -389,7 +389,11 @@ pub fn save_regression(
     std::fs::create_dir_all(&dir)?;
     let next = regressions(root)
         .iter()
-        .filter_map(|(p, _)| p.file_stem()?.to_str()?.parse::<u32>().ok())
+        .filter_map(|(p, _)| {
+            let stem = p.file_stem()?.to_str()?;
+            let digits: String = stem.chars().take_while(char::is_ascii_digit).collect();
+            digits.parse::<u32>().ok()
+        })
         .max()
         .map_or(1, |n| n + 1);
     let path = dir.join(format!("{next:03}.scene"));
