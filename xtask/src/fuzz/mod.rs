@@ -79,9 +79,17 @@ pub enum Verdict {
     Hung,
 }
 
+/// One case at a time per process: the panic record and the memory peak are global, so two
+/// tests running cases at once would blame each other's panics and allocations.
+static ONE_CASE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
 /// Runs one case on a worker thread with the time and memory budgets.
 pub fn run_case(text: &str) -> Verdict {
     install_panic_hook();
+    // A case that panicked while holding the lock poisons nothing we rely on.
+    let _turn = ONE_CASE_AT_A_TIME
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let (send, receive) = mpsc::channel();
     let cancel = Arc::new(AtomicBool::new(false));
     let worker_cancel = Arc::clone(&cancel);
