@@ -2,10 +2,12 @@
 //! together, the way a user does.
 
 mod cli;
+mod conventions;
 mod debug_cli;
 mod debug_tmux;
 mod extremes;
 mod guards;
 mod json_schema;
 mod ray_trees;
+mod reshade;
 mod trace_cli;

@@ -36,7 +36,7 @@ pub fn load(path: &str) -> Loaded {
 }
 
 /// The feature scenes (scenes/*.scene, not the benchmarks), sorted.
-fn feature_scenes() -> Vec<PathBuf> {
+pub fn feature_scenes() -> Vec<PathBuf> {
     let mut scenes: Vec<PathBuf> = std::fs::read_dir("scenes")
         .expect("the scenes directory")
         .filter_map(|entry| entry.ok().map(|e| e.path()))

@@ -3,9 +3,16 @@
 
 mod bench;
 mod ci;
+mod fuzz_cmd;
 mod golden;
 
 use std::process::ExitCode;
+
+use xtask::fuzz::memory::CountingAllocator;
+
+/// Counts live bytes, for the fuzzer's memory budget.
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 const USAGE: &str = "\
 usage: cargo xtask <command>
@@ -15,7 +22,10 @@ commands:
   deps     only the dependency-direction checks
   golden   render the golden scenes and compare with tests/golden/ (--bless to update;
            --scenes DIR --refs DIR for your own folders)
-  bench    release build, then time the benchmark scenes (prints Mrays/s)";
+  bench    release build, then time the benchmark scenes (prints Mrays/s)
+  fuzz     the whole-pipeline fuzzer: --cases N (1000), --seed S (from the clock),
+           --case K (only case K of the seed), --save (shrink new failures into
+           tests/fuzz-regressions/), --replay (only the regression inputs)";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -29,6 +39,7 @@ fn main() -> ExitCode {
         "deps" => ci::check_dependency_directions(),
         "golden" => golden::run(rest),
         "bench" => bench::run(rest),
+        "fuzz" => fuzz_cmd::run(rest),
         "-h" | "--help" | "help" => {
             println!("{USAGE}");
             Ok(())

@@ -1,0 +1,717 @@
+//! An f64 re-shading of recorded ray trees, checked against the rendered pixel: an oracle that
+//! does not trust the tracer's arithmetic (issue 9, deliver 1b).
+//!
+//! From each recorded tree it takes only what a ray tracer cannot avoid deciding for itself:
+//! which surface each ray hit (`t`, point, shading normal, object, material), what each shadow
+//! ray found, and the ray directions. Everything else is recomputed here in f64 with the
+//! textbook formulas, written independently of `crates/tracer`:
+//!
+//! `I = ka·Ia·kd + Σ lights fatt·spot·Ii·S·(kd·(N·L) + ks·(R·V)^n) + kr'·I_r + kt'·I_t`,
+//! times the Beer-Lambert factor `exp(−a·t)` of the medium the ray travels in, where `L`,
+//! `fatt` and `spot` come from the light's position in the IR, `kr'`/`kt'` from the material's
+//! coefficients, Fresnel recomputed from the incidence angle and the ior pair, and the
+//! decisions (a shadow ray is due, total internal reflection, the depth and weight limits)
+//! are made again here. Where a decision sits on a knife edge (f32 and f64 may honestly
+//! disagree), the re-shader follows the recording; everywhere else a different decision is a
+//! failure. The child colours are the re-shader's own, bottom-up: no recorded colour is used.
+
+use whitted_ir::{
+    DMat4, DVec3, Fresnel, Handle, LightKind, Material, ObjectKind, PatternKind, Scene, ShadowMode,
+};
+use whitted_tracer::ray_tree::{trace_pixel, RayNode, SampleChoice, ShadowOutcome};
+use whitted_tracer::{render, NoObserver, RayKind, RenderOptions, Termination};
+
+use crate::ray_trees::{feature_scenes, load, Loaded};
+
+/// How close to the rendered pixel the f64 re-shading must come, relative to the larger of 1
+/// and the pixel's value (per channel).
+///
+/// Why this size: the tracer works in f32 (24-bit mantissa, one rounding ≈ 6e-8 relative).
+/// A node's colour is a sum of a few dozen products, each with about ten roundings (the hit
+/// point, the normal, the normalised light direction, N·L, the attenuation), so one node is
+/// good to about 1e-6 relative. The Phong term `(R·V)^n` multiplies the relative error of
+/// `R·V` by `n` (up to a few hundred in the scenes: ≈ 1e-5), and a tree chains at most ten
+/// levels of such nodes. 1e-4 leaves a margin of about ten over the largest error seen on
+/// correct scenes (printed by the test: about 2e-6 … 1e-5) while any modelling mistake (a
+/// coefficient, a lost or extra term, a wrong Fresnel split) moves pixels by far more.
+const TOLERANCE: f64 = 1e-4;
+
+/// Decisions closer than this to their threshold may come out either way in f32 and f64:
+/// there the re-shader follows the recorded decision (N·L against 0, total internal
+/// reflection against the critical angle, the path weight against `min_weight`, the checker
+/// cell against its edge).
+const KNIFE_EDGE: f64 = 1e-4;
+
+fn v(a: [f32; 3]) -> DVec3 {
+    DVec3::new(f64::from(a[0]), f64::from(a[1]), f64::from(a[2]))
+}
+
+fn c(color: &whitted_ir::Color) -> DVec3 {
+    DVec3::new(color.r, color.g, color.b)
+}
+
+/// The medium a ray travels in: one entry per solid it is inside, innermost last. Entering a
+/// solid's front face pushes its material, leaving through a back face pops; the ior pair at a
+/// surface is (the medium's ior, the next one's). This is the model of solids that overlap
+/// only by nesting. Nested media with priorities and coincident surfaces (a glass of water,
+/// being added on another branch) need this extended: the medium is then the
+/// highest-priority solid the point is inside, and a surface between two solids of which the
+/// higher-priority one does not change is no interface at all.
+#[derive(Clone, Debug, Default)]
+struct Media(Vec<Medium>);
+
+#[derive(Clone, Copy, Debug)]
+struct Medium {
+    ior: f64,
+    absorption: DVec3,
+}
+
+impl Media {
+    fn ior(&self) -> f64 {
+        self.0.last().map_or(1.0, |m| m.ior)
+    }
+    fn absorption(&self) -> DVec3 {
+        self.0.last().map_or(DVec3::ZERO, |m| m.absorption)
+    }
+    /// The ior on the other side of the innermost solid's surface (air outside every solid).
+    fn ior_outside_innermost(&self) -> f64 {
+        let n = self.0.len();
+        if n >= 2 {
+            self.0[n - 2].ior
+        } else {
+            1.0
+        }
+    }
+}
+
+/// Beer-Lambert: `exp(−a·t)` per channel; a channel without absorption transmits fully even
+/// over an infinite distance.
+fn beer_lambert(a: DVec3, t: f64) -> DVec3 {
+    let channel = |a: f64| if a == 0.0 { 1.0 } else { (-a * t).exp() };
+    DVec3::new(channel(a.x), channel(a.y), channel(a.z))
+}
+
+/// Schlick's approximation, taking the cosine on the denser side (the transmitted angle when
+/// light goes into a less dense medium), so that R reaches 1 at the critical angle.
+fn schlick(cos_i: f64, n1: f64, n2: f64) -> f64 {
+    let r0 = ((n1 - n2) / (n1 + n2)).powi(2);
+    let cos = if n1 > n2 {
+        let sin2_t = (n1 / n2).powi(2) * (1.0 - cos_i * cos_i);
+        if sin2_t >= 1.0 {
+            return 1.0;
+        }
+        (1.0 - sin2_t).sqrt()
+    } else {
+        cos_i
+    };
+    r0 + (1.0 - r0) * (1.0 - cos).powi(5)
+}
+
+/// The unpolarised Fresnel reflectance (the mean of the s and p reflectances), for the
+/// `fresnel exact` mode being added on another branch.
+fn fresnel_exact(cos_i: f64, n1: f64, n2: f64) -> f64 {
+    let sin2_t = (n1 / n2).powi(2) * (1.0 - cos_i * cos_i);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let rs = (n1 * cos_i - n2 * cos_t) / (n1 * cos_i + n2 * cos_t);
+    let rp = (n2 * cos_i - n1 * cos_t) / (n2 * cos_i + n1 * cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// Distance attenuation `min(1, 1/(c + l·d + q·d²))`.
+fn fatt(a: &whitted_ir::Attenuation, d: f64) -> f64 {
+    (1.0 / (a.constant + a.linear * d + a.quadratic * d * d)).min(1.0)
+}
+
+/// The smoothstep of the spot cone between the outer and the inner angle.
+fn spot_factor(cos_angle: f64, inner_degrees: f64, outer_degrees: f64) -> f64 {
+    let cos_inner = inner_degrees.to_radians().cos();
+    let cos_outer = outer_degrees.to_radians().cos();
+    if cos_angle >= cos_inner {
+        1.0
+    } else if cos_angle <= cos_outer {
+        0.0
+    } else {
+        let x = (cos_angle - cos_outer) / (cos_inner - cos_outer);
+        x * x * (3.0 - 2.0 * x)
+    }
+}
+
+/// Where the light is seen from `p`: unit direction, distance, fatt and the spot factor.
+fn incidence(kind: &LightKind, p: DVec3) -> (DVec3, f64, f64, f64) {
+    match kind {
+        LightKind::Point {
+            position,
+            attenuation,
+        } => {
+            let d = (*position - p).length();
+            ((*position - p) / d, d, fatt(attenuation, d), 1.0)
+        }
+        LightKind::Directional { direction } => (-direction.normalize(), f64::INFINITY, 1.0, 1.0),
+        LightKind::Spot {
+            position,
+            direction,
+            inner_angle_degrees,
+            outer_angle_degrees,
+            attenuation,
+        } => {
+            let d = (*position - p).length();
+            let l = (*position - p) / d;
+            let cos_angle = (-l).dot(direction.normalize());
+            let spot = spot_factor(cos_angle, *inner_angle_degrees, *outer_angle_degrees);
+            (l, d, fatt(attenuation, d), spot)
+        }
+    }
+}
+
+/// Snell's law for a unit `d` meeting a unit normal `n` that faces it; `None` beyond the
+/// critical angle.
+fn refract(d: DVec3, n: DVec3, n1: f64, n2: f64) -> Option<DVec3> {
+    let eta = n1 / n2;
+    let cos_i = (-d.dot(n)).clamp(0.0, 1.0);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+    (sin2_t <= 1.0).then(|| (eta * d + (eta * cos_i - (1.0 - sin2_t).sqrt()) * n).normalize())
+}
+
+/// One sample re-shaded, and everything found wrong on the way.
+struct Reshader<'a> {
+    scene: &'a Scene,
+    max_depth: u32,
+    min_weight: f64,
+    /// Disagreements in decisions or directions, each with the path of the node.
+    problems: Vec<String>,
+    /// The deepest node whose recorded colour differs from its re-shaded colour.
+    worst_node: Option<(usize, String)>,
+}
+
+impl Reshader<'_> {
+    fn material(&self, index: u32) -> &Material {
+        &self.scene.materials[Handle::from_index(index as usize)]
+    }
+
+    fn problem(&mut self, path: &str, message: String) {
+        self.problems.push(format!("{path}: {message}"));
+    }
+
+    /// The colour `node` returns, in f64. `weight` is its path weight before its own
+    /// absorption, `media` the solids it travels inside.
+    fn shade(&mut self, node: &RayNode, weight: DVec3, media: &Media, path: &str) -> DVec3 {
+        let color = self.shade_inner(node, weight, media, path);
+        let recorded = v(node.color);
+        let error = (color - recorded).abs().max_element() / recorded.max_element().max(1.0);
+        if error > TOLERANCE {
+            let depth = path.matches('/').count();
+            if self.worst_node.as_ref().is_none_or(|(d, _)| depth >= *d) {
+                self.worst_node = Some((
+                    depth,
+                    format!(
+                        "{path} ({} hitting {}): recorded {recorded:?}, f64 {color:?}",
+                        node.kind.name(),
+                        node.hit
+                            .as_ref()
+                            .map_or("nothing", |h| h.object.label.as_str())
+                    ),
+                ));
+            }
+        }
+        color
+    }
+
+    fn shade_inner(&mut self, node: &RayNode, weight: DVec3, media: &Media, path: &str) -> DVec3 {
+        let a = media.absorption();
+        let d = v(node.direction).normalize();
+        let background = c(&self.scene.settings.background);
+        let Some(hit) = &node.hit else {
+            if node.termination != Termination::Miss {
+                self.problem(path, format!("a miss ends with {:?}", node.termination));
+            }
+            return background * beer_lambert(a, f64::INFINITY);
+        };
+        let absorption = beer_lambert(a, f64::from(hit.t));
+        let m = self.material(hit.resolved_material.handle).clone();
+        self.check_pattern(hit, path);
+        let p = v(hit.point);
+        let n = v(hit.shading_normal).normalize();
+        if n.dot(d) > KNIFE_EDGE {
+            self.problem(path, "the shading normal faces away from the ray".into());
+        }
+
+        // Local illumination.
+        let mut local = c(&m.ambient) * c(&self.scene.settings.ambient) * c(&m.diffuse);
+        let lights = node.local.as_ref().map_or(&[][..], |l| &l.lights[..]);
+        if lights.len() != self.scene.lights.len() {
+            self.problem(path, format!("{} light entries", lights.len()));
+        }
+        let kd = c(&m.diffuse);
+        let ks = c(&m.specular);
+        for entry in lights {
+            let light = &self.scene.lights[Handle::from_index(entry.light.handle as usize)];
+            let shadow = entry.shadow_child.and_then(|i| node.children.get(i));
+            // The light is seen from where the shadow ray starts (the point moved off the
+            // surface); without a shadow ray, from the hit point itself.
+            let from = shadow.map_or(p, |s| v(s.origin));
+            let (l, distance, fatt, spot) = incidence(&light.kind, from);
+            let n_dot_l = n.dot(l);
+            let strength = fatt * spot * c(&light.color).max_element();
+            let Some(shadow) = shadow else {
+                // No shadow ray: right when the light cannot count here (or, as a shortcut
+                // some tracers take, when the material has no diffuse or specular term).
+                let counts = n_dot_l > KNIFE_EDGE && strength > KNIFE_EDGE;
+                if counts && (kd != DVec3::ZERO || ks != DVec3::ZERO) {
+                    self.problem(
+                        path,
+                        format!(
+                            "no shadow ray to light #{} though N·L = {n_dot_l}",
+                            entry.light.handle
+                        ),
+                    );
+                }
+                continue;
+            };
+            if n_dot_l < -KNIFE_EDGE || strength == 0.0 {
+                self.problem(
+                    path,
+                    format!(
+                        "a shadow ray to light #{} with N·L = {n_dot_l}",
+                        entry.light.handle
+                    ),
+                );
+                continue;
+            }
+            if (v(shadow.direction) - l).length() > 1e-5 {
+                self.problem(
+                    path,
+                    format!(
+                        "shadow ray direction {:?}, expected {l:?}",
+                        shadow.direction
+                    ),
+                );
+            }
+            if let (Some(max_t), true) = (
+                shadow.shadow.as_ref().and_then(|s| s.max_t),
+                distance.is_finite(),
+            ) {
+                if (f64::from(max_t) - distance).abs() > 1e-5 * distance.max(1.0) {
+                    self.problem(
+                        path,
+                        format!("shadow ray stops at {max_t}, light at {distance}"),
+                    );
+                }
+            }
+            let passed = match shadow.shadow.as_ref() {
+                Some(info) => match info.result {
+                    ShadowOutcome::Unblocked => DVec3::ONE,
+                    ShadowOutcome::Blocked => DVec3::ZERO,
+                    ShadowOutcome::Filtered => {
+                        if self.scene.settings.shadows != ShadowMode::Filtered {
+                            self.problem(
+                                path,
+                                "a filtered shadow in an opaque-shadow scene".into(),
+                            );
+                        }
+                        info.transmittance.map_or(DVec3::ZERO, v)
+                    }
+                },
+                None => {
+                    self.problem(path, "a shadow child without shadow data".into());
+                    DVec3::ZERO
+                }
+            };
+            let light_in = c(&light.color) * fatt * spot * passed;
+            let diffuse = light_in * kd * n_dot_l.max(0.0);
+            let r = -l + 2.0 * n_dot_l * n; // L mirrored about N
+            let r_dot_v = r.dot(-d).max(0.0);
+            let specular = light_in * ks * r_dot_v.powf(m.shininess);
+            local += diffuse + specular;
+        }
+
+        // Secondary rays: what the material asks for, split by Fresnel.
+        let leaf = &self.scene.objects[Handle::from_index(hit.leaf.handle as usize)];
+        let solid = match &leaf.kind {
+            ObjectKind::Shape { shape } => shape.is_solid(),
+            _ => true,
+        };
+        let kr = c(&m.reflective);
+        let kt = c(&m.transmissive);
+        let cos_i = (-d).dot(n).clamp(0.0, 1.0);
+        // The media on each side: entering a solid adds it, leaving removes it.
+        let (n1, n2, inside) = if !solid {
+            (media.ior(), media.ior(), media.clone())
+        } else if hit.front_face {
+            let mut inside = media.clone();
+            inside.0.push(Medium {
+                ior: m.ior,
+                absorption: c(&m.absorption),
+            });
+            (media.ior(), m.ior, inside)
+        } else {
+            let mut outside = media.clone();
+            outside.0.pop();
+            (m.ior, media.ior_outside_innermost(), outside)
+        };
+        let mut reflect = kr;
+        let mut transmit = DVec3::ZERO;
+        let mut refracted = None;
+        let mut tir = false;
+        if kt != DVec3::ZERO {
+            let sin2_t = (n1 / n2).powi(2) * (1.0 - cos_i * cos_i);
+            let recorded_tir = node
+                .skipped
+                .iter()
+                .any(|s| s.reason == Termination::TotalInternalReflection)
+                || node
+                    .child(RayKind::Reflected)
+                    .and_then(|r| r.interface.as_ref())
+                    .is_some_and(|i| i.total_internal_reflection);
+            tir = if (sin2_t - 1.0).abs() < KNIFE_EDGE {
+                recorded_tir
+            } else {
+                sin2_t > 1.0
+            };
+            if tir != recorded_tir {
+                self.problem(
+                    path,
+                    format!(
+                        "total internal reflection: recorded {recorded_tir}, sin²θt = {sin2_t}"
+                    ),
+                );
+            }
+            let r = match m.fresnel {
+                Fresnel::Off => None,
+                Fresnel::Schlick => Some(schlick(cos_i, n1, n2)),
+            };
+            if tir {
+                // Textbook: with Fresnel everything reflects (R = 1); without it the
+                // transmitted term is dropped.
+                if r.is_some() {
+                    reflect = kr + kt;
+                }
+            } else {
+                refracted = refract(d, n, n1, n2);
+                match r {
+                    Some(r) => {
+                        reflect = kr + kt * r;
+                        transmit = kt * (1.0 - r);
+                    }
+                    None => transmit = kt,
+                }
+            }
+        }
+
+        let carried = weight * absorption;
+        let mut color = local;
+        let mut traced_any = false;
+        let mut first_skip = None;
+        let secondaries = [
+            (
+                RayKind::Reflected,
+                reflect,
+                Some(d - 2.0 * d.dot(n) * n),
+                media.clone(),
+            ),
+            (RayKind::Transmitted, transmit, refracted, inside),
+        ];
+        for (kind, coefficient, direction, child_media) in secondaries {
+            if kind == RayKind::Transmitted && tir {
+                first_skip = first_skip.or(Some(Termination::TotalInternalReflection));
+            }
+            let recorded = node.child(kind);
+            let skipped = node.skipped.iter().find(|s| s.kind == kind);
+            if coefficient == DVec3::ZERO {
+                if let Some(recorded) = recorded {
+                    self.problem(
+                        path,
+                        format!(
+                            "a {} ray with coefficient {:?}, expected none",
+                            kind.name(),
+                            recorded.coefficient
+                        ),
+                    );
+                }
+                continue;
+            }
+            let child_weight = carried * coefficient;
+            let verdict = if node.depth + 1 > self.max_depth {
+                Some(Termination::MaxDepth)
+            } else if (child_weight.max_element() - self.min_weight).abs()
+                < KNIFE_EDGE * self.min_weight
+            {
+                // On the edge: follow the recording.
+                skipped.map(|s| s.reason)
+            } else if child_weight.max_element() < self.min_weight {
+                Some(Termination::WeightCutoff)
+            } else {
+                None
+            };
+            match (verdict, recorded) {
+                (None, Some(child)) => {
+                    traced_any = true;
+                    if let Some(expected) = direction {
+                        if (v(child.direction) - expected).length() > 1e-4 {
+                            self.problem(
+                                path,
+                                format!(
+                                    "{} direction {:?}, expected {expected:?}",
+                                    kind.name(),
+                                    child.direction
+                                ),
+                            );
+                        }
+                    }
+                    let child_path = format!("{path}/{}", kind.name());
+                    let returned = self.shade(child, child_weight, &child_media, &child_path);
+                    color += coefficient * returned;
+                }
+                (Some(reason), None) => {
+                    first_skip = first_skip.or(Some(reason));
+                    if skipped.map(|s| s.reason) != Some(reason) {
+                        self.problem(
+                            path,
+                            format!("{} ray should be skipped for {reason:?}", kind.name()),
+                        );
+                    }
+                }
+                (None, None) => self.problem(
+                    path,
+                    format!(
+                        "no {} ray, expected one with coefficient {coefficient:?}",
+                        kind.name()
+                    ),
+                ),
+                (Some(reason), Some(_)) => self.problem(
+                    path,
+                    format!(
+                        "a {} ray was traced though it should be skipped for {reason:?}",
+                        kind.name()
+                    ),
+                ),
+            }
+        }
+        let expected_termination = if traced_any {
+            Termination::NotEnded
+        } else {
+            first_skip.unwrap_or(Termination::Absorbed)
+        };
+        if node.termination != expected_termination {
+            self.problem(
+                path,
+                format!(
+                    "ends with {:?}, expected {expected_termination:?}",
+                    node.termination
+                ),
+            );
+        }
+        color * absorption
+    }
+
+    /// Recomputes which of a pattern's two materials covers the hit point (away from cell
+    /// edges) from the leaf's transform and the pattern's own, in f64.
+    fn check_pattern(&mut self, hit: &whitted_tracer::ray_tree::HitInfo, path: &str) {
+        let given = self.material(hit.material.handle);
+        let Some(pattern) = &given.pattern else {
+            if hit.resolved_material.handle != hit.material.handle {
+                self.problem(path, "a resolved material without a pattern".into());
+            }
+            return;
+        };
+        let leaf = &self.scene.objects[Handle::from_index(hit.leaf.handle as usize)];
+        let object_from_world: DMat4 = leaf.world_from_object.inverse();
+        let q = (pattern.pattern_from_object * object_from_world).transform_point3(v(hit.point))
+            / pattern.scale;
+        let coordinates: &[f64] = match pattern.kind {
+            PatternKind::Checker => &[q.x, q.y, q.z],
+            PatternKind::Stripes => &[q.x],
+        };
+        // The hit point is f32: near a cell edge the cell is not decidable from it.
+        if coordinates
+            .iter()
+            .any(|x| (x - x.round()).abs() < 1e-3 * x.abs().max(1.0))
+        {
+            return;
+        }
+        let parity: i64 = coordinates.iter().map(|x| x.floor() as i64).sum();
+        let expected = if parity.rem_euclid(2) == 0 {
+            pattern.a
+        } else {
+            pattern.b
+        };
+        if expected.index() != hit.resolved_material.handle as usize {
+            self.problem(
+                path,
+                format!(
+                    "pattern cell at {q:?} gives material #{}, recorded #{}",
+                    expected.index(),
+                    hit.resolved_material.handle
+                ),
+            );
+        }
+    }
+}
+
+/// What re-shading one pixel found.
+struct PixelVerdict {
+    error: f64,
+    problems: Vec<String>,
+    worst_node: Option<String>,
+}
+
+fn reshade_pixel(
+    loaded: &Loaded,
+    options: &RenderOptions,
+    x: u32,
+    y: u32,
+    rendered: [f32; 3],
+) -> PixelVerdict {
+    let tree = trace_pixel(
+        &loaded.prepared,
+        &loaded.scene,
+        options,
+        x,
+        y,
+        SampleChoice::All,
+    )
+    .unwrap_or_else(|error| panic!("{error}"));
+    let mut reshader = Reshader {
+        scene: &loaded.scene,
+        max_depth: tree.max_depth,
+        min_weight: f64::from(tree.min_weight),
+        problems: Vec::new(),
+        worst_node: None,
+    };
+    let mut sum = DVec3::ZERO;
+    for sample in &tree.samples {
+        let path = format!("sample {}", sample.index);
+        sum += reshader.shade(&sample.root, DVec3::ONE, &Media::default(), &path);
+    }
+    let mean = sum / tree.samples.len().max(1) as f64;
+    let rendered = v(rendered);
+    PixelVerdict {
+        error: (mean - rendered).abs().max_element() / rendered.max_element().max(1.0),
+        problems: reshader.problems,
+        worst_node: reshader.worst_node.map(|(_, s)| s),
+    }
+}
+
+/// Re-shades every pixel of a small render of `path`; returns the failures (one line each,
+/// at most a few per scene) and the largest relative error seen.
+fn check_scene(path: &str, width: u32, height: u32) -> (Vec<String>, f64, usize) {
+    let loaded = load(path);
+    let options = RenderOptions {
+        width,
+        height,
+        ..RenderOptions::from_settings(&loaded.scene.settings)
+    };
+    let Some((image, _)) = render(&loaded.prepared, &options, &NoObserver) else {
+        panic!("{path}: the render was cancelled");
+    };
+    let mut failures = Vec::new();
+    let mut failing_pixels = 0;
+    let mut largest = 0.0f64;
+    for y in 0..height {
+        for x in 0..width {
+            let rendered = image.pixel(x, y).unwrap_or([f32::NAN; 3]);
+            let verdict = reshade_pixel(&loaded, &options, x, y, rendered);
+            largest = largest.max(verdict.error);
+            if verdict.error > TOLERANCE || !verdict.problems.is_empty() || verdict.error.is_nan() {
+                failing_pixels += 1;
+                if failures.len() < 3 {
+                    failures.push(format!(
+                        "{path} pixel ({x}, {y}): relative error {:.3e}; {}; deepest wrong node: {}",
+                        verdict.error,
+                        if verdict.problems.is_empty() {
+                            "no wrong decision".to_string()
+                        } else {
+                            verdict.problems[..verdict.problems.len().min(3)].join("; ")
+                        },
+                        verdict.worst_node.unwrap_or_else(|| "none".into())
+                    ));
+                }
+            }
+        }
+    }
+    (failures, largest, failing_pixels)
+}
+
+#[test]
+fn every_scene_re_shaded_in_f64_from_its_ray_trees_matches_the_render() {
+    let scenes = feature_scenes();
+    assert!(scenes.len() >= 15, "found {} scenes", scenes.len());
+    let mut report = Vec::new();
+    let mut failures = Vec::new();
+    for scene in &scenes {
+        let name = scene.display().to_string();
+        let (mut found, largest, failing) = check_scene(&name, 40, 30);
+        report.push(format!(
+            "{name}: largest error {largest:.2e}, {failing} of 1200 pixels fail"
+        ));
+        failures.append(&mut found);
+    }
+    eprintln!("{}", report.join("\n"));
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The oracle must be able to fail: re-shading a tree against a pixel of another colour, or
+/// with the textbook's coefficient changed, is caught.
+#[test]
+fn the_re_shader_catches_a_wrong_pixel_and_a_wrong_coefficient() {
+    let loaded = load("scenes/whitted.scene");
+    let options = RenderOptions {
+        width: 40,
+        height: 30,
+        ..RenderOptions::from_settings(&loaded.scene.settings)
+    };
+    let Some((image, _)) = render(&loaded.prepared, &options, &NoObserver) else {
+        panic!("cancelled");
+    };
+    let mut caught_pixel = 0;
+    let mut caught_material = 0;
+    let mut lit = 0;
+    // A scene whose glass is a little less transparent than the one rendered.
+    let mut altered = loaded.scene.scene().clone();
+    for i in 0..altered.materials.len() {
+        let material = &mut altered.materials[Handle::from_index(i)];
+        material.transmissive.g *= 0.99;
+        material.diffuse.r *= 0.99;
+    }
+    let altered = Loaded {
+        scene: whitted_ir::validate(altered).unwrap_or_else(|_| panic!("invalid")),
+        prepared: whitted_tracer::PreparedScene::new(&loaded.scene),
+    };
+    for y in (0..30).step_by(3) {
+        for x in (0..40).step_by(3) {
+            let rendered = image.pixel(x, y).unwrap_or([f32::NAN; 3]);
+            if v(rendered).max_element() < 0.05 {
+                continue;
+            }
+            lit += 1;
+            let nudged = rendered.map(|c| c + 1e-3);
+            if reshade_pixel(&loaded, &options, x, y, nudged).error > TOLERANCE {
+                caught_pixel += 1;
+            }
+            let verdict = reshade_pixel(&altered, &options, x, y, rendered);
+            if verdict.error > TOLERANCE {
+                caught_material += 1;
+            }
+        }
+    }
+    assert!(lit > 50, "{lit}");
+    assert_eq!(caught_pixel, lit, "a pixel 1e-3 off must be caught");
+    assert!(caught_material > lit / 2, "{caught_material} of {lit}");
+}
+
+#[test]
+fn fresnel_formulas_agree_at_normal_incidence_and_reach_one_at_the_critical_angle() {
+    let r0 = ((1.5f64 - 1.0) / 2.5).powi(2);
+    assert!((schlick(1.0, 1.0, 1.5) - r0).abs() < 1e-12);
+    assert!((fresnel_exact(1.0, 1.0, 1.5) - r0).abs() < 1e-12);
+    let critical = (1.0f64 / 1.5).asin();
+    let just_beyond = (critical + 1e-6).cos();
+    assert_eq!(schlick(just_beyond, 1.5, 1.0), 1.0);
+    assert_eq!(fresnel_exact(just_beyond, 1.5, 1.0), 1.0);
+    // At 60° into glass the exact value is about 0.0898; Schlick's is close to it.
+    let cos60 = 60f64.to_radians().cos();
+    assert!((fresnel_exact(cos60, 1.0, 1.5) - 0.0898).abs() < 1e-3);
+    assert!((schlick(cos60, 1.0, 1.5) - 0.0898).abs() < 2e-2);
+}
