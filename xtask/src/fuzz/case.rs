@@ -24,11 +24,14 @@ const MAX_DEPTH: u32 = 10;
 pub fn limits() -> Limits {
     Limits {
         max_objects: 20_000,
-        max_loop_iterations: 50_000,
+        max_evaluation_steps: 200_000,
         max_call_depth: 64,
         max_nesting: 256,
         max_import_depth: 8,
+        max_imports: 16,
         max_source_bytes: 1 << 20,
+        max_lights: 64,
+        max_materials: 20_000,
     }
 }
 
@@ -36,11 +39,11 @@ pub fn limits() -> Limits {
 struct Files;
 
 impl SourceLoader for Files {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
+    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
         let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
         match name {
-            "materials.scene" => Ok("material chrome { reflective 0.8 specular 1 }\n".into()),
-            "loop.scene" => Ok("import \"loop.scene\"\nsphere { }\n".into()),
+            "materials.scene" => Ok(b"material chrome { reflective 0.8 specular 1 }\n".to_vec()),
+            "loop.scene" => Ok(b"import \"loop.scene\"\nsphere { }\n".to_vec()),
             _ => Err(std::io::Error::new(
                 std::io::ErrorKind::NotFound,
                 "no such file",
