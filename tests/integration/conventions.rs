@@ -10,7 +10,7 @@ use whitted_tracer::{render, NoObserver, PreparedScene, RenderOptions};
 struct NoImports;
 
 impl SourceLoader for NoImports {
-    fn load(&mut self, path: &Path) -> std::io::Result<String> {
+    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
         Err(std::io::Error::other(format!(
             "no imports here: {}",
             path.display()
