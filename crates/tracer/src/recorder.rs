@@ -31,7 +31,7 @@
 
 use glam::Vec3A;
 use serde::Serialize;
-use whitted_ir::{Handle, Light, Material, Object};
+use whitted_ir::{Fresnel, Handle, Light, Material, Object};
 
 /// What a ray is for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -66,7 +66,8 @@ pub enum Termination {
     MaxDepth,
     /// A secondary ray's path weight was below the minimum on every channel.
     WeightCutoff,
-    /// Refraction was impossible; the transmitted weight went to the reflected ray.
+    /// Refraction was impossible. Without Fresnel the transmitted term is dropped; with
+    /// Fresnel (R = 1) it went to the reflected ray.
     TotalInternalReflection,
     /// The surface neither reflects nor transmits: only its local colour returns.
     Absorbed,
@@ -138,7 +139,10 @@ pub struct Interface {
     /// Whether the incoming ray was entering a solid (it hit the outside of a solid's
     /// surface; always false on thin surfaces).
     pub entering: bool,
-    /// Schlick's reflectance `R` when the material asks for Fresnel (transmission is `1 − R`).
+    /// The material's Fresnel model.
+    pub fresnel: Fresnel,
+    /// The Fresnel reflectance `R` (Schlick's or the exact one) when the material asks for
+    /// Fresnel (transmission is `1 − R`; `R` is 1 on total internal reflection).
     pub fresnel_reflectance: Option<f32>,
     pub total_internal_reflection: bool,
 }

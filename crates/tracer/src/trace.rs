@@ -10,10 +10,12 @@
 //! against air: the ior pair at a surface is (1.0, ior) entering and (ior, 1.0) leaving.
 
 use glam::Vec3A;
-use whitted_ir::ShadowMode;
+use whitted_ir::{Fresnel, ShadowMode};
 
 use crate::material::PreparedMaterial;
-use crate::optics::{beer_lambert, max_channel, reflect, refract, schlick, surface_offset};
+use crate::optics::{
+    beer_lambert, fresnel_exact, max_channel, reflect, refract, schlick, surface_offset,
+};
 use crate::query::{Scratch, Shadow};
 use crate::ray::Ray;
 use crate::recorder::{
@@ -219,11 +221,17 @@ impl<'a> Tracer<'a> {
         }
         if split.interface.total_internal_reflection {
             let reason = Termination::TotalInternalReflection;
+            // What the impossible transmission loses: all of `kt` without Fresnel (dropped),
+            // nothing with Fresnel (R = 1 gave it to the reflected ray).
+            let lost = match m.fresnel {
+                Fresnel::Off => m.transmissive,
+                Fresnel::Schlick | Fresnel::Exact => Vec3A::ZERO,
+            };
             rec.secondary_skipped(&SkippedRay {
                 kind: RayKind::Transmitted,
                 depth,
-                weight: Vec3A::ZERO,
-                coefficient: Vec3A::ZERO,
+                weight: carried * lost,
+                coefficient: lost,
                 reason,
             });
             outcome.skipped(reason);
@@ -438,7 +446,7 @@ impl Outcome {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Split {
     pub interface: Interface,
-    /// `kr`, plus `kt·R` with Fresnel, plus all of `kt` on total internal reflection.
+    /// `kr`, plus `kt·R` with Fresnel (R = 1 on total internal reflection).
     pub reflect: Vec3A,
     /// `kt`, times `1 − R` with Fresnel; zero on total internal reflection.
     pub transmit: Vec3A,
@@ -462,6 +470,7 @@ pub fn split_weights(
             cos_incidence,
             ior: None,
             entering: solid && front_face,
+            fresnel: m.fresnel,
             fresnel_reflectance: None,
             total_internal_reflection: false,
         },
@@ -481,19 +490,31 @@ pub fn split_weights(
     match refract(d, n, from, to) {
         None => {
             split.interface.total_internal_reflection = true;
-            if m.schlick {
-                split.interface.fresnel_reflectance = Some(1.0);
+            match m.fresnel {
+                // The textbook model (MIT 6.837): refraction is impossible, so the
+                // transmitted term is dropped and only `kr` reflects. Handing `kt` to the
+                // reflected ray instead made glass with kr + kt > 1 gain light per bounce.
+                Fresnel::Off => {}
+                // Fresnel reflects R = 1 of the transmitted share: `kt·R` joins `kr`.
+                Fresnel::Schlick | Fresnel::Exact => {
+                    split.interface.fresnel_reflectance = Some(1.0);
+                    split.reflect = m.reflective + m.transmissive;
+                }
             }
-            split.reflect = m.reflective + m.transmissive;
         }
         Some(direction) => {
-            if m.schlick {
-                let r = schlick(cos_incidence, from, to);
-                split.interface.fresnel_reflectance = Some(r);
-                split.reflect = m.reflective + m.transmissive * r;
-                split.transmit = m.transmissive * (1.0 - r);
-            } else {
-                split.transmit = m.transmissive;
+            let reflectance = match m.fresnel {
+                Fresnel::Off => None,
+                Fresnel::Schlick => Some(schlick(cos_incidence, from, to)),
+                Fresnel::Exact => Some(fresnel_exact(cos_incidence, from, to)),
+            };
+            match reflectance {
+                Some(r) => {
+                    split.interface.fresnel_reflectance = Some(r);
+                    split.reflect = m.reflective + m.transmissive * r;
+                    split.transmit = m.transmissive * (1.0 - r);
+                }
+                None => split.transmit = m.transmissive,
             }
             split.refracted = Some(direction);
         }

@@ -20,6 +20,8 @@ use crate::value::Value;
 const MAX_IMAGE_SIDE: f64 = 32768.0;
 const MAX_SAMPLES: f64 = 65536.0;
 const MAX_DEPTH: f64 = 1000.0;
+/// The largest nested-media priority a material may have (any order of a few solids fits).
+const MAX_PRIORITY: f64 = 1000.0;
 
 /// A property's evaluated values: one, or a short list (vertices, coefficients, matrix).
 enum Values {
@@ -1003,6 +1005,10 @@ impl<'a> Evaluator<'a> {
             Prop::Ior => {
                 number = self.in_range(value, value_span, prop, 0.0, true, f64::INFINITY)?
             }
+            Prop::Priority => {
+                number =
+                    f64::from(self.whole_in_range(value, value_span, prop, 0.0, MAX_PRIORITY)?)
+            }
             _ => {}
         }
         let Some(Target::Material(b)) = self.targets.last_mut() else {
@@ -1024,12 +1030,13 @@ impl<'a> Evaluator<'a> {
             Prop::Shininess => m.shininess = number,
             Prop::Ior => m.ior = number,
             Prop::Fresnel => {
-                m.fresnel = if word(property) == Some("schlick") {
-                    whitted_ir::Fresnel::Schlick
-                } else {
-                    whitted_ir::Fresnel::Off
+                m.fresnel = match word(property) {
+                    Some("schlick") => whitted_ir::Fresnel::Schlick,
+                    Some("exact") => whitted_ir::Fresnel::Exact,
+                    _ => whitted_ir::Fresnel::Off,
                 }
             }
+            Prop::Priority => m.priority = number as u32,
             _ => {}
         }
         Ok(())

@@ -110,7 +110,9 @@ pub struct InterfaceInfo {
     pub ior: Option<[f32; 2]>,
     /// Whether the incoming ray hit the outside of a solid (always false on thin surfaces).
     pub entering: bool,
-    /// Schlick's `R` when the material uses Fresnel.
+    /// The material's Fresnel model: `off`, `schlick` or `exact`.
+    pub fresnel: whitted_ir::Fresnel,
+    /// The Fresnel `R` (Schlick's or the exact one) when the material uses Fresnel.
     pub fresnel_reflectance: Option<f32>,
     /// `1 − R` when the material uses Fresnel.
     pub fresnel_transmittance: Option<f32>,
@@ -273,8 +275,9 @@ pub struct Blocker {
 pub struct SkippedInfo {
     pub kind: RayKind,
     pub depth: u32,
-    /// The path weight it would have had (zero for a transmission lost to total internal
-    /// reflection, whose weight went to the reflected ray).
+    /// The path weight it would have had. On total internal reflection, the weight lost:
+    /// `kt` times the parent's weight without Fresnel (the transmitted term is dropped), zero
+    /// with Fresnel (R = 1: the weight went to the reflected ray).
     pub weight: [f32; 3],
     pub coefficient: [f32; 3],
     /// `max_depth`, `weight_cutoff` or `total_internal_reflection`.

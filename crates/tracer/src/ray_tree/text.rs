@@ -131,10 +131,15 @@ impl Printer {
             lines.push(format!("local      {}", self.color(local.total)));
         }
         for skipped in &node.skipped {
-            // A transmission lost to total internal reflection has no weight of its own: it
+            // A transmission lost to total internal reflection: dropped (no Fresnel), or
             // went to the reflected ray.
             let weight = match skipped.reason {
-                Termination::TotalInternalReflection => String::new(),
+                Termination::TotalInternalReflection if skipped.coefficient == [0.0; 3] => {
+                    " (Fresnel R = 1: the transmission went to the reflected ray)".to_string()
+                }
+                Termination::TotalInternalReflection => {
+                    format!(" (weight {} dropped)", self.color(skipped.weight))
+                }
                 _ => format!(" (weight {})", self.color(skipped.weight)),
             };
             lines.push(format!(
@@ -268,7 +273,12 @@ fn interface_text(interface: &InterfaceInfo) -> String {
         interface.fresnel_reflectance,
         interface.fresnel_transmittance,
     ) {
-        let _ = write!(text, ", Fresnel R {} T {}", num(r), num(t));
+        // Schlick's is the common case and keeps the short form.
+        let model = match interface.fresnel {
+            whitted_ir::Fresnel::Exact => "exact ",
+            _ => "",
+        };
+        let _ = write!(text, ", {model}Fresnel R {} T {}", num(r), num(t));
     }
     if interface.total_internal_reflection {
         text.push_str(", total internal reflection");

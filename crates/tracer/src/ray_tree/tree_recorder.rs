@@ -230,6 +230,7 @@ fn interface_info(interface: &Interface) -> InterfaceInfo {
         cos_incidence: interface.cos_incidence,
         ior: interface.ior.map(|(from, to)| [from, to]),
         entering: interface.entering,
+        fresnel: interface.fresnel,
         fresnel_reflectance: interface.fresnel_reflectance,
         fresnel_transmittance: interface.fresnel_reflectance.map(|r| 1.0 - r),
         total_internal_reflection: interface.total_internal_reflection,

@@ -3,6 +3,7 @@
 
 mod acne;
 mod csg_scenes;
+mod energy;
 mod optics_scenes;
 
 use glam::Vec3A;
