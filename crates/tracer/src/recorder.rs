@@ -233,8 +233,11 @@ pub struct LightSample {
     /// The spot cone factor (1 for other lights).
     pub spot: f32,
     /// `None` when no shadow ray was needed: the light is behind the surface, outside its
-    /// cone, or too far to count.
+    /// cone, or too far to count, or the material is unshaded (see `unshaded`).
     pub shadow_ray: Option<ShadowRay>,
+    /// The light faces the surface, but no shadow ray was cast because the material has no
+    /// diffuse and no specular colour: the light could add nothing.
+    pub unshaded: bool,
     /// `fatt·spot·Ii·shadow·kd·(N·L)`, as added to the colour.
     pub diffuse: Vec3A,
     /// `fatt·spot·Ii·shadow·ks·(R·V)^n`, as added to the colour.

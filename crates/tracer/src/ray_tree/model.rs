@@ -236,6 +236,9 @@ pub enum Visibility {
     /// No shadow ray was cast: the light is behind the surface (`N·L <= 0`), outside its
     /// cone, too far to count, or black.
     NotFacing,
+    /// No shadow ray was cast: the light faces the surface, but the material has no diffuse
+    /// and no specular colour, so it could add nothing.
+    Unshaded,
 }
 
 /// What a shadow ray was cast for and what it found.

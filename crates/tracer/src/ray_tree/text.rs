@@ -198,6 +198,9 @@ impl Printer {
     fn light_line(&self, light: &LightContribution) -> String {
         let shadow = match (light.visibility, light.shadow_child) {
             (Visibility::NotFacing, _) => "no shadow ray".to_string(),
+            (Visibility::Unshaded, _) => {
+                "no shadow ray (no diffuse or specular colour to light)".to_string()
+            }
             (visibility, Some(index)) => {
                 format!("shadow ray {index}: {}", visibility_text(visibility))
             }
@@ -310,6 +313,7 @@ fn visibility_text(visibility: Visibility) -> &'static str {
         Visibility::Filtered => "filtered",
         Visibility::Blocked => "blocked",
         Visibility::NotFacing => "not facing",
+        Visibility::Unshaded => "unshaded",
     }
 }
 

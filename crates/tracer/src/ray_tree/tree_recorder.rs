@@ -106,6 +106,7 @@ impl Recorder for TreeRecorder<'_> {
         let light = light_ref(scene, sample.light);
         let mut shadow_child = None;
         let visibility = match &sample.shadow_ray {
+            None if sample.unshaded => Visibility::Unshaded,
             None => Visibility::NotFacing,
             Some(shadow_ray) => {
                 let (result, blocker, transmittance, filters, passed, termination) =

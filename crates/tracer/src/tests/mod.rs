@@ -5,6 +5,7 @@ mod acne;
 mod csg_scenes;
 mod energy;
 mod optics_scenes;
+mod shadow_rays;
 
 use glam::Vec3A;
 
