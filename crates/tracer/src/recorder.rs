@@ -204,7 +204,9 @@ pub enum ShadowResult {
         leaf: Handle<Object>,
         t: f32,
     },
-    /// Filtered shadows: the light passed through transmissive objects only.
+    /// Filtered shadows: the light passed through transmissive surfaces only, filtered by
+    /// `kt` at each (`blockers` counts surfaces: a solid filters where the ray enters and
+    /// again where it leaves).
     Filtered {
         transmittance: Vec3A,
         blockers: u32,

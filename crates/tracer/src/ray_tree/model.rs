@@ -252,7 +252,8 @@ pub struct ShadowInfo {
     pub blocker: Option<Blocker>,
     /// The product of the transmissive colours passed through, on `filtered` results.
     pub transmittance: Option<[f32; 3]>,
-    /// How many transmissive objects it passed through, on `filtered` results.
+    /// How many transmissive surfaces it crossed, on `filtered` results (a solid counts
+    /// twice: where the ray enters it and where it leaves).
     pub filters: Option<u32>,
 }
 

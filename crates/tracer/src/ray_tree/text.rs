@@ -230,7 +230,7 @@ impl Printer {
             (ShadowOutcome::Unblocked, _) => "unblocked".to_string(),
             (ShadowOutcome::Filtered, _) => {
                 let through = shadow.filters.map_or(String::new(), |n| {
-                    format!(" through {}", plural(n, "transmissive object"))
+                    format!(" through {}", plural(n, "transmissive surface"))
                 });
                 let transmittance = shadow.transmittance.map_or(String::new(), |t| {
                     format!(", transmittance {}", self.color(t))
