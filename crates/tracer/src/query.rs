@@ -348,6 +348,41 @@ impl PreparedScene {
         }
     }
 
+    /// Every crossing of a solid's surface strictly inside `(t − window, t + window)` (and
+    /// beyond `tmin`), for nested media: surfaces that close together are crossed as one.
+    /// `found` gets each crossing and returns whether to go on.
+    pub(crate) fn solid_crossings_near(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        t: f32,
+        window: f32,
+        scratch: &mut Scratch,
+        mut found: impl FnMut(Hit) -> bool,
+    ) {
+        let Scratch { csg, bvh_stack } = scratch;
+        let (low, high) = ((t - window).max(tmin), t + window);
+        self.visit(ray, low, high, bvh_stack, |item_ref, item, _| {
+            let mut from = low;
+            while let Some((t, leaf, part, flip)) = item_hit(item, ray, from, high, csg) {
+                if item.leaf(leaf).geometry.is_solid() {
+                    let hit = Hit {
+                        t,
+                        item: item_ref,
+                        leaf,
+                        part,
+                        flip,
+                    };
+                    if !found(hit) {
+                        return Step::Stop;
+                    }
+                }
+                from = t;
+            }
+            Step::Continue
+        });
+    }
+
     /// Full surface data for a hit along `ray`.
     #[inline(always)]
     pub(crate) fn surface(&self, ray: &Ray, hit: &Hit) -> Surface<'_> {

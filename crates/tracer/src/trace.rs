@@ -4,19 +4,23 @@
 //! `I = ka·Ia·kd + Σ visible lights fatt·spot·Ii·(kd·(N·L) + ks·(R·V)^n) + kr·I_r + kt·I_t`,
 //! with Beer-Lambert absorption on rays travelling inside an absorbing solid.
 //!
-//! Media: a transmitted ray that enters a solid travels in that solid's material; one that
-//! leaves a solid travels in air (ior 1.0, no absorption); a reflected ray stays where its
-//! parent was. Nested media (glass in water) are therefore approximated as each solid
-//! against air: the ior pair at a surface is (1.0, ior) entering and (ior, 1.0) leaving.
+//! Media (`media.rs`): every ray carries the stack of solids it is inside. The ior pair at a
+//! solid's surface is (the medium before, the medium beyond): (1.0, 1.5) from air into
+//! glass, (1.5, 1.33) from glass into water. A surface that leaves the current medium
+//! unchanged (a lower-priority solid inside a higher-priority one) is a false hit: the ray
+//! goes on through it. In scenes with priorities, surfaces within the offset distance of
+//! each other (water touching glass) are crossed together, as one interface. A reflected
+//! ray stays in its parent's media; Beer-Lambert absorption follows the current medium.
 
 use glam::Vec3A;
-use whitted_ir::{Fresnel, ShadowMode};
+use whitted_ir::{Fresnel, Handle, Material, ShadowMode};
 
 use crate::material::PreparedMaterial;
+use crate::media::{same_medium, Medium, MediumStack};
 use crate::optics::{
     beer_lambert, fresnel_exact, max_channel, reflect, refract, schlick, surface_offset,
 };
-use crate::query::{Scratch, Shadow};
+use crate::query::{Hit, Scratch, Shadow, Surface};
 use crate::ray::Ray;
 use crate::recorder::{
     Interface, LightSample, RayKind, RayStart, Recorder, ShadowRay, ShadowResult, SkippedRay,
@@ -54,6 +58,8 @@ pub struct PathState {
     pub coefficient: Vec3A,
     /// Absorption per unit distance of the medium the ray travels in (0 in air).
     pub medium: Vec3A,
+    /// The solids the ray is inside (`medium` is the current one's absorption).
+    pub media: MediumStack,
     pub interface: Option<Interface>,
 }
 
@@ -65,6 +71,7 @@ impl PathState {
             weight: Vec3A::ONE,
             coefficient: Vec3A::ONE,
             medium: Vec3A::ZERO,
+            media: MediumStack::EMPTY,
             interface: None,
         }
     }
@@ -77,6 +84,29 @@ struct Path {
     depth: u32,
     weight: Vec3A,
     medium: Vec3A,
+    media: MediumStack,
+}
+
+/// The surface a ray really meets (after false hits), with the media on either side.
+struct Meeting<'s> {
+    hit: Hit,
+    surface: Surface<'s>,
+    front_face: bool,
+    material: Handle<Material>,
+    /// The media on the incoming side: where a reflected ray travels.
+    before: MediumStack,
+    /// The media beyond: where a transmitted ray travels.
+    after: MediumStack,
+    /// Where to look on when the meeting is a false hit.
+    resume: f32,
+}
+
+/// One surface crossing near a hit, for coincident-surface handling.
+#[derive(Clone, Copy)]
+struct NearCrossing {
+    hit: Hit,
+    entering: bool,
+    medium: Medium,
 }
 
 /// One worker's tracing context: the scene, the limits, CSG scratch space and counters.
@@ -139,6 +169,7 @@ impl<'a> Tracer<'a> {
             depth: path.depth,
             weight: path.weight,
             medium: path.medium,
+            media: path.media,
         };
         self.count(&path);
         self.trace_started(ray, &path, rec)
@@ -165,32 +196,54 @@ impl<'a> Tracer<'a> {
         // transmittance (exactly 1) can be skipped without changing a bit.
         let in_air = path.medium == Vec3A::ZERO;
 
-        let Some(hit) = scene.intersect(ray, 0.0, f32::INFINITY, &mut self.scratch) else {
-            let color = if in_air {
-                scene.background
-            } else {
-                scene.background * beer_lambert(path.medium, f32::INFINITY)
+        // False hits (surfaces that do not change the medium) are passed through: the same
+        // ray looks on beyond them, so `t` stays measured from its origin and the medium,
+        // unchanged by a false hit, absorbs along the whole distance.
+        let mut media = path.media;
+        let mut tmin = 0.0;
+        let meeting = loop {
+            let Some(hit) = scene.intersect(ray, tmin, f32::INFINITY, &mut self.scratch) else {
+                let color = if in_air {
+                    scene.background
+                } else {
+                    scene.background * beer_lambert(path.medium, f32::INFINITY)
+                };
+                rec.ray_missed(scene.background);
+                rec.ray_finished(color, Termination::Miss);
+                return color;
             };
-            rec.ray_missed(scene.background);
-            rec.ray_finished(color, Termination::Miss);
-            return color;
+            let meeting = self.meet(ray, tmin, hit, &media);
+            if meeting.surface.leaf.geometry.is_solid()
+                && same_medium(meeting.before.current(), meeting.after.current())
+            {
+                media = meeting.after;
+                tmin = meeting.resume;
+                continue;
+            }
+            break meeting;
         };
+        let Meeting {
+            hit,
+            surface,
+            front_face,
+            material: material_handle,
+            before,
+            after,
+            ..
+        } = meeting;
         let absorption = if in_air {
             Vec3A::ONE
         } else {
             beer_lambert(path.medium, hit.t)
         };
 
-        let surface = scene.surface(ray, &hit);
         let d = ray.direction;
-        let front_face = surface.geometric_normal.dot(d) < 0.0;
         let n = if front_face {
             surface.geometric_normal
         } else {
             -surface.geometric_normal
         };
         let point = surface.point;
-        let material_handle = scene.resolve_material(surface.leaf, point, hit.part);
         let m = &scene.materials[material_handle.index()];
         rec.surface_hit(&SurfaceHit {
             t: hit.t,
@@ -211,7 +264,14 @@ impl<'a> Tracer<'a> {
 
         // Secondary rays.
         let solid = surface.leaf.geometry.is_solid();
-        let split = split_weights(m, d, n, solid, front_face);
+        let (outer, inner) = (before.current(), after.current());
+        let split = split_at(
+            m,
+            d,
+            n,
+            (self.ior(outer), self.ior(inner)),
+            solid && front_face,
+        );
         let mut outcome = Outcome::default();
         let carried = if in_air {
             path.weight
@@ -224,7 +284,8 @@ impl<'a> Tracer<'a> {
                 kind: RayKind::Reflected,
                 depth,
                 weight: carried * split.reflect,
-                medium: path.medium,
+                medium: self.absorption(outer),
+                media: before,
             };
             // Unit already: a reflection preserves length (to a few ulps).
             let reflected = Ray::new(outside, reflect(d, n));
@@ -250,16 +311,12 @@ impl<'a> Tracer<'a> {
             outcome.skipped(reason);
         }
         if let Some(direction) = split.refracted.filter(|_| split.transmit != Vec3A::ZERO) {
-            let medium = match (solid, front_face) {
-                (false, _) => path.medium,
-                (true, true) => m.absorption,
-                (true, false) => Vec3A::ZERO,
-            };
             let child = Path {
                 kind: RayKind::Transmitted,
                 depth,
                 weight: carried * split.transmit,
-                medium,
+                medium: self.absorption(inner),
+                media: after,
             };
             let transmitted = Ray::new(point - offset * n, direction);
             if let Some(c) = self.spawn(&transmitted, &child, &split, &mut outcome, rec) {
@@ -277,6 +334,164 @@ impl<'a> Tracer<'a> {
         };
         rec.ray_finished(color, termination);
         color
+    }
+
+    /// The refractive index of a medium (air is 1).
+    #[inline(always)]
+    fn ior(&self, medium: Option<Medium>) -> f32 {
+        medium.map_or(1.0, |m| self.scene.materials[m.material as usize].ior)
+    }
+
+    /// The absorption per unit distance of a medium (air absorbs nothing).
+    #[inline(always)]
+    fn absorption(&self, medium: Option<Medium>) -> Vec3A {
+        medium.map_or(Vec3A::ZERO, |m| {
+            self.scene.materials[m.material as usize].absorption
+        })
+    }
+
+    /// The surface `hit` and the media on either side of it, for a ray in `media`. Thin
+    /// surfaces have the same media on both sides. In scenes with priorities every solid
+    /// surface within the offset distance of the hit is crossed with it (coincident
+    /// surfaces are one interface); otherwise the hit is crossed alone.
+    #[inline(always)]
+    fn meet(&mut self, ray: &Ray, tmin: f32, hit: Hit, media: &MediumStack) -> Meeting<'a> {
+        let scene = self.scene;
+        let surface = scene.surface(ray, &hit);
+        let front_face = surface.geometric_normal.dot(ray.direction) < 0.0;
+        let material = scene.resolve_material(surface.leaf, surface.point, hit.part);
+        let mut meeting = Meeting {
+            hit,
+            surface,
+            front_face,
+            material,
+            before: *media,
+            after: *media,
+            resume: hit.t,
+        };
+        if !surface.leaf.geometry.is_solid() {
+            return meeting;
+        }
+        if scene.nested_media {
+            return self.meet_coincident(ray, tmin, meeting);
+        }
+        let medium = Medium {
+            object: surface.item.object().index() as u32,
+            material: material.index() as u32,
+            rank: scene.materials[material.index()].rank,
+        };
+        if front_face {
+            meeting.after.enter(medium);
+        } else {
+            if !meeting.before.contains(medium.object) {
+                meeting.before.insert_outermost(medium);
+            }
+            meeting.after = meeting.before;
+            meeting.after.leave(medium.object);
+        }
+        meeting
+    }
+
+    /// [`Tracer::meet`] for scenes with priorities: every solid surface within the offset
+    /// distance of the hit is crossed at once (a glass wall and the water touching it), and
+    /// the interface is the surface of the medium that wins: the higher rank of the medium
+    /// left and the medium entered.
+    #[cold]
+    #[inline(never)]
+    fn meet_coincident(&mut self, ray: &Ray, tmin: f32, first: Meeting<'a>) -> Meeting<'a> {
+        const MOST: usize = MediumStack::CAPACITY;
+        let scene = self.scene;
+        let window = surface_offset(first.surface.point, scene.epsilon);
+        let resume = first.hit.t + window;
+        let empty = NearCrossing {
+            hit: first.hit,
+            entering: false,
+            medium: Medium {
+                object: u32::MAX,
+                material: 0,
+                rank: 0,
+            },
+        };
+        let mut near = [empty; MOST];
+        let mut count = 0usize;
+        let crossing = |hit: Hit| {
+            let surface = scene.surface(ray, &hit);
+            let material = scene.resolve_material(surface.leaf, surface.point, hit.part);
+            NearCrossing {
+                hit,
+                entering: surface.geometric_normal.dot(ray.direction) < 0.0,
+                medium: Medium {
+                    object: surface.item.object().index() as u32,
+                    material: material.index() as u32,
+                    rank: scene.materials[material.index()].rank,
+                },
+            }
+        };
+        scene.solid_crossings_near(ray, tmin, first.hit.t, window, &mut self.scratch, |hit| {
+            near[count] = crossing(hit);
+            count += 1;
+            count < MOST
+        });
+        let first_found = near[..count]
+            .iter()
+            .any(|c| c.hit.item == first.hit.item && c.hit.leaf == first.hit.leaf);
+        if !first_found && count < MOST {
+            near[count] = crossing(first.hit);
+            count += 1;
+        }
+        let near = &mut near[..count];
+        // Along the ray; at equal distances leave before entering.
+        near.sort_by(|a, b| {
+            a.hit
+                .t
+                .total_cmp(&b.hit.t)
+                .then(a.entering.cmp(&b.entering))
+        });
+        let mut before = first.before;
+        for c in near.iter().filter(|c| !c.entering) {
+            if !before.contains(c.medium.object) {
+                before.insert_outermost(c.medium);
+            }
+        }
+        let mut after = before;
+        for c in near.iter() {
+            if c.entering {
+                after.enter(c.medium);
+            } else {
+                after.leave(c.medium.object);
+            }
+        }
+        let (outer, inner) = (before.current(), after.current());
+        let left = outer.and_then(|o| {
+            near.iter()
+                .find(|c| !c.entering && c.medium.object == o.object)
+        });
+        let entered = inner.and_then(|i| {
+            near.iter()
+                .find(|c| c.entering && c.medium.object == i.object)
+        });
+        let chosen = match (left, entered) {
+            (Some(l), Some(e)) if l.medium.rank > e.medium.rank => Some(l),
+            (_, Some(e)) => Some(e),
+            (l, None) => l,
+        };
+        let mut meeting = match chosen {
+            Some(c) => {
+                let surface = scene.surface(ray, &c.hit);
+                Meeting {
+                    hit: c.hit,
+                    surface,
+                    front_face: c.entering,
+                    material: Handle::from_index(c.medium.material as usize),
+                    ..first
+                }
+            }
+            None => first,
+        };
+        meeting.before = before;
+        meeting.after = after;
+        meeting.resume = resume;
+        meeting
     }
 
     /// `ka·Ia·kd` plus, for every light on the visible side, `fatt·spot·Ii·(kd·(N·L) +
@@ -477,8 +692,10 @@ pub struct Split {
 }
 
 /// The reflection/transmission split at a surface hit along `d`, with `n` the unit normal
-/// facing the incoming ray. Solids refract between air (1.0) and the material's ior, the
-/// direction decided by `front_face`; thin surfaces (no inside) have 1.0 on both sides.
+/// facing the incoming ray, for a solid in air: it refracts between air (1.0) and the
+/// material's ior, the direction decided by `front_face`; thin surfaces (no inside) have
+/// 1.0 on both sides. (The tracer calls [`split_at`] with the media it knows; tests use this.)
+#[cfg(test)]
 pub fn split_weights(
     m: &PreparedMaterial,
     d: Vec3A,
@@ -486,12 +703,29 @@ pub fn split_weights(
     solid: bool,
     front_face: bool,
 ) -> Split {
+    let ior = match (solid, front_face) {
+        (false, _) => (1.0, 1.0),
+        (true, true) => (1.0, m.ior),
+        (true, false) => (m.ior, 1.0),
+    };
+    split_at(m, d, n, ior, solid && front_face)
+}
+
+/// [`split_weights`] between the media on either side: `ior` is (before, beyond) the
+/// surface, and `entering` whether the ray enters a solid there (for the record).
+pub fn split_at(
+    m: &PreparedMaterial,
+    d: Vec3A,
+    n: Vec3A,
+    ior: (f32, f32),
+    entering: bool,
+) -> Split {
     let cos_incidence = (-d).dot(n).clamp(0.0, 1.0);
     let mut split = Split {
         interface: Interface {
             cos_incidence,
             ior: None,
-            entering: solid && front_face,
+            entering,
             fresnel: m.fresnel,
             fresnel_reflectance: None,
             total_internal_reflection: false,
@@ -503,11 +737,7 @@ pub fn split_weights(
     if m.transmissive == Vec3A::ZERO {
         return split;
     }
-    let (from, to) = match (solid, front_face) {
-        (false, _) => (1.0, 1.0),
-        (true, true) => (1.0, m.ior),
-        (true, false) => (m.ior, 1.0),
-    };
+    let (from, to) = ior;
     split.interface.ior = Some((from, to));
     match refract(d, n, from, to) {
         None => {
