@@ -4,6 +4,7 @@
 mod acne;
 mod csg_scenes;
 mod energy;
+mod media_scenes;
 mod optics_scenes;
 mod shadow_rays;
 
