@@ -132,9 +132,9 @@ impl TerminationSet {
 pub struct Interface {
     /// Cosine of the angle between the incoming ray and the shading normal (1 = head on).
     pub cos_incidence: f32,
-    /// The refractive indices (from, to) when the material transmits; the outside of every
-    /// solid is taken to be air (1.0), and thin surfaces (disks, triangles, open cylinders
-    /// and cones) have (1.0, 1.0) on both sides.
+    /// The refractive indices (from, to) when the material transmits: the medium the ray
+    /// leaves and the one beyond (nested media; air is 1.0). Thin surfaces (disks,
+    /// triangles, open cylinders and cones) have the current medium on both sides.
     pub ior: Option<(f32, f32)>,
     /// Whether the incoming ray was entering a solid (it hit the outside of a solid's
     /// surface; always false on thin surfaces).

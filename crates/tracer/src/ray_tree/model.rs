@@ -106,7 +106,8 @@ pub struct InterfaceInfo {
     /// The angle between the incoming ray and the shading normal, in degrees (0 = head on).
     pub incidence_degrees: f32,
     pub cos_incidence: f32,
-    /// `[from, to]` refractive indices when the material transmits (air is 1).
+    /// `[from, to]` refractive indices when the material transmits: the medium left and the
+    /// medium beyond (air is 1).
     pub ior: Option<[f32; 2]>,
     /// Whether the incoming ray hit the outside of a solid (always false on thin surfaces).
     pub entering: bool,
