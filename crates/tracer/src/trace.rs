@@ -441,7 +441,7 @@ impl<'a> Tracer<'a> {
         }
         let near = &mut near[..count];
         // Along the ray; at equal distances leave before entering.
-        near.sort_by(|a, b| {
+        near.sort_unstable_by(|a, b| {
             a.hit
                 .t
                 .total_cmp(&b.hit.t)
