@@ -69,6 +69,20 @@ impl MediumStack {
         best
     }
 
+    /// The medium that would be current once the most recent entry of `object` is gone.
+    #[inline]
+    pub fn current_without(&self, object: u32) -> Option<Medium> {
+        let entries = self.as_slice();
+        let skip = entries.iter().rposition(|m| m.object == object);
+        let mut best: Option<Medium> = None;
+        for (i, &entry) in entries.iter().enumerate() {
+            if Some(i) != skip && best.is_none_or(|b| entry.rank >= b.rank) {
+                best = Some(entry);
+            }
+        }
+        best
+    }
+
     pub fn contains(&self, object: u32) -> bool {
         self.as_slice().iter().any(|m| m.object == object)
     }

@@ -78,13 +78,31 @@ impl PathState {
 }
 
 /// What the recursion carries from ray to ray: all that a ray's colour depends on.
+/// The media stack is borrowed, not copied: most rays share their parent's.
 #[derive(Clone, Copy, Debug)]
-struct Path {
+struct Path<'m> {
     kind: RayKind,
     depth: u32,
     weight: Vec3A,
     medium: Vec3A,
-    media: MediumStack,
+    media: &'m MediumStack,
+}
+
+/// How crossing a surface changes a ray's media. Stacks are only built for the rays that
+/// need them (a transmitted ray, a ray that passes a false hit).
+#[derive(Clone, Copy, Debug)]
+enum Change {
+    /// A thin surface: the same media on both sides.
+    Thin,
+    Enter(Medium),
+    /// Leaving a solid the ray knows it is inside.
+    Leave(Medium),
+    /// Leaving a solid the ray did not know it was inside (it started inside): it was the
+    /// outermost.
+    LeaveUnknown(Medium),
+    /// Several coincident surfaces (nested media): the stacks are in
+    /// [`Tracer::coincident`].
+    Coincident,
 }
 
 /// The surface a ray really meets (after false hits), with the media on either side.
@@ -93,10 +111,10 @@ struct Meeting<'s> {
     surface: Surface<'s>,
     front_face: bool,
     material: Handle<Material>,
-    /// The media on the incoming side: where a reflected ray travels.
-    before: MediumStack,
-    /// The media beyond: where a transmitted ray travels.
-    after: MediumStack,
+    change: Change,
+    /// The current medium before the surface (where a reflected ray travels) and beyond it.
+    outer: Option<Medium>,
+    inner: Option<Medium>,
     /// Where to look on when the meeting is a false hit.
     resume: f32,
 }
@@ -122,6 +140,9 @@ pub struct Tracer<'a> {
     /// colour (nothing the ray could find would change the colour); false only in tests
     /// that prove the skip changes no pixel.
     skip_unshaded_shadows: bool,
+    /// The media before and beyond the last coincident meeting (nested media only), read
+    /// right after [`Tracer::meet`] returns.
+    coincident: (MediumStack, MediumStack),
 }
 
 impl<'a> Tracer<'a> {
@@ -134,6 +155,7 @@ impl<'a> Tracer<'a> {
             counters: RayCounters::default(),
             offset_scale: 1.0,
             skip_unshaded_shadows: true,
+            coincident: (MediumStack::EMPTY, MediumStack::EMPTY),
         }
     }
 
@@ -169,7 +191,7 @@ impl<'a> Tracer<'a> {
             depth: path.depth,
             weight: path.weight,
             medium: path.medium,
-            media: path.media,
+            media: &path.media,
         };
         self.count(&path);
         self.trace_started(ray, &path, rec)
@@ -199,9 +221,10 @@ impl<'a> Tracer<'a> {
         // False hits (surfaces that do not change the medium) are passed through: the same
         // ray looks on beyond them, so `t` stays measured from its origin and the medium,
         // unchanged by a false hit, absorbs along the whole distance.
-        let mut media = path.media;
+        let mut passed: Option<MediumStack> = None;
         let mut tmin = 0.0;
         let meeting = loop {
+            let media = passed.as_ref().unwrap_or(path.media);
             let Some(hit) = scene.intersect(ray, tmin, f32::INFINITY, &mut self.scratch) else {
                 let color = if in_air {
                     scene.background
@@ -212,25 +235,47 @@ impl<'a> Tracer<'a> {
                 rec.ray_finished(color, Termination::Miss);
                 return color;
             };
-            let meeting = self.meet(ray, tmin, hit, &media);
-            if meeting.surface.leaf.geometry.is_solid()
-                && same_medium(meeting.before.current(), meeting.after.current())
+            let meeting = self.meet(ray, tmin, hit, media);
+            if meeting.surface.leaf.geometry.is_solid() && same_medium(meeting.outer, meeting.inner)
             {
-                media = meeting.after;
+                let beyond = self.media_beyond(media, meeting.change);
+                passed = Some(beyond);
                 tmin = meeting.resume;
                 continue;
             }
             break meeting;
         };
+        let media = passed.as_ref().unwrap_or(path.media);
         let Meeting {
             hit,
             surface,
             front_face,
             material: material_handle,
-            before,
-            after,
+            change,
+            outer,
+            inner,
             ..
         } = meeting;
+        // The media a reflected ray travels in: the incoming ray's, unless it turned out to
+        // be inside the solid it leaves (or the surfaces were coincident).
+        let before_store;
+        let before: &MediumStack = match change {
+            Change::LeaveUnknown(medium) => {
+                let mut stack = *media;
+                stack.insert_outermost(medium);
+                before_store = stack;
+                &before_store
+            }
+            Change::Coincident => {
+                before_store = self.coincident.0;
+                &before_store
+            }
+            _ => media,
+        };
+        let after = match change {
+            Change::Coincident => self.coincident.1,
+            _ => MediumStack::EMPTY,
+        };
         let absorption = if in_air {
             Vec3A::ONE
         } else {
@@ -264,7 +309,6 @@ impl<'a> Tracer<'a> {
 
         // Secondary rays.
         let solid = surface.leaf.geometry.is_solid();
-        let (outer, inner) = (before.current(), after.current());
         let split = split_at(
             m,
             d,
@@ -311,12 +355,16 @@ impl<'a> Tracer<'a> {
             outcome.skipped(reason);
         }
         if let Some(direction) = split.refracted.filter(|_| split.transmit != Vec3A::ZERO) {
+            let beyond = match change {
+                Change::Coincident => after,
+                _ => self.media_beyond(media, change),
+            };
             let child = Path {
                 kind: RayKind::Transmitted,
                 depth,
                 weight: carried * split.transmit,
                 medium: self.absorption(inner),
-                media: after,
+                media: &beyond,
             };
             let transmitted = Ray::new(point - offset * n, direction);
             if let Some(c) = self.spawn(&transmitted, &child, &split, &mut outcome, rec) {
@@ -350,44 +398,69 @@ impl<'a> Tracer<'a> {
         })
     }
 
-    /// The surface `hit` and the media on either side of it, for a ray in `media`. Thin
-    /// surfaces have the same media on both sides. In scenes with priorities every solid
-    /// surface within the offset distance of the hit is crossed with it (coincident
-    /// surfaces are one interface); otherwise the hit is crossed alone.
+    /// The media beyond a surface, for a ray in `media` crossing it.
+    #[inline]
+    fn media_beyond(&self, media: &MediumStack, change: Change) -> MediumStack {
+        let mut stack = *media;
+        match change {
+            Change::Thin | Change::LeaveUnknown(_) => {}
+            Change::Enter(medium) => stack.enter(medium),
+            Change::Leave(medium) => {
+                stack.leave(medium.object);
+            }
+            Change::Coincident => stack = self.coincident.1,
+        }
+        stack
+    }
+
+    /// The surface `hit` and the current media on either side of it, for a ray in `media`,
+    /// worked out without copying the stack. Thin surfaces have the same medium on both
+    /// sides. In scenes with priorities every solid surface within the offset distance of
+    /// the hit is crossed with it (coincident surfaces are one interface); otherwise the
+    /// hit is crossed alone.
     #[inline(always)]
     fn meet(&mut self, ray: &Ray, tmin: f32, hit: Hit, media: &MediumStack) -> Meeting<'a> {
         let scene = self.scene;
         let surface = scene.surface(ray, &hit);
         let front_face = surface.geometric_normal.dot(ray.direction) < 0.0;
         let material = scene.resolve_material(surface.leaf, surface.point, hit.part);
+        let current = media.current();
         let mut meeting = Meeting {
             hit,
             surface,
             front_face,
             material,
-            before: *media,
-            after: *media,
+            change: Change::Thin,
+            outer: current,
+            inner: current,
             resume: hit.t,
         };
         if !surface.leaf.geometry.is_solid() {
             return meeting;
         }
         if scene.nested_media {
-            return self.meet_coincident(ray, tmin, meeting);
+            return self.meet_coincident(ray, tmin, meeting, media);
         }
         let medium = Medium {
             object: surface.item.object().index() as u32,
             material: material.index() as u32,
             rank: scene.materials[material.index()].rank,
         };
+        // As `MediumStack::current` would find after `enter`, `leave` or
+        // `insert_outermost`: the highest rank wins, the latest among equals.
         if front_face {
-            meeting.after.enter(medium);
-        } else {
-            if !meeting.before.contains(medium.object) {
-                meeting.before.insert_outermost(medium);
+            meeting.change = Change::Enter(medium);
+            if current.is_none_or(|c| medium.rank >= c.rank) {
+                meeting.inner = Some(medium);
             }
-            meeting.after = meeting.before;
-            meeting.after.leave(medium.object);
+        } else if media.contains(medium.object) {
+            meeting.change = Change::Leave(medium);
+            meeting.inner = media.current_without(medium.object);
+        } else {
+            meeting.change = Change::LeaveUnknown(medium);
+            if current.is_none_or(|c| medium.rank > c.rank) {
+                meeting.outer = Some(medium);
+            }
         }
         meeting
     }
@@ -398,7 +471,13 @@ impl<'a> Tracer<'a> {
     /// left and the medium entered.
     #[cold]
     #[inline(never)]
-    fn meet_coincident(&mut self, ray: &Ray, tmin: f32, first: Meeting<'a>) -> Meeting<'a> {
+    fn meet_coincident(
+        &mut self,
+        ray: &Ray,
+        tmin: f32,
+        first: Meeting<'a>,
+        media: &MediumStack,
+    ) -> Meeting<'a> {
         const MOST: usize = MediumStack::CAPACITY;
         let scene = self.scene;
         let window = surface_offset(first.surface.point, scene.epsilon);
@@ -447,7 +526,7 @@ impl<'a> Tracer<'a> {
                 .total_cmp(&b.hit.t)
                 .then(a.entering.cmp(&b.entering))
         });
-        let mut before = first.before;
+        let mut before = *media;
         for c in near.iter().filter(|c| !c.entering) {
             if !before.contains(c.medium.object) {
                 before.insert_outermost(c.medium);
@@ -488,8 +567,10 @@ impl<'a> Tracer<'a> {
             }
             None => first,
         };
-        meeting.before = before;
-        meeting.after = after;
+        self.coincident = (before, after);
+        meeting.change = Change::Coincident;
+        meeting.outer = outer;
+        meeting.inner = inner;
         meeting.resume = resume;
         meeting
     }
