@@ -222,28 +222,28 @@ impl<'a> Tracer<'a> {
         // ray looks on beyond them, so `t` stays measured from its origin and the medium,
         // unchanged by a false hit, absorbs along the whole distance.
         let mut passed: Option<MediumStack> = None;
-        let mut tmin = 0.0;
-        let meeting = loop {
-            let media = passed.as_ref().unwrap_or(path.media);
-            let Some(hit) = scene.intersect(ray, tmin, f32::INFINITY, &mut self.scratch) else {
-                let color = if in_air {
-                    scene.background
-                } else {
-                    scene.background * beer_lambert(path.medium, f32::INFINITY)
-                };
-                rec.ray_missed(scene.background);
-                rec.ray_finished(color, Termination::Miss);
-                return color;
+        let mut found = None;
+        if let Some(hit) = scene.intersect(ray, 0.0, f32::INFINITY, &mut self.scratch) {
+            let meeting = self.meet(ray, 0.0, hit, path.media);
+            found = if is_false_hit(&meeting) {
+                self.beyond_false_hits(ray, path.media, meeting)
+                    .map(|(meeting, media)| {
+                        passed = Some(media);
+                        meeting
+                    })
+            } else {
+                Some(meeting)
             };
-            let meeting = self.meet(ray, tmin, hit, media);
-            if meeting.surface.leaf.geometry.is_solid() && same_medium(meeting.outer, meeting.inner)
-            {
-                let beyond = self.media_beyond(media, meeting.change);
-                passed = Some(beyond);
-                tmin = meeting.resume;
-                continue;
-            }
-            break meeting;
+        }
+        let Some(meeting) = found else {
+            let color = if in_air {
+                scene.background
+            } else {
+                scene.background * beer_lambert(path.medium, f32::INFINITY)
+            };
+            rec.ray_missed(scene.background);
+            rec.ray_finished(color, Termination::Miss);
+            return color;
         };
         let media = passed.as_ref().unwrap_or(path.media);
         let Meeting {
@@ -272,10 +272,8 @@ impl<'a> Tracer<'a> {
             }
             _ => media,
         };
-        let after = match change {
-            Change::Coincident => self.coincident.1,
-            _ => MediumStack::EMPTY,
-        };
+        // Saved now: the reflected ray's own meetings overwrite `self.coincident`.
+        let coincident_after = matches!(change, Change::Coincident).then(|| self.coincident.1);
         let absorption = if in_air {
             Vec3A::ONE
         } else {
@@ -355,9 +353,9 @@ impl<'a> Tracer<'a> {
             outcome.skipped(reason);
         }
         if let Some(direction) = split.refracted.filter(|_| split.transmit != Vec3A::ZERO) {
-            let beyond = match change {
-                Change::Coincident => after,
-                _ => self.media_beyond(media, change),
+            let beyond = match coincident_after {
+                Some(after) => after,
+                None => self.media_beyond(media, change),
             };
             let child = Path {
                 kind: RayKind::Transmitted,
@@ -398,8 +396,34 @@ impl<'a> Tracer<'a> {
         })
     }
 
+    /// Passes false hits (surfaces that do not change the medium): the same ray looks on
+    /// beyond them, so `t` stays measured from its origin and the medium, unchanged by a
+    /// false hit, absorbs along the whole distance. Returns the surface really met and the
+    /// ray's media there, or `None` when the ray leaves the scene.
+    #[cold]
+    #[inline(never)]
+    fn beyond_false_hits(
+        &mut self,
+        ray: &Ray,
+        media: &MediumStack,
+        first: Meeting<'a>,
+    ) -> Option<(Meeting<'a>, MediumStack)> {
+        let scene = self.scene;
+        let mut media = self.media_beyond(media, first.change);
+        let mut tmin = first.resume;
+        loop {
+            let hit = scene.intersect(ray, tmin, f32::INFINITY, &mut self.scratch)?;
+            let meeting = self.meet(ray, tmin, hit, &media);
+            if !is_false_hit(&meeting) {
+                return Some((meeting, media));
+            }
+            media = self.media_beyond(&media, meeting.change);
+            tmin = meeting.resume;
+        }
+    }
+
     /// The media beyond a surface, for a ray in `media` crossing it.
-    #[inline]
+    #[inline(always)]
     fn media_beyond(&self, media: &MediumStack, change: Change) -> MediumStack {
         let mut stack = *media;
         match change {
@@ -725,6 +749,13 @@ impl<'a> Tracer<'a> {
     }
 }
 
+/// Whether a meeting is no interface at all: a solid's surface that leaves the current
+/// medium unchanged.
+#[inline(always)]
+fn is_false_hit(meeting: &Meeting<'_>) -> bool {
+    meeting.surface.leaf.geometry.is_solid() && same_medium(meeting.outer, meeting.inner)
+}
+
 /// A shadow query's outcome as the recorder reports it.
 fn shadow_result(scene: &PreparedScene, shadow: Shadow) -> ShadowResult {
     match shadow {
@@ -794,6 +825,7 @@ pub fn split_weights(
 
 /// [`split_weights`] between the media on either side: `ior` is (before, beyond) the
 /// surface, and `entering` whether the ray enters a solid there (for the record).
+#[inline(always)]
 pub fn split_at(
     m: &PreparedMaterial,
     d: Vec3A,
