@@ -110,6 +110,8 @@ struct Meeting<'s> {
     hit: Hit,
     surface: Surface<'s>,
     front_face: bool,
+    /// Whether the surface is a solid's (thin surfaces have no media of their own).
+    solid: bool,
     material: Handle<Material>,
     change: Change,
     /// The current medium before the surface (where a reflected ray travels) and beyond it.
@@ -225,7 +227,7 @@ impl<'a> Tracer<'a> {
         let mut found = None;
         if let Some(hit) = scene.intersect(ray, 0.0, f32::INFINITY, &mut self.scratch) {
             let meeting = self.meet(ray, 0.0, hit, path.media);
-            found = if is_false_hit(&meeting) {
+            found = if is_false_hit(meeting.solid, meeting.outer, meeting.inner) {
                 self.beyond_false_hits(ray, path.media, meeting)
                     .map(|(meeting, media)| {
                         passed = Some(media);
@@ -250,6 +252,7 @@ impl<'a> Tracer<'a> {
             hit,
             surface,
             front_face,
+            solid,
             material: material_handle,
             change,
             outer,
@@ -306,7 +309,6 @@ impl<'a> Tracer<'a> {
         let mut color = self.local_illumination(m, outside, n, -d, rec);
 
         // Secondary rays.
-        let solid = surface.leaf.geometry.is_solid();
         let split = split_at(
             m,
             d,
@@ -414,7 +416,7 @@ impl<'a> Tracer<'a> {
         loop {
             let hit = scene.intersect(ray, tmin, f32::INFINITY, &mut self.scratch)?;
             let meeting = self.meet(ray, tmin, hit, &media);
-            if !is_false_hit(&meeting) {
+            if !is_false_hit(meeting.solid, meeting.outer, meeting.inner) {
                 return Some((meeting, media));
             }
             media = self.media_beyond(&media, meeting.change);
@@ -449,17 +451,19 @@ impl<'a> Tracer<'a> {
         let front_face = surface.geometric_normal.dot(ray.direction) < 0.0;
         let material = scene.resolve_material(surface.leaf, surface.point, hit.part);
         let current = media.current();
+        let solid = surface.leaf.geometry.is_solid();
         let mut meeting = Meeting {
             hit,
             surface,
             front_face,
+            solid,
             material,
             change: Change::Thin,
             outer: current,
             inner: current,
             resume: hit.t,
         };
-        if !surface.leaf.geometry.is_solid() {
+        if !solid {
             return meeting;
         }
         if scene.nested_media {
@@ -752,8 +756,8 @@ impl<'a> Tracer<'a> {
 /// Whether a meeting is no interface at all: a solid's surface that leaves the current
 /// medium unchanged.
 #[inline(always)]
-fn is_false_hit(meeting: &Meeting<'_>) -> bool {
-    meeting.surface.leaf.geometry.is_solid() && same_medium(meeting.outer, meeting.inner)
+fn is_false_hit(solid: bool, outer: Option<Medium>, inner: Option<Medium>) -> bool {
+    solid && same_medium(outer, inner)
 }
 
 /// A shadow query's outcome as the recorder reports it.
