@@ -223,30 +223,17 @@ impl<'a> Tracer<'a> {
         // False hits (surfaces that do not change the medium) are passed through: the same
         // ray looks on beyond them, so `t` stays measured from its origin and the medium,
         // unchanged by a false hit, absorbs along the whole distance.
-        let mut passed: Option<MediumStack> = None;
-        let mut found = None;
-        if let Some(hit) = scene.intersect(ray, 0.0, f32::INFINITY, &mut self.scratch) {
-            let meeting = self.meet(ray, 0.0, hit, path.media);
-            found = if is_false_hit(meeting.solid, meeting.outer, meeting.inner) {
-                self.beyond_false_hits(ray, path.media, meeting)
-                    .map(|(meeting, media)| {
-                        passed = Some(media);
-                        meeting
-                    })
-            } else {
-                Some(meeting)
-            };
-        }
-        let Some(meeting) = found else {
-            let color = if in_air {
-                scene.background
-            } else {
-                scene.background * beer_lambert(path.medium, f32::INFINITY)
-            };
-            rec.ray_missed(scene.background);
-            rec.ray_finished(color, Termination::Miss);
-            return color;
+        let Some(hit) = scene.intersect(ray, 0.0, f32::INFINITY, &mut self.scratch) else {
+            return self.missed(path, rec);
         };
+        let mut meeting = self.meet(ray, 0.0, hit, path.media);
+        let mut passed: Option<MediumStack> = None;
+        if is_false_hit(meeting.solid, meeting.outer, meeting.inner) {
+            match self.beyond_false_hits(ray, path.media, &mut meeting) {
+                Some(media) => passed = Some(media),
+                None => return self.missed(path, rec),
+            }
+        }
         let media = passed.as_ref().unwrap_or(path.media);
         let Meeting {
             hit,
@@ -400,28 +387,41 @@ impl<'a> Tracer<'a> {
 
     /// Passes false hits (surfaces that do not change the medium): the same ray looks on
     /// beyond them, so `t` stays measured from its origin and the medium, unchanged by a
-    /// false hit, absorbs along the whole distance. Returns the surface really met and the
-    /// ray's media there, or `None` when the ray leaves the scene.
+    /// false hit, absorbs along the whole distance. Leaves the surface really met in
+    /// `meeting` and returns the ray's media there, or `None` when the ray leaves the scene.
     #[cold]
     #[inline(never)]
     fn beyond_false_hits(
         &mut self,
         ray: &Ray,
         media: &MediumStack,
-        first: Meeting<'a>,
-    ) -> Option<(Meeting<'a>, MediumStack)> {
+        meeting: &mut Meeting<'a>,
+    ) -> Option<MediumStack> {
         let scene = self.scene;
-        let mut media = self.media_beyond(media, first.change);
-        let mut tmin = first.resume;
+        let mut media = self.media_beyond(media, meeting.change);
         loop {
+            let tmin = meeting.resume;
             let hit = scene.intersect(ray, tmin, f32::INFINITY, &mut self.scratch)?;
-            let meeting = self.meet(ray, tmin, hit, &media);
+            *meeting = self.meet(ray, tmin, hit, &media);
             if !is_false_hit(meeting.solid, meeting.outer, meeting.inner) {
-                return Some((meeting, media));
+                return Some(media);
             }
             media = self.media_beyond(&media, meeting.change);
-            tmin = meeting.resume;
         }
+    }
+
+    /// A ray that left the scene: the background, through the medium it travels in.
+    #[inline(always)]
+    fn missed<R: Recorder>(&self, path: &Path, rec: &mut R) -> Vec3A {
+        let scene = self.scene;
+        let color = if path.medium == Vec3A::ZERO {
+            scene.background
+        } else {
+            scene.background * beer_lambert(path.medium, f32::INFINITY)
+        };
+        rec.ray_missed(scene.background);
+        rec.ray_finished(color, Termination::Miss);
+        color
     }
 
     /// The media beyond a surface, for a ray in `media` crossing it.
