@@ -381,6 +381,7 @@ impl Reshader<'_> {
             let r = match m.fresnel {
                 Fresnel::Off => None,
                 Fresnel::Schlick => Some(schlick(cos_i, n1, n2)),
+                Fresnel::Exact => Some(fresnel_exact(cos_i, n1, n2)),
             };
             if tir {
                 // Textbook: with Fresnel everything reflects (R = 1); without it the

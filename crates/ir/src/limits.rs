@@ -72,6 +72,9 @@ pub const MAX_INTENSITY: f64 = 1e6;
 /// overflowed.
 pub const MAX_REFLECTANCE: f64 = 1.0;
 
+/// The largest nested-media priority of a material (any order of a few solids fits).
+pub const MAX_PRIORITY: u32 = 1_000;
+
 /// The smallest index of refraction.
 pub const MIN_IOR: f64 = 1e-3;
 
@@ -171,6 +174,7 @@ pub const ALL: &[Limit] = &[
         MAX_RENDER_MEMORY_BYTES,
         "estimated bytes of memory for one render",
     ),
+    count("priority", MAX_PRIORITY as u64, "a material's nested-media priority"),
     number(
         "largest coordinate",
         MAX_COORDINATE,

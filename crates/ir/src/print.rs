@@ -120,11 +120,16 @@ fn material_name(m: &Material) -> String {
 }
 
 fn material_fields(m: &Material) -> String {
-    format!(
+    let mut fields = format!(
         "ambient {} diffuse {} specular {} shininess {} reflective {} transmissive {} ior {} fresnel {:?} absorption {}",
         color(&m.ambient), color(&m.diffuse), color(&m.specular), m.shininess, color(&m.reflective),
         color(&m.transmissive), m.ior, m.fresnel, color(&m.absorption)
-    )
+    );
+    // Only nested media use a priority: plain materials print as they always did.
+    if m.priority != 0 {
+        fields.push_str(&format!(" priority {}", m.priority));
+    }
+    fields
 }
 
 fn print_object(scene: &Scene, handle: Handle<Object>, depth: usize, out: &mut String) {

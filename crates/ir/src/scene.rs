@@ -163,6 +163,20 @@ pub enum Fresnel {
     Off,
     /// Schlick's approximation splits the weight between reflection and transmission.
     Schlick,
+    /// The exact Fresnel equations for a dielectric (the average of the s- and
+    /// p-polarised reflectances) split the weight between reflection and transmission.
+    Exact,
+}
+
+impl Fresnel {
+    /// The word the scene language uses for it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fresnel::Off => "off",
+            Fresnel::Schlick => "schlick",
+            Fresnel::Exact => "exact",
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -203,6 +217,10 @@ pub struct Material {
     pub transmissive: Color,
     pub ior: f64,
     pub fresnel: Fresnel,
+    /// Which medium fills the overlap of two solids (nested media): the higher priority
+    /// wins and the other solid's surfaces inside it are skipped. 0 (the default) is a plain
+    /// solid, whose surfaces are always surfaces and whose own medium applies inside it.
+    pub priority: u32,
     /// Beer-Lambert absorption per unit distance inside a transmissive solid.
     pub absorption: Color,
     /// When set, the surface takes pattern.a or pattern.b at each point instead of this.
@@ -222,6 +240,7 @@ impl Default for Material {
             transmissive: Color::BLACK,
             ior: 1.0,
             fresnel: Fresnel::Off,
+            priority: 0,
             absorption: Color::BLACK,
             pattern: None,
         }

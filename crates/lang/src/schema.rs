@@ -192,6 +192,7 @@ pub enum Prop {
     Ior,
     Fresnel,
     Absorption,
+    Priority,
 }
 
 /// How many values a property takes after its name.
@@ -209,7 +210,7 @@ pub enum Arity {
 }
 
 impl Prop {
-    pub const ALL: [Prop; 46] = {
+    pub const ALL: [Prop; 47] = {
         use Prop::*;
         [
             Center,
@@ -258,6 +259,7 @@ impl Prop {
             Ior,
             Fresnel,
             Absorption,
+            Priority,
         ]
     };
 
@@ -310,6 +312,7 @@ impl Prop {
             Ior => "ior",
             Fresnel => "fresnel",
             Absorption => "absorption",
+            Priority => "priority",
         }
     }
 
@@ -327,7 +330,7 @@ impl Prop {
     pub fn words(self) -> Option<&'static [&'static str]> {
         match self {
             Prop::Shadows => Some(&["opaque", "filtered"]),
-            Prop::Fresnel => Some(&["off", "schlick"]),
+            Prop::Fresnel => Some(&["off", "schlick", "exact"]),
             _ => None,
         }
     }
@@ -363,6 +366,7 @@ const MATERIAL: &[Prop] = &[
     Prop::Ior,
     Prop::Fresnel,
     Prop::Absorption,
+    Prop::Priority,
 ];
 
 /// The kind of block an item sits in, which decides what the item may be.

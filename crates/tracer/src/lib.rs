@@ -13,6 +13,7 @@ mod csg;
 pub mod display;
 mod light;
 mod material;
+mod media;
 pub mod optics;
 mod query;
 mod ray;

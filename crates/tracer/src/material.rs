@@ -17,7 +17,9 @@ pub struct PreparedMaterial {
     pub reflective: Vec3A,
     pub transmissive: Vec3A,
     pub ior: f32,
-    pub schlick: bool,
+    pub fresnel: Fresnel,
+    /// The nested-media rank: the material's priority, with 0 (plain) above every other.
+    pub rank: u32,
     pub absorption: Vec3A,
     pub pattern: Option<PreparedPattern>,
 }
@@ -57,7 +59,12 @@ impl PreparedMaterial {
             reflective: color(&m.reflective),
             transmissive: color(&m.transmissive),
             ior: m.ior as f32,
-            schlick: m.fresnel == Fresnel::Schlick,
+            fresnel: m.fresnel,
+            rank: if m.priority == 0 {
+                u32::MAX
+            } else {
+                m.priority
+            },
             absorption: color(&m.absorption),
             pattern: m.pattern.as_ref().map(|p| PreparedPattern {
                 kind: p.kind,

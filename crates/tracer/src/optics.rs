@@ -1,5 +1,5 @@
 //! The optics of Whitted's model as small pure functions: reflection, Snell refraction,
-//! Schlick's Fresnel term, light attenuation and the spot-light cone, and the surface offset.
+//! Schlick's and the exact Fresnel terms, light attenuation and the spot-light cone, and the surface offset.
 //!
 //! They are kept free of scene types so that unit tests can check each formula numerically.
 
@@ -45,6 +45,25 @@ pub fn schlick(cos_i: f32, ior_from: f32, ior_to: f32) -> f32 {
     };
     let x = (1.0 - cos.clamp(0.0, 1.0)).powi(5);
     r0 + (1.0 - r0) * x
+}
+
+/// The exact Fresnel reflectance of a dielectric interface for unpolarised light crossing
+/// from `ior_from` into `ior_to` at an angle whose cosine is `cos_i`: the average of the
+/// s- and p-polarised reflectances, `Rs = ((n1·cos i − n2·cos t)/(n1·cos i + n2·cos t))²`
+/// and `Rp = ((n2·cos i − n1·cos t)/(n2·cos i + n1·cos t))²`. 1 beyond the critical angle.
+#[inline]
+pub fn fresnel_exact(cos_i: f32, ior_from: f32, ior_to: f32) -> f32 {
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let eta = ior_from / ior_to;
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let (n1, n2) = (ior_from, ior_to);
+    let rs = (n1 * cos_i - n2 * cos_t) / (n1 * cos_i + n2 * cos_t);
+    let rp = (n2 * cos_i - n1 * cos_t) / (n2 * cos_i + n1 * cos_t);
+    (0.5 * (rs * rs + rp * rp)).min(1.0)
 }
 
 /// The critical angle (radians) beyond which light going from `ior_from` into a less dense
@@ -189,6 +208,48 @@ mod tests {
             let value = schlick(i as f32 / 10.0, 1.0, 1.5);
             assert!(value >= previous);
             previous = value;
+        }
+    }
+
+    #[test]
+    fn exact_fresnel_matches_values_worked_by_hand() {
+        // Normal incidence: ((n1 − n2)/(n1 + n2))², from either side.
+        assert!(close(fresnel_exact(1.0, 1.0, 1.5), 0.04, 1e-7));
+        assert!(close(fresnel_exact(1.0, 1.5, 1.0), 0.04, 1e-7));
+        let r0_diamond = ((2.4f32 - 1.0) / 3.4).powi(2);
+        assert!(close(fresnel_exact(1.0, 1.0, 2.4), r0_diamond, 1e-6));
+        // Brewster's angle, tan θB = n2/n1: Rp vanishes, so R = Rs / 2 with
+        // Rs = ((1 − n²)/(1 + n²))² = (1.25/3.25)² for n = 1.5.
+        let brewster = 1.5f32.atan();
+        let rs = (1.25f32 / 3.25).powi(2);
+        assert!(close(
+            fresnel_exact(brewster.cos(), 1.0, 1.5),
+            0.5 * rs,
+            1e-6
+        ));
+        // From the dense side Brewster's angle is atan(1/1.5); the same Rs.
+        let inner_brewster = (1.0f32 / 1.5).atan();
+        assert!(close(
+            fresnel_exact(inner_brewster.cos(), 1.5, 1.0),
+            0.5 * rs,
+            1e-6
+        ));
+        // Grazing incidence reflects everything; so does every angle past the critical one.
+        assert!(close(fresnel_exact(0.0, 1.0, 1.5), 1.0, 1e-6));
+        let critical = critical_angle(1.5, 1.0).unwrap_or(0.0);
+        assert_eq!(fresnel_exact((critical + 1e-3).cos(), 1.5, 1.0), 1.0);
+        assert_eq!(fresnel_exact(0.5, 2.4, 1.0), 1.0);
+        // Just inside the critical angle it is close to 1 and below it.
+        let near = fresnel_exact((critical - 1e-3).cos(), 1.5, 1.0);
+        assert!(near > 0.5 && near < 1.0, "{near}");
+        // Equal indices: no interface, nothing reflected.
+        assert!(close(fresnel_exact(0.3, 1.33, 1.33), 0.0, 1e-10));
+        // Schlick approximates it within a few hundredths over the air-to-glass range.
+        for i in 0..=20 {
+            let cos = i as f32 / 20.0;
+            let exact = fresnel_exact(cos, 1.0, 1.5);
+            assert!((0.0..=1.0).contains(&exact));
+            assert!(close(schlick(cos, 1.0, 1.5), exact, 0.06), "cos {cos}");
         }
     }
 

@@ -1,6 +1,6 @@
 //! Ray queries against a prepared scene, named by their cost: [`PreparedScene::intersect`]
 //! (closest hit, cheap data only), [`PreparedScene::occluded`] (any blocker, stops at the
-//! first), [`PreparedScene::filter_shadow`] (every blocker, for filtered shadows) and
+//! first), [`PreparedScene::filter_shadow`] (every surface crossed, for filtered shadows) and
 //! [`PreparedScene::surface`] (full surface data, computed for the nearest hit only).
 //!
 //! Unbounded items are tested one by one, bounded ones through the CwBvh. The traversal
@@ -56,9 +56,10 @@ impl Hit {
 pub enum Shadow {
     Clear,
     Blocked(Hit),
-    /// Only transmissive blockers: the light passes, multiplied by their colours.
+    /// Only transmissive surfaces: the light passes, multiplied by their colours.
     Filtered {
         transmittance: Vec3A,
+        /// How many surfaces the ray crossed (a solid counts at entry and at exit).
         blockers: u32,
     },
 }
@@ -295,9 +296,11 @@ impl PreparedScene {
         }
     }
 
-    /// Filtered shadows: every object crossing the segment multiplies the light by the
-    /// transmissive colour of the material where the shadow ray first meets it (once per
-    /// object); an opaque one (transmissive black) blocks and ends the query.
+    /// Filtered shadows: every surface the segment crosses multiplies the light by the
+    /// transmissive colour of the material there, exactly as a camera ray through the same
+    /// surfaces is weighted by `kt` at each (a solid box filters twice, like its 12
+    /// triangles; a CSG solid at each boundary of its interval list). An opaque surface
+    /// (transmissive black) blocks and ends the query.
     pub(crate) fn filter_shadow(
         &self,
         ray: &Ray,
@@ -310,26 +313,29 @@ impl PreparedScene {
         let mut blockers = 0u32;
         let mut blocked = None;
         self.visit(ray, tmin, tmax, bvh_stack, |item_ref, item, _| {
-            // Never shrink: every blocker counts, not just the nearest.
-            let Some((t, leaf, part, flip)) = item_hit(item, ray, tmin, tmax, csg) else {
-                return Step::Continue;
-            };
-            let hit = Hit {
-                t,
-                item: item_ref,
-                leaf,
-                part,
-                flip,
-            };
-            let leaf = item.leaf(leaf);
-            let material = self.resolve_material(leaf, ray.at(t), part);
-            let kt = self.materials[material.index()].transmissive;
-            if kt == Vec3A::ZERO {
-                blocked = Some(hit);
-                return Step::Stop;
+            // Never shrink: every surface counts, not just the nearest. Each crossing of
+            // this item is found by asking again beyond the previous one (strictly greater
+            // distances, so the walk ends).
+            let mut from = tmin;
+            while let Some((t, leaf, part, flip)) = item_hit(item, ray, from, tmax, csg) {
+                let hit = Hit {
+                    t,
+                    item: item_ref,
+                    leaf,
+                    part,
+                    flip,
+                };
+                let leaf = item.leaf(leaf);
+                let material = self.resolve_material(leaf, ray.at(t), part);
+                let kt = self.materials[material.index()].transmissive;
+                if kt == Vec3A::ZERO {
+                    blocked = Some(hit);
+                    return Step::Stop;
+                }
+                transmittance *= kt;
+                blockers += 1;
+                from = t;
             }
-            transmittance *= kt;
-            blockers += 1;
             Step::Continue
         });
         match (blocked, blockers) {
@@ -340,6 +346,41 @@ impl PreparedScene {
                 blockers,
             },
         }
+    }
+
+    /// Every crossing of a solid's surface strictly inside `(t − window, t + window)` (and
+    /// beyond `tmin`), for nested media: surfaces that close together are crossed as one.
+    /// `found` gets each crossing and returns whether to go on.
+    pub(crate) fn solid_crossings_near(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        t: f32,
+        window: f32,
+        scratch: &mut Scratch,
+        mut found: impl FnMut(Hit) -> bool,
+    ) {
+        let Scratch { csg, bvh_stack } = scratch;
+        let (low, high) = ((t - window).max(tmin), t + window);
+        self.visit(ray, low, high, bvh_stack, |item_ref, item, _| {
+            let mut from = low;
+            while let Some((t, leaf, part, flip)) = item_hit(item, ray, from, high, csg) {
+                if item.leaf(leaf).geometry.is_solid() {
+                    let hit = Hit {
+                        t,
+                        item: item_ref,
+                        leaf,
+                        part,
+                        flip,
+                    };
+                    if !found(hit) {
+                        return Step::Stop;
+                    }
+                }
+                from = t;
+            }
+            Step::Continue
+        });
     }
 
     /// Full surface data for a hit along `ray`.

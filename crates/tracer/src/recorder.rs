@@ -31,7 +31,7 @@
 
 use glam::Vec3A;
 use serde::Serialize;
-use whitted_ir::{Handle, Light, Material, Object};
+use whitted_ir::{Fresnel, Handle, Light, Material, Object};
 
 /// What a ray is for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
@@ -66,7 +66,8 @@ pub enum Termination {
     MaxDepth,
     /// A secondary ray's path weight was below the minimum on every channel.
     WeightCutoff,
-    /// Refraction was impossible; the transmitted weight went to the reflected ray.
+    /// Refraction was impossible. Without Fresnel the transmitted term is dropped; with
+    /// Fresnel (R = 1) it went to the reflected ray.
     TotalInternalReflection,
     /// The surface neither reflects nor transmits: only its local colour returns.
     Absorbed,
@@ -131,14 +132,17 @@ impl TerminationSet {
 pub struct Interface {
     /// Cosine of the angle between the incoming ray and the shading normal (1 = head on).
     pub cos_incidence: f32,
-    /// The refractive indices (from, to) when the material transmits; the outside of every
-    /// solid is taken to be air (1.0), and thin surfaces (disks, triangles, open cylinders
-    /// and cones) have (1.0, 1.0) on both sides.
+    /// The refractive indices (from, to) when the material transmits: the medium the ray
+    /// leaves and the one beyond (nested media; air is 1.0). Thin surfaces (disks,
+    /// triangles, open cylinders and cones) have the current medium on both sides.
     pub ior: Option<(f32, f32)>,
     /// Whether the incoming ray was entering a solid (it hit the outside of a solid's
     /// surface; always false on thin surfaces).
     pub entering: bool,
-    /// Schlick's reflectance `R` when the material asks for Fresnel (transmission is `1 − R`).
+    /// The material's Fresnel model.
+    pub fresnel: Fresnel,
+    /// The Fresnel reflectance `R` (Schlick's or the exact one) when the material asks for
+    /// Fresnel (transmission is `1 − R`; `R` is 1 on total internal reflection).
     pub fresnel_reflectance: Option<f32>,
     pub total_internal_reflection: bool,
 }
@@ -200,7 +204,9 @@ pub enum ShadowResult {
         leaf: Handle<Object>,
         t: f32,
     },
-    /// Filtered shadows: the light passed through transmissive objects only.
+    /// Filtered shadows: the light passed through transmissive surfaces only, filtered by
+    /// `kt` at each (`blockers` counts surfaces: a solid filters where the ray enters and
+    /// again where it leaves).
     Filtered {
         transmittance: Vec3A,
         blockers: u32,
@@ -229,8 +235,11 @@ pub struct LightSample {
     /// The spot cone factor (1 for other lights).
     pub spot: f32,
     /// `None` when no shadow ray was needed: the light is behind the surface, outside its
-    /// cone, or too far to count.
+    /// cone, or too far to count, or the material is unshaded (see `unshaded`).
     pub shadow_ray: Option<ShadowRay>,
+    /// The light faces the surface, but no shadow ray was cast because the material has no
+    /// diffuse and no specular colour: the light could add nothing.
+    pub unshaded: bool,
     /// `fatt·spot·Ii·shadow·kd·(N·L)`, as added to the colour.
     pub diffuse: Vec3A,
     /// `fatt·spot·Ii·shadow·ks·(R·V)^n`, as added to the colour.

@@ -80,6 +80,9 @@ pub struct PreparedScene {
     pub(crate) ambient: Vec3A,
     pub(crate) epsilon: f32,
     pub(crate) shadows: ShadowMode,
+    /// Whether any material has a nested-media priority: only then are coincident
+    /// surfaces looked for and crossed together.
+    pub(crate) nested_media: bool,
     build_seconds: f64,
 }
 
@@ -135,6 +138,7 @@ impl PreparedScene {
             ambient: color(&settings.ambient),
             epsilon: settings.epsilon as f32,
             shadows: settings.shadows,
+            nested_media: scene.materials.iter().any(|(_, m)| m.priority != 0),
             settings,
             build_seconds: started.elapsed().as_secs_f64(),
         }

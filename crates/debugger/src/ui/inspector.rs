@@ -270,6 +270,7 @@ impl Lines {
                     Visibility::Filtered => "filtered".to_string(),
                     Visibility::Blocked => "in shadow".to_string(),
                     Visibility::NotFacing => "faces away (no shadow ray)".to_string(),
+                    Visibility::Unshaded => "nothing to light (no shadow ray)".to_string(),
                 },
                 format!("N·L {}", number(light.n_dot_l)),
             ];

@@ -1061,6 +1061,10 @@ impl<'a> Evaluator<'a> {
             Prop::Ior => {
                 number = self.in_range(value, value_span, prop, 0.0, true, f64::INFINITY)?
             }
+            Prop::Priority => {
+                number =
+                    f64::from(self.whole_in_range(value, value_span, prop, 0.0, limits::MAX_PRIORITY.into())?)
+            }
             _ => {}
         }
         let Some(Target::Material(b)) = self.targets.last_mut() else {
@@ -1082,12 +1086,13 @@ impl<'a> Evaluator<'a> {
             Prop::Shininess => m.shininess = number,
             Prop::Ior => m.ior = number,
             Prop::Fresnel => {
-                m.fresnel = if word(property) == Some("schlick") {
-                    whitted_ir::Fresnel::Schlick
-                } else {
-                    whitted_ir::Fresnel::Off
+                m.fresnel = match word(property) {
+                    Some("schlick") => whitted_ir::Fresnel::Schlick,
+                    Some("exact") => whitted_ir::Fresnel::Exact,
+                    _ => whitted_ir::Fresnel::Off,
                 }
             }
+            Prop::Priority => m.priority = number as u32,
             _ => {}
         }
         Ok(())

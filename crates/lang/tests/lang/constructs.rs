@@ -355,6 +355,29 @@ fn materials_set_every_field_and_inherit() {
 }
 
 #[test]
+fn exact_fresnel_and_priority_are_material_properties() {
+    let scene = scene(
+        "material glass { transmissive 1 ior 1.5 fresnel exact priority 2 }\n\
+         material water : glass { ior 1.33 priority 1 }\n\
+         sphere { material water } sphere { material glass } sphere { }",
+    );
+    let material = |i: usize| &scene.materials[scene.objects[scene.roots[i]].material];
+    assert_eq!(
+        (material(0).fresnel, material(0).priority),
+        (Fresnel::Exact, 1)
+    );
+    assert_eq!(
+        (material(1).fresnel, material(1).priority),
+        (Fresnel::Exact, 2)
+    );
+    // The default: a plain solid.
+    assert_eq!(
+        (material(2).fresnel, material(2).priority),
+        (Fresnel::Off, 0)
+    );
+}
+
+#[test]
 fn inline_materials_new_and_derived() {
     check(
         "inline_materials",

@@ -174,3 +174,13 @@ fn limits_raised_far_past_the_defaults_still_cannot_overflow_the_stack() {
         );
     }
 }
+
+#[test]
+fn a_priority_is_a_whole_number_within_its_range() {
+    let fraction = first_error_of("material m { priority 1.5 }\nsphere { material m }");
+    assert!(fraction.contains("whole number"), "{fraction}");
+    let huge = first_error_of("material m { priority 1e12 }\nsphere { material m }");
+    assert!(huge.contains("priority"), "{huge}");
+    let negative = first_error_of("material m { priority -1 }\nsphere { material m }");
+    assert!(negative.contains("priority"), "{negative}");
+}

@@ -114,11 +114,14 @@ pub struct InterfaceInfo {
     /// The angle between the incoming ray and the shading normal, in degrees (0 = head on).
     pub incidence_degrees: f32,
     pub cos_incidence: f32,
-    /// `[from, to]` refractive indices when the material transmits (air is 1).
+    /// `[from, to]` refractive indices when the material transmits: the medium left and the
+    /// medium beyond (air is 1).
     pub ior: Option<[f32; 2]>,
     /// Whether the incoming ray hit the outside of a solid (always false on thin surfaces).
     pub entering: bool,
-    /// Schlick's `R` when the material uses Fresnel.
+    /// The material's Fresnel model: `off`, `schlick` or `exact`.
+    pub fresnel: whitted_ir::Fresnel,
+    /// The Fresnel `R` (Schlick's or the exact one) when the material uses Fresnel.
     pub fresnel_reflectance: Option<f32>,
     /// `1 − R` when the material uses Fresnel.
     pub fresnel_transmittance: Option<f32>,
@@ -242,6 +245,9 @@ pub enum Visibility {
     /// No shadow ray was cast: the light is behind the surface (`N·L <= 0`), outside its
     /// cone, too far to count, or black.
     NotFacing,
+    /// No shadow ray was cast: the light faces the surface, but the material has no diffuse
+    /// and no specular colour, so it could add nothing.
+    Unshaded,
 }
 
 /// What a shadow ray was cast for and what it found.
@@ -255,7 +261,8 @@ pub struct ShadowInfo {
     pub blocker: Option<Blocker>,
     /// The product of the transmissive colours passed through, on `filtered` results.
     pub transmittance: Option<[f32; 3]>,
-    /// How many transmissive objects it passed through, on `filtered` results.
+    /// How many transmissive surfaces it crossed, on `filtered` results (a solid counts
+    /// twice: where the ray enters it and where it leaves).
     pub filters: Option<u32>,
 }
 
@@ -281,8 +288,9 @@ pub struct Blocker {
 pub struct SkippedInfo {
     pub kind: RayKind,
     pub depth: u32,
-    /// The path weight it would have had (zero for a transmission lost to total internal
-    /// reflection, whose weight went to the reflected ray).
+    /// The path weight it would have had. On total internal reflection, the weight lost:
+    /// `kt` times the parent's weight without Fresnel (the transmitted term is dropped), zero
+    /// with Fresnel (R = 1: the weight went to the reflected ray).
     pub weight: [f32; 3],
     pub coefficient: [f32; 3],
     /// `max_depth`, `weight_cutoff` or `total_internal_reflection`.

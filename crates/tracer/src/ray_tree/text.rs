@@ -146,10 +146,15 @@ impl Printer {
             ));
         }
         for skipped in &node.skipped {
-            // A transmission lost to total internal reflection has no weight of its own: it
+            // A transmission lost to total internal reflection: dropped (no Fresnel), or
             // went to the reflected ray.
             let weight = match skipped.reason {
-                Termination::TotalInternalReflection => String::new(),
+                Termination::TotalInternalReflection if skipped.coefficient == [0.0; 3] => {
+                    " (Fresnel R = 1: the transmission went to the reflected ray)".to_string()
+                }
+                Termination::TotalInternalReflection => {
+                    format!(" (weight {} dropped)", self.color(skipped.weight))
+                }
                 _ => format!(" (weight {})", self.color(skipped.weight)),
             };
             lines.push(format!(
@@ -208,6 +213,9 @@ impl Printer {
     fn light_line(&self, light: &LightContribution) -> String {
         let shadow = match (light.visibility, light.shadow_child) {
             (Visibility::NotFacing, _) => "no shadow ray".to_string(),
+            (Visibility::Unshaded, _) => {
+                "no shadow ray (no diffuse or specular colour to light)".to_string()
+            }
             (visibility, Some(index)) => {
                 format!("shadow ray {index}: {}", visibility_text(visibility))
             }
@@ -237,7 +245,7 @@ impl Printer {
             (ShadowOutcome::Unblocked, _) => "unblocked".to_string(),
             (ShadowOutcome::Filtered, _) => {
                 let through = shadow.filters.map_or(String::new(), |n| {
-                    format!(" through {}", plural(n, "transmissive object"))
+                    format!(" through {}", plural(n, "transmissive surface"))
                 });
                 let transmittance = shadow.transmittance.map_or(String::new(), |t| {
                     format!(", transmittance {}", self.color(t))
@@ -290,7 +298,12 @@ fn interface_text(interface: &InterfaceInfo) -> String {
         interface.fresnel_reflectance,
         interface.fresnel_transmittance,
     ) {
-        let _ = write!(text, ", Fresnel R {} T {}", num(r), num(t));
+        // Schlick's is the common case and keeps the short form.
+        let model = match interface.fresnel {
+            whitted_ir::Fresnel::Exact => "exact ",
+            _ => "",
+        };
+        let _ = write!(text, ", {model}Fresnel R {} T {}", num(r), num(t));
     }
     if interface.total_internal_reflection {
         text.push_str(", total internal reflection");
@@ -336,6 +349,7 @@ fn visibility_text(visibility: Visibility) -> &'static str {
         Visibility::Filtered => "filtered",
         Visibility::Blocked => "blocked",
         Visibility::NotFacing => "not facing",
+        Visibility::Unshaded => "unshaded",
     }
 }
 

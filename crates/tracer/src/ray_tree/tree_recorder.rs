@@ -181,6 +181,7 @@ impl Recorder for TreeRecorder<'_> {
         let light = light_ref(scene, sample.light);
         let mut shadow_child = None;
         let visibility = match &sample.shadow_ray {
+            None if sample.unshaded => Visibility::Unshaded,
             None => Visibility::NotFacing,
             Some(shadow_ray) => {
                 let (result, blocker, transmittance, filters, passed, termination) =
@@ -315,6 +316,7 @@ fn interface_info(interface: &Interface) -> InterfaceInfo {
         cos_incidence: interface.cos_incidence,
         ior: interface.ior.map(|(from, to)| [from, to]),
         entering: interface.entering,
+        fresnel: interface.fresnel,
         fresnel_reflectance: interface.fresnel_reflectance,
         fresnel_transmittance: interface.fresnel_reflectance.map(|r| 1.0 - r),
         total_internal_reflection: interface.total_internal_reflection,

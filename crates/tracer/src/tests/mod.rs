@@ -3,7 +3,10 @@
 
 mod acne;
 mod csg_scenes;
+mod energy;
+mod media_scenes;
 mod optics_scenes;
+mod shadow_rays;
 
 use glam::Vec3A;
 

@@ -92,12 +92,11 @@ fn refraction_through_a_ball_obeys_snell_at_both_surfaces() {
     assert_eq!(out.termination, Termination::Miss);
 }
 
-#[test]
-fn total_internal_reflection_sends_the_transmitted_weight_to_reflection() {
-    // Enter the cube's top face at 80°; inside, the ray meets the side face x = 1 at
-    // 90° − asin(sin 80° / 1.5) ≈ 48.96°, beyond the critical angle of 41.81°.
+/// A ray entering the top face of a glass cube at 80°; inside, it meets the side face
+/// x = 1 at 90° − asin(sin 80° / 1.5) ≈ 48.96°, beyond the critical angle of 41.81°.
+fn tir_in_a_cube(glass: Material) -> Node {
     let mut b = SceneBuilder::new();
-    let glass = b.material(clear_glass(Fresnel::Off));
+    let glass = b.material(glass);
     b.add(
         Shape::Box {
             min: DVec3::splat(-1.0),
@@ -109,29 +108,78 @@ fn total_internal_reflection_sends_the_transmitted_weight_to_reflection() {
     let theta = 80f64.to_radians();
     let d = DVec3::new(theta.sin(), -theta.cos(), 0.0);
     let entry = DVec3::new(0.2, 1.0, 0.0);
-    let root = shoot(b, entry - 5.0 * d, entry, 6);
-    let inside = child(&root, RayKind::Transmitted);
-    let side = inside.hit.unwrap_or_else(|| panic!("no side hit"));
-    assert!(side.geometric_normal.abs_diff_eq(Vec3A::X, 1e-6));
-    let skipped = inside
+    shoot(b, entry - 5.0 * d, entry, 6)
+}
+
+fn tir_skip(inside: &Node) -> &crate::recorder::SkippedRay {
+    inside
         .skipped
         .iter()
         .find(|s| s.kind == RayKind::Transmitted)
-        .unwrap_or_else(|| panic!("no skipped transmission: {inside:#?}"));
+        .unwrap_or_else(|| panic!("no skipped transmission: {inside:#?}"))
+}
+
+#[test]
+fn total_internal_reflection_without_fresnel_drops_the_transmitted_term() {
+    // kr 0.5, kt 0.9: the textbook drops kt at total internal reflection; only kr reflects.
+    let root = tir_in_a_cube(Material {
+        reflective: Color::gray(0.5),
+        transmissive: Color::gray(0.9),
+        ..clear_glass(Fresnel::Off)
+    });
+    let inside = child(&root, RayKind::Transmitted);
+    let side = inside.hit.unwrap_or_else(|| panic!("no side hit"));
+    assert!(side.geometric_normal.abs_diff_eq(Vec3A::X, 1e-6));
+    let skipped = tir_skip(inside);
     assert_eq!(skipped.reason, Termination::TotalInternalReflection);
+    // The record says what was lost: kt, at the weight the transmitted ray would have had.
+    assert_eq!(skipped.coefficient, Vec3A::splat(0.9));
+    assert!(skipped
+        .weight
+        .abs_diff_eq(inside.start.weight * Vec3A::splat(0.9), 1e-6));
     let reflected = child(inside, RayKind::Reflected);
     let interface = reflected
         .start
         .interface
         .unwrap_or_else(|| panic!("no interface"));
     assert!(interface.total_internal_reflection);
+    assert_eq!(interface.fresnel_reflectance, None);
     let critical = optics::critical_angle(1.5, 1.0).unwrap_or(0.0).to_degrees();
     let incidence = interface.incidence_degrees();
     assert!(incidence > critical, "{incidence}° vs critical {critical}°");
     assert!((incidence - 48.96).abs() < 0.01, "{incidence}");
-    // kr + kt = 0 + 1: all the weight is reflected.
-    assert_eq!(reflected.start.coefficient, Vec3A::ONE);
+    assert_eq!(reflected.start.coefficient, Vec3A::splat(0.5));
     assert_eq!(inside.termination, Termination::NotEnded);
+
+    // Clear glass without Fresnel (kr 0) keeps nothing: the ray ends there.
+    let root = tir_in_a_cube(clear_glass(Fresnel::Off));
+    let inside = child(&root, RayKind::Transmitted);
+    assert!(inside
+        .children
+        .iter()
+        .all(|c| c.start.kind == RayKind::Shadow));
+    assert_eq!(inside.termination, Termination::TotalInternalReflection);
+}
+
+#[test]
+fn total_internal_reflection_with_fresnel_reflects_the_transmitted_share() {
+    for fresnel in [Fresnel::Schlick, Fresnel::Exact] {
+        let root = tir_in_a_cube(clear_glass(fresnel));
+        let inside = child(&root, RayKind::Transmitted);
+        let skipped = tir_skip(inside);
+        assert_eq!(skipped.coefficient, Vec3A::ZERO);
+        assert_eq!(skipped.weight, Vec3A::ZERO);
+        let reflected = child(inside, RayKind::Reflected);
+        let interface = reflected
+            .start
+            .interface
+            .unwrap_or_else(|| panic!("no interface"));
+        assert!(interface.total_internal_reflection);
+        assert_eq!(interface.fresnel, fresnel);
+        assert_eq!(interface.fresnel_reflectance, Some(1.0));
+        // kr + kt·R = 0 + 1·1: all the weight is reflected.
+        assert_eq!(reflected.start.coefficient, Vec3A::ONE);
+    }
 }
 
 #[test]
@@ -310,17 +358,17 @@ fn transparent_blockers_filter_or_block_by_setting() {
     let shadow = filtered
         .shadow_ray
         .unwrap_or_else(|| panic!("no shadow ray"));
+    // The ball filters where the shadow ray enters it and again where it leaves.
+    let kt = Vec3A::new(0.9, 0.5, 0.2);
     assert_eq!(
         shadow.result,
         ShadowResult::Filtered {
-            transmittance: Vec3A::new(0.9, 0.5, 0.2),
-            blockers: 1
+            transmittance: kt * kt,
+            blockers: 2
         }
     );
     let fatt_kd = 0.5 * filtered.n_dot_l;
-    assert!(filtered
-        .diffuse
-        .abs_diff_eq(Vec3A::new(0.9, 0.5, 0.2) * fatt_kd, 1e-6));
+    assert!(filtered.diffuse.abs_diff_eq(kt * kt * fatt_kd, 1e-6));
     let opaque = shoot(build(ShadowMode::Opaque), eye, floor_point, 0).lights[0];
     assert!(matches!(
         opaque.shadow_ray.map(|s| s.result),
