@@ -337,12 +337,26 @@ fn first_bit_high(value: u32) -> u32 {
     31 - value.leading_zeros()
 }
 
-/// obvhs's octant code for child ordering.
+/// obvhs's octant code for child ordering, from the sign bits of the direction. The sign
+/// bit, not `< 0.0`, must decide: [`inverse_direction`] turns a −0.0 component into −1/ε,
+/// and the walk's near and far planes must agree with that sign, or every box is missed
+/// (obvhs's own `ray_get_octant_inv4` compares with `< 0.0` and has that bug). For a −0.0
+/// component the order is obvhs's order for a direction with a tiny negative component.
 #[inline(always)]
 fn octant_inv4(direction: Vec3A) -> u32 {
-    (if direction.x < 0.0 { 0 } else { 0x0404_0404 })
-        | (if direction.y < 0.0 { 0 } else { 0x0202_0202 })
-        | (if direction.z < 0.0 { 0 } else { 0x0101_0101 })
+    (if direction.x.is_sign_negative() {
+        0
+    } else {
+        0x0404_0404
+    }) | (if direction.y.is_sign_negative() {
+        0
+    } else {
+        0x0202_0202
+    }) | (if direction.z.is_sign_negative() {
+        0
+    } else {
+        0x0101_0101
+    })
 }
 
 /// The world-space f32 planes of a node's children, rounded outwards. The quantised plane
@@ -399,9 +413,9 @@ mod tests {
         }
         let query = NodeQuery::new(ray, tmin);
         let backwards = [
-            ray.direction.x < 0.0,
-            ray.direction.y < 0.0,
-            ray.direction.z < 0.0,
+            ray.direction.x.is_sign_negative(),
+            ray.direction.y.is_sign_negative(),
+            ray.direction.z.is_sign_negative(),
         ];
         let mut tmax = tmax;
         let oct_inv4 = octant_inv4(ray.direction);
