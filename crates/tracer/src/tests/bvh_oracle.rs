@@ -65,7 +65,10 @@ impl Rng {
 
 /// A generated object's size: most are ordinary, some tiny, some huge.
 fn size(rng: &mut Rng) -> f64 {
-    match rng.below(10) {
+    match rng.below(40) {
+        // Extreme sizes broke the BVH build (issue 10: `sphere { radius 1e19 }` panicked).
+        39 => rng.range(1e15, 1e19),
+        38 => rng.range(1e-7, 1e-6),
         0 => rng.range(1e-4, 1e-2),
         1 => rng.range(50.0, 2000.0),
         _ => rng.range(0.2, 2.0),
@@ -467,4 +470,31 @@ fn regression_straight_down_directional_light_casts_a_shadow() {
         }
     }
     assert!(in_shadow > 0, "no floor point under the ball was in view");
+}
+
+/// Issue 10: `sphere { radius 1e19 } sphere { }` panicked in the BVH build (obvhs's
+/// converter found only infinite costs). It must build, and render without NaN.
+#[test]
+fn regression_huge_sphere_builds_and_renders() {
+    for radius in [1e19, 1e30, 3e38] {
+        let mut b = SceneBuilder::new();
+        b.camera(DVec3::new(0.0, 0.0, -5.0), DVec3::ZERO, 40.0);
+        b.point_light(DVec3::new(0.0, 3.0, -3.0), 1.0);
+        let m = b.material(matte(0.5, 0.5, 0.5));
+        b.add(sphere(0.0, 0.0, 0.0, radius), DMat4::IDENTITY, m);
+        for i in 0..6 {
+            b.add(sphere(f64::from(i), 0.0, 0.0, 1.0), DMat4::IDENTITY, m);
+        }
+        b.add(sphere(1e-30, 0.0, 0.0, 1e-31), DMat4::IDENTITY, m);
+        let scene = prepare(b);
+        let opts = options(16, 12);
+        let rendered = crate::render::render(&scene, &opts, &crate::render::NoObserver);
+        let Some((image, _)) = rendered else {
+            panic!("the render was cancelled");
+        };
+        assert!(
+            image.pixels.iter().flatten().all(|c| c.is_finite()),
+            "radius {radius}: a pixel is not finite"
+        );
+    }
 }
