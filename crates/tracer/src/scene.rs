@@ -78,7 +78,8 @@ pub struct PreparedScene {
     pub(crate) bvh: Option<Bvh>,
     pub(crate) background: Vec3A,
     pub(crate) ambient: Vec3A,
-    pub(crate) epsilon: f32,
+    /// The scene's explicit surface offset; `None` for error-bounded offsets.
+    pub(crate) epsilon: Option<f32>,
     pub(crate) shadows: ShadowMode,
     build_seconds: f64,
 }
@@ -133,7 +134,7 @@ impl PreparedScene {
             bvh,
             background: color(&settings.background),
             ambient: color(&settings.ambient),
-            epsilon: settings.epsilon as f32,
+            epsilon: settings.epsilon.map(|e| e as f32),
             shadows: settings.shadows,
             settings,
             build_seconds: started.elapsed().as_secs_f64(),

@@ -190,7 +190,10 @@ impl<'a> Tracer<'a> {
             absorption,
         });
 
-        let offset = surface_offset(point, scene.epsilon) * self.offset_scale;
+        let offset = match scene.epsilon {
+            Some(epsilon) => epsilon,
+            None => surface_offset(ray.origin, hit.t, point),
+        } * self.offset_scale;
         let outside = point + offset * n;
         let mut color = self.local_illumination(m, outside, n, -d, rec);
 

@@ -867,7 +867,7 @@ impl<'a> Evaluator<'a> {
                 settings.min_weight = self.in_range(value, value_span, prop, 0.0, false, 1.0)?
             }
             Prop::Epsilon => {
-                settings.epsilon = self.in_range(value, value_span, prop, 0.0, true, 1.0)?
+                settings.epsilon = Some(self.in_range(value, value_span, prop, 0.0, true, 1.0)?)
             }
             Prop::Background => settings.background = self.as_color(value, value_span, prop)?,
             Prop::Ambient => settings.ambient = self.as_color(value, value_span, prop)?,
