@@ -14,7 +14,7 @@ use whitted_ir::{
 use crate::bounds::Bound;
 use crate::bvh::Bvh;
 use crate::camera::PreparedCamera;
-use crate::csg::{CsgNode, CsgTree};
+use crate::csg::{ChildAccel, CsgNode, CsgTree, NO_ACCEL};
 use crate::light::PreparedLight;
 use crate::material::{color, PatternFrame, PreparedMaterial, Snap};
 use crate::shapes::Geometry;
@@ -270,15 +270,24 @@ fn build_csg(scene: &Scene, materials: &[PreparedMaterial], root: Handle<Object>
             }
             ObjectKind::Csg { op, children } => {
                 let child_nodes = finished.split_off(finished.len().saturating_sub(children.len()));
-                let bounds = child_nodes
+                let child_bounds: Vec<Bound> = child_nodes
                     .iter()
-                    .map(|&n| node_bound(&tree.nodes[n as usize]));
+                    .map(|&n| node_bound(&tree.nodes[n as usize]))
+                    .collect();
+                let bounds = child_bounds.iter().copied();
                 let bound = match op {
                     CsgOp::Union => bounds.fold(Bound::Empty, Bound::union),
                     CsgOp::Intersection => {
                         bounds.reduce(Bound::intersection).unwrap_or(Bound::Empty)
                     }
                     CsgOp::Difference => bounds.take(1).next().unwrap_or(Bound::Empty),
+                };
+                let accel = match ChildAccel::new(*op, &child_bounds) {
+                    Some(accel) => {
+                        tree.accels.push(accel);
+                        tree.accels.len() as u32 - 1
+                    }
+                    None => NO_ACCEL,
                 };
                 let first_child = tree.children.len() as u32;
                 tree.children.extend_from_slice(&child_nodes);
@@ -287,6 +296,7 @@ fn build_csg(scene: &Scene, materials: &[PreparedMaterial], root: Handle<Object>
                     first_child,
                     child_count: child_nodes.len() as u32,
                     bound,
+                    accel,
                 });
                 finished.push(tree.nodes.len() as u32 - 1);
             }
