@@ -157,15 +157,20 @@ impl Input<'_> {
         region_offset: u32,
         depth: u32,
     ) -> (Bvh2Node, Work) {
-        let bounds = prims
-            .iter()
-            .fold(Aabb::empty(), |acc, &p| acc.union(&self.boxes[p as usize]));
+        // One pass for the node's box and the bounds of its centroids.
+        let mut bounds = Aabb::empty();
+        let mut centroid_bounds = Aabb::empty();
+        for &p in prims.iter() {
+            bounds = bounds.union(&self.boxes[p as usize]);
+            let c = self.centroids[p as usize];
+            centroid_bounds = centroid_bounds.union(&Aabb::new(c, c));
+        }
         if prims.len() <= 1 {
             let work = Work { steps: 1, depth };
             return (Bvh2Node::new(bounds, 1, prim_offset), work);
         }
         let len = prims.len();
-        let left_len = self.split(prims, depth);
+        let left_len = self.split(prims, &centroid_bounds, depth);
         let (left_prims, right_prims) = prims.split_at_mut(left_len);
         let (children, below) = region.split_at_mut(2);
         let (left_region, right_region) = below.split_at_mut(2 * left_len - 2);
@@ -198,15 +203,9 @@ impl Input<'_> {
     }
 
     /// Reorders `prims` into two non-empty parts and returns the length of the first.
-    fn split(&self, prims: &mut [u32], depth: u32) -> usize {
-        let mut lo = Vec3A::splat(f32::INFINITY);
-        let mut hi = Vec3A::splat(f32::NEG_INFINITY);
-        for &p in prims.iter() {
-            let c = self.centroids[p as usize];
-            lo = lo.min(c);
-            hi = hi.max(c);
-        }
-        let extent = hi - lo;
+    fn split(&self, prims: &mut [u32], centroid_bounds: &Aabb, depth: u32) -> usize {
+        let lo = centroid_bounds.min;
+        let extent = centroid_bounds.max - lo;
         let axis = extent.max_position();
         if extent[axis] > 0.0 && depth < SAH_DEPTH_LIMIT {
             if let Some(left_len) = self.sah_split(prims, lo, extent) {
@@ -224,18 +223,23 @@ impl Input<'_> {
             // `as` saturates, and NaN becomes 0.
             (x as usize).min(BINS - 1)
         };
+        // One pass bins every primitive on all three axes.
+        let mut counts = [[0u32; BINS]; 3];
+        let mut bin_boxes = [[Aabb::empty(); BINS]; 3];
+        for &p in prims.iter() {
+            let (c, aabb) = (self.centroids[p as usize], &self.boxes[p as usize]);
+            for axis in 0..3 {
+                let b = bin_of(c, axis);
+                counts[axis][b] += 1;
+                bin_boxes[axis][b] = bin_boxes[axis][b].union(aabb);
+            }
+        }
         let mut best: Option<(f32, usize, usize)> = None;
         for axis in 0..3 {
             if extent[axis] <= 0.0 {
                 continue;
             }
-            let mut counts = [0u32; BINS];
-            let mut boxes = [Aabb::empty(); BINS];
-            for &p in prims.iter() {
-                let b = bin_of(self.centroids[p as usize], axis);
-                counts[b] += 1;
-                boxes[b] = boxes[b].union(&self.boxes[p as usize]);
-            }
+            let (counts, boxes) = (&counts[axis], &bin_boxes[axis]);
             // Right-to-left sweep of areas, then left to right for the costs.
             let mut right_area = [0.0f32; BINS];
             let mut acc = Aabb::empty();
