@@ -195,9 +195,7 @@ mod tests {
             .err()
             .expect("a 32768x32768 image is refused");
         assert!(
-            errors.diagnostics[0]
-                .message
-                .contains("pixels limit"),
+            errors.diagnostics[0].message.contains("pixels limit"),
             "{}",
             errors.diagnostics[0].message
         );

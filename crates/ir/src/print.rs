@@ -24,7 +24,7 @@ pub fn print(scene: &Scene) -> String {
         "  background {}, ambient {}, epsilon {}, shadows {:?}",
         color(&s.background),
         color(&s.ambient),
-        s.epsilon,
+        s.epsilon.map_or("auto".to_string(), |e| e.to_string()),
         s.shadows
     );
     let c = &scene.camera;

@@ -175,7 +175,10 @@ impl Ranges<'_> {
                 ));
             }
         }
-        self.size("`epsilon`", s.epsilon, span);
+        // Unset, the tracer bounds the offset by the hit point's rounding error itself.
+        if let Some(epsilon) = s.epsilon {
+            self.size("`epsilon`", epsilon, span);
+        }
         self.color(
             "`background`",
             &s.background,

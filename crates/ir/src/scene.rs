@@ -63,8 +63,9 @@ pub struct Settings {
     pub background: Color,
     /// The global ambient light `Ia`.
     pub ambient: Color,
-    /// Secondary rays start this far off the surface along the normal.
-    pub epsilon: f64,
+    /// When set, secondary rays start exactly this far off the surface along the normal;
+    /// when not, the tracer uses the floating-point error bound of each hit point.
+    pub epsilon: Option<f64>,
     pub shadows: ShadowMode,
 }
 
@@ -78,7 +79,7 @@ impl Default for Settings {
             samples_per_pixel: 1,
             background: Color::BLACK,
             ambient: Color::WHITE,
-            epsilon: 1e-4,
+            epsilon: None,
             shadows: ShadowMode::Opaque,
         }
     }

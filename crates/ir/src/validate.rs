@@ -110,9 +110,9 @@ impl Checker {
                 span,
             );
         }
-        if !(s.epsilon.is_finite() && s.epsilon > 0.0) {
+        if let Some(epsilon) = s.epsilon.filter(|e| !(e.is_finite() && *e > 0.0)) {
             self.error(
-                format!("the surface offset epsilon must be > 0, not {}", s.epsilon),
+                format!("the surface offset epsilon must be > 0, not {epsilon}"),
                 span,
             );
         }

@@ -29,6 +29,7 @@ use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::CwBvh;
 
 use crate::bounds::inverse_direction;
+use crate::bvh_build::{build_bvh2, round_down, round_up, BuildScale};
 use crate::ray::Ray;
 
 /// Children's box planes of one node, four children per half: `halves[h][axis * 2]` holds
@@ -68,7 +69,7 @@ impl WideNode {
     /// `None` when the metadata is not laid out as obvhs's converter writes it (inner child
     /// `c` with metadata `0b001` and `24 + c`; leaves with at most three primitives within
     /// the node's 24), where the decoded bits would not give obvhs's hit mask.
-    fn new(node: &CwBvhNode) -> Option<WideNode> {
+    fn new(node: &CwBvhNode, scale: BuildScale) -> Option<WideNode> {
         let mut leaf_bits = [0u32; 8];
         for (slot, (bits, &meta)) in leaf_bits.iter_mut().zip(&node.child_meta).enumerate() {
             let inner = node.imask & (1 << slot) != 0;
@@ -87,7 +88,7 @@ impl WideNode {
             }
         }
         Some(WideNode {
-            planes: dequantise(node),
+            planes: dequantise(node, scale),
             leaf_bits,
             child_base: node.child_base_idx,
             primitive_base: node.primitive_base_idx,
@@ -153,27 +154,33 @@ pub enum Step {
     Stop,
 }
 
-fn build_cwbvh(aabbs: &[Aabb]) -> CwBvh {
-    obvhs::cwbvh::builder::build_cwbvh(
-        aabbs,
-        obvhs::BvhBuildParams::medium_build(),
-        &mut std::time::Duration::default(),
-    )
+/// Our binary BVH (see `bvh_build`) converted by obvhs, with leaves of up to three
+/// primitives as `BvhBuildParams::medium_build()` would make them; the boxes it holds are
+/// in build space, `scale` times the world.
+fn build_cwbvh(aabbs: &[Aabb]) -> (CwBvh, BuildScale) {
+    let built = build_bvh2(aabbs);
+    let cwbvh = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&built.bvh2, 3, true, false);
+    (cwbvh, built.scale)
 }
 
 /// How many primitives a finished build may hold in total before ids overflow u32.
 pub const MAX_PRIMITIVES: usize = u32::MAX as usize;
 
 impl Bvh {
-    /// Builds with obvhs (`build_cwbvh`, `BvhBuildParams::medium_build()`, parallel on the
-    /// current rayon pool). Returns the BVH and `primitive_indices`: the input index of
-    /// each BVH primitive id.
+    /// Builds the binary BVH (`bvh_build`, parallel on the current rayon pool) and has
+    /// obvhs convert it. Returns the BVH and `primitive_indices`: the input index of each
+    /// BVH primitive id.
     pub fn build(aabbs: &[Aabb]) -> (Bvh, Vec<u32>) {
-        Self::from_cwbvh(build_cwbvh(aabbs))
+        let (cwbvh, scale) = build_cwbvh(aabbs);
+        Self::from_cwbvh(cwbvh, scale)
     }
 
-    fn from_cwbvh(cwbvh: CwBvh) -> (Bvh, Vec<u32>) {
-        let nodes: Option<Vec<WideNode>> = cwbvh.nodes.iter().map(WideNode::new).collect();
+    fn from_cwbvh(cwbvh: CwBvh, scale: BuildScale) -> (Bvh, Vec<u32>) {
+        let nodes: Option<Vec<WideNode>> = cwbvh
+            .nodes
+            .iter()
+            .map(|node| WideNode::new(node, scale))
+            .collect();
         match nodes {
             Some(nodes) => (Bvh { nodes }, cwbvh.primitive_indices),
             // Not the layout obvhs documents: no BVH, so the caller tests every item.
@@ -337,18 +344,34 @@ fn first_bit_high(value: u32) -> u32 {
     31 - value.leading_zeros()
 }
 
-/// obvhs's octant code for child ordering.
+/// obvhs's octant code for child ordering, from the sign bits of the direction. The sign
+/// bit, not `< 0.0`, must decide: [`inverse_direction`] turns a −0.0 component into −1/ε,
+/// and the walk's near and far planes must agree with that sign, or every box is missed
+/// (obvhs's own `ray_get_octant_inv4` compares with `< 0.0` and has that bug). For a −0.0
+/// component the order is obvhs's order for a direction with a tiny negative component.
 #[inline(always)]
 fn octant_inv4(direction: Vec3A) -> u32 {
-    (if direction.x < 0.0 { 0 } else { 0x0404_0404 })
-        | (if direction.y < 0.0 { 0 } else { 0x0202_0202 })
-        | (if direction.z < 0.0 { 0 } else { 0x0101_0101 })
+    (if direction.x.is_sign_negative() {
+        0
+    } else {
+        0x0404_0404
+    }) | (if direction.y.is_sign_negative() {
+        0
+    } else {
+        0x0202_0202
+    }) | (if direction.z.is_sign_negative() {
+        0
+    } else {
+        0x0101_0101
+    })
 }
 
 /// The world-space f32 planes of a node's children, rounded outwards. The quantised plane
-/// is `p + 2^e·q` exactly (a power of two times a byte), computed in f64 and then moved to
-/// the f32 on the conservative side.
-fn dequantise(node: &CwBvhNode) -> NodePlanes {
+/// is `p + 2^e·q` exactly (a power of two times a byte) in build space; divided by the build
+/// scale (a power of two) in f64 it is exact in world space, and then moved to the f32 on
+/// the conservative side (infinite where the world plane is beyond f32's range).
+fn dequantise(node: &CwBvhNode, build_scale: BuildScale) -> NodePlanes {
+    let unscale = build_scale.factor().recip();
     let mut out = NodePlanes::default();
     let quantised = [
         &node.child_min_x,
@@ -364,14 +387,12 @@ fn dequantise(node: &CwBvhNode) -> NodePlanes {
         let origin = f64::from(node.p[axis]);
         let scale = f64::from(f32::from_bits(u32::from(node.e[axis]) << 23));
         for child in 0..8 {
-            let exact = origin + scale * f64::from(bytes[child]);
-            let mut rounded = exact as f32;
-            if is_max && f64::from(rounded) < exact {
-                rounded = rounded.next_up();
-            } else if !is_max && f64::from(rounded) > exact {
-                rounded = rounded.next_down();
-            }
-            out.halves[child / 4][slot][child % 4] = rounded;
+            let exact = (origin + scale * f64::from(bytes[child])) * unscale;
+            out.halves[child / 4][slot][child % 4] = if is_max {
+                round_up(exact)
+            } else {
+                round_down(exact)
+            };
         }
     }
     out
@@ -399,9 +420,9 @@ mod tests {
         }
         let query = NodeQuery::new(ray, tmin);
         let backwards = [
-            ray.direction.x < 0.0,
-            ray.direction.y < 0.0,
-            ray.direction.z < 0.0,
+            ray.direction.x.is_sign_negative(),
+            ray.direction.y.is_sign_negative(),
+            ray.direction.z.is_sign_negative(),
         ];
         let mut tmax = tmax;
         let oct_inv4 = octant_inv4(ray.direction);
@@ -499,8 +520,8 @@ mod tests {
                 Aabb::new(c - half, c + half)
             })
             .collect();
-        let cwbvh = build_cwbvh(&aabbs);
-        let (bvh, _) = Bvh::from_cwbvh(cwbvh.clone());
+        let (cwbvh, scale) = build_cwbvh(&aabbs);
+        let (bvh, _) = Bvh::from_cwbvh(cwbvh.clone(), scale);
         assert!(bvh.node_count() > 100);
         let mut stack = Vec::new();
         let mut compared = 0;
@@ -535,9 +556,9 @@ mod tests {
     /// The decoded child bits give obvhs's hit mask for every touched set and octant.
     #[test]
     fn decoded_child_bits_give_obvhs_hit_masks() {
-        let cwbvh = build_cwbvh(&boxes(2000));
+        let (cwbvh, scale) = build_cwbvh(&boxes(2000));
         for node in &cwbvh.nodes {
-            let Some(wide) = WideNode::new(node) else {
+            let Some(wide) = WideNode::new(node, scale) else {
                 panic!("obvhs wrote metadata the walk does not expect");
             };
             for oct in 0..8u32 {

@@ -9,10 +9,18 @@
 //! Evaluation is iterative over an explicit stack and works in a per-thread [`CsgScratch`]
 //! whose buffers grow to the largest tree seen and are then reused: no allocation per ray,
 //! no recursion limit, and no fixed cap on the number of spans.
+//!
+//! A union or difference with many children carries a BVH over its children's bounds
+//! ([`ChildAccel`]): a ray then evaluates only the children whose boxes its window touches
+//! (for a difference, the first child and the subtracted ones it touches), in source order,
+//! which is exactly what the plain loop computes, since an untouched child adds no span.
 
+use glam::UVec2;
+use obvhs::aabb::Aabb;
 use whitted_ir::CsgOp;
 
 use crate::bounds::{inverse_direction, Bound};
+use crate::bvh::{Bvh, Step};
 use crate::ray::Ray;
 use crate::scene::Leaf;
 use crate::shapes::Part;
@@ -47,7 +55,77 @@ pub enum CsgNode {
         first_child: u32,
         child_count: u32,
         bound: Bound,
+        /// Index into [`CsgTree::accels`], or [`NO_ACCEL`].
+        accel: u32,
     },
+}
+
+/// An operation without a BVH over its children.
+pub const NO_ACCEL: u32 = u32::MAX;
+
+/// From this many children on, a union or difference gets a BVH over its children.
+pub const ACCEL_MIN_CHILDREN: usize = 8;
+
+/// The BVH over an operation's children, and the children it cannot hold.
+#[derive(Clone, Debug)]
+pub struct ChildAccel {
+    bvh: Bvh,
+    /// The child position (0-based among the node's children) of each BVH primitive id.
+    positions: Vec<u32>,
+    /// Positions evaluated for every ray: unbounded children, and a difference's first.
+    always: Vec<u32>,
+}
+
+impl ChildAccel {
+    /// The BVH over the children at `bounds` (positions in order); `None` when it would not
+    /// help (an intersection, too few children, or too few bounded ones).
+    pub fn new(op: CsgOp, bounds: &[Bound]) -> Option<ChildAccel> {
+        if op == CsgOp::Intersection || bounds.len() < ACCEL_MIN_CHILDREN {
+            return None;
+        }
+        let mut always = Vec::new();
+        let mut boxed: Vec<(u32, Aabb)> = Vec::new();
+        for (position, bound) in bounds.iter().enumerate() {
+            let position = position as u32;
+            match bound {
+                _ if op == CsgOp::Difference && position == 0 => always.push(position),
+                Bound::Infinite => always.push(position),
+                // An empty child adds no span to a union or a difference.
+                Bound::Empty => {}
+                Bound::Finite(aabb) => boxed.push((position, *aabb)),
+            }
+        }
+        if boxed.len() < ACCEL_MIN_CHILDREN {
+            return None;
+        }
+        let aabbs: Vec<Aabb> = boxed.iter().map(|&(_, aabb)| aabb).collect();
+        let (bvh, indices) = Bvh::build(&aabbs);
+        if bvh.node_count() == 0 || indices.len() != boxed.len() {
+            return None;
+        }
+        let positions = indices
+            .iter()
+            .map(|&i| boxed.get(i as usize).map_or(0, |&(p, _)| p))
+            .collect();
+        Some(ChildAccel {
+            bvh,
+            positions,
+            always,
+        })
+    }
+
+    /// Appends to `out` the positions of the children the window may touch, ascending.
+    fn touched(&self, ray: &Ray, tmin: f32, tmax: f32, stack: &mut Vec<UVec2>, out: &mut Vec<u32>) {
+        let start = out.len();
+        out.extend_from_slice(&self.always);
+        self.bvh.traverse(ray, tmin, tmax, stack, |id, _| {
+            if let Some(&position) = self.positions.get(id as usize) {
+                out.push(position);
+            }
+            Step::Continue
+        });
+        out[start..].sort_unstable();
+    }
 }
 
 /// One top-level CSG object: nodes in bottom-up order (the root is last) and its leaves.
@@ -56,6 +134,7 @@ pub struct CsgTree {
     pub nodes: Vec<CsgNode>,
     pub children: Vec<u32>,
     pub leaves: Vec<Leaf>,
+    pub accels: Vec<ChildAccel>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -67,6 +146,10 @@ struct Frame {
     start: u32,
     /// Where the most recent child's spans begin.
     middle: u32,
+    /// With a [`ChildAccel`]: where this node's touched child positions begin in
+    /// `CsgScratch::touched`, and how many there are.
+    touched_start: u32,
+    touched_len: u32,
 }
 
 /// Reusable buffers for CSG evaluation; one per worker thread (or per tile).
@@ -75,9 +158,26 @@ pub struct CsgScratch {
     spans: Vec<Span>,
     merged: Vec<Span>,
     stack: Vec<Frame>,
+    /// Child positions touched by the ray, one run per accelerated node on the stack.
+    touched: Vec<u32>,
+    bvh_stack: Vec<UVec2>,
 }
 
 impl CsgTree {
+    /// The same tree with every operation evaluated by the plain loop over its children:
+    /// the oracle for the accelerated evaluation.
+    #[cfg(test)]
+    pub fn without_acceleration(&self) -> CsgTree {
+        let mut plain = self.clone();
+        plain.accels.clear();
+        for node in &mut plain.nodes {
+            if let CsgNode::Op { accel, .. } = node {
+                *accel = NO_ACCEL;
+            }
+        }
+        plain
+    }
+
     fn root(&self) -> u32 {
         self.nodes.len().saturating_sub(1) as u32
     }
@@ -101,15 +201,11 @@ impl CsgTree {
         let inv_direction = inverse_direction(ray.direction);
         scratch.spans.clear();
         scratch.stack.clear();
+        scratch.touched.clear();
         if self.nodes.is_empty() {
             return;
         }
-        scratch.stack.push(Frame {
-            node: self.root(),
-            next: 0,
-            start: 0,
-            middle: 0,
-        });
+        scratch.stack.push(Frame::new(self.root()));
         while let Some(&frame) = scratch.stack.last() {
             let top = scratch.stack.len() - 1;
             match &self.nodes[frame.node as usize] {
@@ -136,36 +232,71 @@ impl CsgTree {
                     first_child,
                     child_count,
                     bound,
+                    accel,
                 } => {
                     let len = scratch.spans.len() as u32;
+                    let accel = self.accels.get(*accel as usize);
                     if frame.next == 0 {
                         if *child_count == 0 || !bound.admits(ray, inv_direction, tmin, tmax) {
                             scratch.stack.pop();
                             continue;
                         }
                         scratch.stack[top].start = len;
+                        if let Some(accel) = accel {
+                            let touched_start = scratch.touched.len();
+                            accel.touched(
+                                ray,
+                                tmin,
+                                tmax,
+                                &mut scratch.bvh_stack,
+                                &mut scratch.touched,
+                            );
+                            scratch.stack[top].touched_start = touched_start as u32;
+                            scratch.stack[top].touched_len =
+                                (scratch.touched.len() - touched_start) as u32;
+                        }
                     } else if frame.next >= 2 {
                         // The child started last has finished: fold it into the accumulator.
                         combine_in_place(*op, frame.start as usize, frame.middle as usize, scratch);
                     }
+                    let frame = scratch.stack[top];
                     let accumulated_empty = scratch.spans.len() as u32 == frame.start;
-                    let finished = frame.next == *child_count
+                    let count = match accel {
+                        Some(_) => frame.touched_len,
+                        None => *child_count,
+                    };
+                    let finished = frame.next == count
                         || (frame.next > 0 && accumulated_empty && *op != CsgOp::Union);
                     if finished {
+                        if accel.is_some() {
+                            scratch.touched.truncate(frame.touched_start as usize);
+                        }
                         scratch.stack.pop();
                         continue;
                     }
-                    let child = self.children[(*first_child + frame.next) as usize];
+                    let position = match accel {
+                        Some(_) => scratch.touched[(frame.touched_start + frame.next) as usize],
+                        None => frame.next,
+                    };
+                    let child = self.children[(*first_child + position) as usize];
                     scratch.stack[top].middle = scratch.spans.len() as u32;
                     scratch.stack[top].next += 1;
-                    scratch.stack.push(Frame {
-                        node: child,
-                        next: 0,
-                        start: 0,
-                        middle: 0,
-                    });
+                    scratch.stack.push(Frame::new(child));
                 }
             }
+        }
+    }
+}
+
+impl Frame {
+    fn new(node: u32) -> Frame {
+        Frame {
+            node,
+            next: 0,
+            start: 0,
+            middle: 0,
+            touched_start: 0,
+            touched_len: 0,
         }
     }
 }

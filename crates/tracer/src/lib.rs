@@ -8,6 +8,7 @@
 
 mod bounds;
 mod bvh;
+mod bvh_build;
 mod camera;
 mod csg;
 pub mod display;

@@ -17,7 +17,7 @@ use crate::scene::{Item, Leaf, PreparedScene};
 use crate::shapes::{plane_first_hit, sphere_first_hit, unit_normal, Geometry, Part};
 
 /// Up to this many bounded items a plain loop beats walking the BVH.
-const LINEAR_LIMIT: usize = 4;
+pub(crate) const LINEAR_LIMIT: usize = 4;
 
 /// Which top-level item was hit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -81,6 +81,14 @@ pub struct Scratch {
     bvh_stack: Vec<UVec2>,
 }
 
+#[cfg(test)]
+impl Scratch {
+    /// The CSG buffers, for tests that call [`item_hit`] themselves.
+    pub(crate) fn csg(&mut self) -> &mut CsgScratch {
+        &mut self.csg
+    }
+}
+
 /// What the cheap test of one item reports: the distance, the CSG leaf (0 for a plain
 /// shape), the part, and whether the leaf's normal is flipped.
 type ItemHit = (f32, u32, Part, bool);
@@ -89,7 +97,7 @@ type ItemHit = (f32, u32, Part, bool);
 /// must be fast, are tested inline; everything else goes through [`other_item_hit`], kept
 /// out of line so that the query loops stay small enough for the compiler to inline.
 #[inline(always)]
-fn item_hit(
+pub(crate) fn item_hit(
     item: &Item,
     ray: &Ray,
     tmin: f32,

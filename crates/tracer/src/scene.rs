@@ -14,9 +14,10 @@ use whitted_ir::{
 use crate::bounds::Bound;
 use crate::bvh::Bvh;
 use crate::camera::PreparedCamera;
-use crate::csg::{CsgNode, CsgTree};
+use crate::csg::{ChildAccel, CsgNode, CsgTree, NO_ACCEL};
 use crate::light::PreparedLight;
 use crate::material::{color, PatternFrame, PreparedMaterial, Snap};
+use crate::ray::Ray;
 use crate::shapes::Geometry;
 
 /// A primitive shape ready to intersect, with what shading needs to know about it.
@@ -78,7 +79,8 @@ pub struct PreparedScene {
     pub(crate) bvh: Option<Bvh>,
     pub(crate) background: Vec3A,
     pub(crate) ambient: Vec3A,
-    pub(crate) epsilon: f32,
+    /// The scene's explicit surface offset; `None` for error-bounded offsets.
+    pub(crate) epsilon: Option<f32>,
     pub(crate) shadows: ShadowMode,
     /// Whether any material has a nested-media priority: only then are coincident
     /// surfaces looked for and crossed together.
@@ -87,6 +89,16 @@ pub struct PreparedScene {
 }
 
 impl PreparedScene {
+    /// How far a secondary ray starts off the surface at `point`, reached by `ray` at `t`:
+    /// the scene's explicit `epsilon`, or else the error bound of the hit point.
+    #[inline]
+    pub(crate) fn offset_at(&self, ray: &Ray, t: f32, point: Vec3A) -> f32 {
+        match self.epsilon {
+            Some(epsilon) => epsilon,
+            None => crate::optics::surface_offset(ray.origin, t, point),
+        }
+    }
+
     /// Prepares a validated scene: converts shapes (in parallel on the current rayon pool)
     /// and builds the BVH.
     pub fn new(valid: &ValidScene) -> PreparedScene {
@@ -136,7 +148,7 @@ impl PreparedScene {
             bvh,
             background: color(&settings.background),
             ambient: color(&settings.ambient),
-            epsilon: settings.epsilon as f32,
+            epsilon: settings.epsilon.map(|e| e as f32),
             shadows: settings.shadows,
             nested_media: scene.materials.iter().any(|(_, m)| m.priority != 0),
             settings,
@@ -273,15 +285,24 @@ fn build_csg(scene: &Scene, materials: &[PreparedMaterial], root: Handle<Object>
             }
             ObjectKind::Csg { op, children } => {
                 let child_nodes = finished.split_off(finished.len().saturating_sub(children.len()));
-                let bounds = child_nodes
+                let child_bounds: Vec<Bound> = child_nodes
                     .iter()
-                    .map(|&n| node_bound(&tree.nodes[n as usize]));
+                    .map(|&n| node_bound(&tree.nodes[n as usize]))
+                    .collect();
+                let bounds = child_bounds.iter().copied();
                 let bound = match op {
                     CsgOp::Union => bounds.fold(Bound::Empty, Bound::union),
                     CsgOp::Intersection => {
                         bounds.reduce(Bound::intersection).unwrap_or(Bound::Empty)
                     }
                     CsgOp::Difference => bounds.take(1).next().unwrap_or(Bound::Empty),
+                };
+                let accel = match ChildAccel::new(*op, &child_bounds) {
+                    Some(accel) => {
+                        tree.accels.push(accel);
+                        tree.accels.len() as u32 - 1
+                    }
+                    None => NO_ACCEL,
                 };
                 let first_child = tree.children.len() as u32;
                 tree.children.extend_from_slice(&child_nodes);
@@ -290,6 +311,7 @@ fn build_csg(scene: &Scene, materials: &[PreparedMaterial], root: Handle<Object>
                     first_child,
                     child_count: child_nodes.len() as u32,
                     bound,
+                    accel,
                 });
                 finished.push(tree.nodes.len() as u32 - 1);
             }

@@ -17,9 +17,7 @@ use whitted_ir::{Fresnel, Handle, Material, ShadowMode};
 
 use crate::material::PreparedMaterial;
 use crate::media::{same_medium, Medium, MediumStack};
-use crate::optics::{
-    beer_lambert, fresnel_exact, max_channel, reflect, refract, schlick, surface_offset,
-};
+use crate::optics::{beer_lambert, fresnel_exact, max_channel, reflect, refract, schlick};
 use crate::query::{Hit, Scratch, Shadow, Surface};
 use crate::ray::Ray;
 use crate::recorder::{
@@ -291,7 +289,7 @@ impl<'a> Tracer<'a> {
             absorption,
         });
 
-        let offset = surface_offset(point, scene.epsilon) * self.offset_scale;
+        let offset = scene.offset_at(ray, hit.t, point) * self.offset_scale;
         let outside = point + offset * n;
         let mut color = self.local_illumination(m, outside, n, -d, rec);
 
@@ -508,7 +506,8 @@ impl<'a> Tracer<'a> {
     ) -> Meeting<'a> {
         const MOST: usize = MediumStack::CAPACITY;
         let scene = self.scene;
-        let window = surface_offset(first.surface.point, scene.epsilon);
+        // Surfaces closer together than the hit point's error bound cannot be told apart.
+        let window = scene.offset_at(ray, first.hit.t, first.surface.point);
         let resume = first.hit.t + window;
         let empty = NearCrossing {
             hit: first.hit,

@@ -909,7 +909,7 @@ impl<'a> Evaluator<'a> {
             }
             Prop::Epsilon => {
                 settings.epsilon =
-                    self.in_range(value, value_span, prop, limits::MIN_SIZE, false, 1.0)?
+                    Some(self.in_range(value, value_span, prop, limits::MIN_SIZE, false, 1.0)?)
             }
             Prop::Background => settings.background = self.light_color(value, value_span, prop)?,
             Prop::Ambient => settings.ambient = self.light_color(value, value_span, prop)?,
@@ -1062,8 +1062,13 @@ impl<'a> Evaluator<'a> {
                 number = self.in_range(value, value_span, prop, 0.0, true, f64::INFINITY)?
             }
             Prop::Priority => {
-                number =
-                    f64::from(self.whole_in_range(value, value_span, prop, 0.0, limits::MAX_PRIORITY.into())?)
+                number = f64::from(self.whole_in_range(
+                    value,
+                    value_span,
+                    prop,
+                    0.0,
+                    limits::MAX_PRIORITY.into(),
+                )?)
             }
             _ => {}
         }

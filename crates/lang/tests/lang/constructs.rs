@@ -271,7 +271,7 @@ fn settings_set_every_field() {
         (s.width, s.height, s.max_depth, s.samples_per_pixel),
         (320, 200, 7, 4)
     );
-    assert_eq!((s.min_weight, s.epsilon), (0.01, 1e-3));
+    assert_eq!((s.min_weight, s.epsilon), (0.01, Some(1e-3)));
     assert_eq!(s.background, Color::new(0.1, 0.2, 0.6));
     assert_eq!(s.ambient, Color::gray(0.5));
     assert_eq!(s.shadows, ShadowMode::Filtered);

@@ -313,3 +313,70 @@ fn secondary_rays_leave_their_surface() {
     }
     assert!(secondary > 500, "only {secondary} secondary rays traced");
 }
+
+/// Whether the shadow ray from where a ray straight down meets the slab's top, at
+/// `(-0.0002, 0, 0.3)`, is blocked: a slab with a rim 0.0024 thick that stands 5e-5 above
+/// the top (one CSG union), lit by a directional light grazing the top at N·L = 0.03 from
+/// beyond the rim. The straight line to the light enters the rim at height 3.6e-5.
+fn thin_rim_blocks(epsilon: Option<f64>) -> bool {
+    let mut b = SceneBuilder::new();
+    b.settings().epsilon = epsilon;
+    let n_dot_l: f64 = 0.03;
+    let to_light = DVec3::new((1.0 - n_dot_l * n_dot_l).sqrt(), n_dot_l, 0.0);
+    b.light(whitted_ir::Light {
+        name: None,
+        color: whitted_ir::Color::gray(1.0),
+        kind: whitted_ir::LightKind::Directional {
+            direction: -to_light,
+        },
+    });
+    let m = b.material(matte(0.8, 0.8, 0.8));
+    let slab = b.part(
+        Shape::Box {
+            min: DVec3::new(-1.0, -0.5, -1.0),
+            max: DVec3::new(1.0, 0.0, 1.0),
+        },
+        DMat4::IDENTITY,
+        m,
+    );
+    let rim = b.part(
+        Shape::Box {
+            min: DVec3::new(0.001, -0.5, -1.0),
+            max: DVec3::new(0.0034, 5e-5, 1.0),
+        },
+        DMat4::IDENTITY,
+        m,
+    );
+    b.csg(whitted_ir::CsgOp::Union, vec![slab, rim], m);
+    let scene = prepare(b);
+    let mut tracer = crate::trace::Tracer::new(&scene, 1, 0.001);
+    let mut tape = super::Tape::default();
+    let ray = crate::ray::Ray::new(
+        glam::Vec3A::new(-0.0002, 0.5, 0.3),
+        glam::Vec3A::new(0.0, -1.0, 0.0),
+    );
+    tracer.trace(&ray, &crate::trace::PathState::camera(), &mut tape);
+    let Some(root) = tape.roots.pop() else {
+        panic!("no ray recorded");
+    };
+    let Some(hit) = root.hit else {
+        panic!("the ray missed the slab");
+    };
+    assert!(hit.point.y.abs() < 1e-6, "{}", hit.point);
+    let Some(shadow) = root.lights.first().and_then(|l| l.shadow_ray) else {
+        panic!("no shadow ray was cast");
+    };
+    matches!(shadow.result, ShadowResult::Blocked { .. })
+}
+
+/// Issue 9: shadow rays started 1e-4 along the normal and passed over a thin rim under a
+/// grazing light. With error-bounded offsets the rim blocks; with the old fixed offset
+/// (now only as an explicit `epsilon 1e-4`) the light leaks, which proves the check.
+#[test]
+fn thin_rim_blocks_a_grazing_light() {
+    assert!(thin_rim_blocks(None), "the light leaks over the rim");
+    assert!(
+        !thin_rim_blocks(Some(1e-4)),
+        "with an explicit epsilon of 1e-4 the shadow ray should start above the rim"
+    );
+}

@@ -2,6 +2,7 @@
 //! tree-building recorder they share.
 
 mod acne;
+mod bvh_oracle;
 mod csg_scenes;
 mod energy;
 mod media_scenes;
