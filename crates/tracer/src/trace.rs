@@ -890,7 +890,24 @@ pub fn split_at(
             split.refracted = Some(direction);
         }
     }
+    conserve_energy(&mut split);
     split
+}
+
+/// Scales a surface's reflected and transmitted coefficients down, channel by channel, so
+/// that they add up to at most 1: a material with `reflective + transmissive` over 1 (the
+/// language warns) would otherwise return more light than arrives at every bounce, and a
+/// trapped ray (total internal reflection with Fresnel, where `kr + kt·R = kr + kt`) would
+/// grow brighter without bound as `max_depth` rises. The ray tree records the scaled
+/// coefficients, so it shows the weights that were used.
+#[inline(always)]
+fn conserve_energy(split: &mut Split) {
+    let total = split.reflect + split.transmit;
+    if total.cmpgt(Vec3A::ONE).any() {
+        let scale = Vec3A::ONE / total.max(Vec3A::ONE);
+        split.reflect *= scale;
+        split.transmit *= scale;
+    }
 }
 
 #[cfg(test)]

@@ -94,3 +94,14 @@ fn a_gem_with_fresnel_does_not_gain_light_with_depth() {
         check_bounded(&gem_scene(gem(fresnel, 0.0)), fresnel.name());
     }
 }
+
+#[test]
+fn the_issue_s_gem_with_fresnel_does_not_gain_light_with_depth() {
+    // The gem of issue 9 (kr 0.5 + kt 0.95 = 1.45, the material warns) with Fresnel: at
+    // total internal reflection R = 1, so kr + kt·R = 1.45 would reflect more than arrives
+    // at every trapped bounce. The tracer scales a surface's reflected and transmitted
+    // coefficients down to add up to 1 where they would add up to more.
+    for fresnel in [Fresnel::Schlick, Fresnel::Exact] {
+        check_bounded(&gem_scene(gem(fresnel, 0.5)), fresnel.name());
+    }
+}
