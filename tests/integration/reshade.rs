@@ -56,7 +56,8 @@ fn c(color: &whitted_ir::Color) -> DVec3 {
 /// only by nesting. Nested media with priorities and coincident surfaces (a glass of water,
 /// being added on another branch) need this extended: the medium is then the
 /// highest-priority solid the point is inside, and a surface between two solids of which the
-/// higher-priority one does not change is no interface at all.
+/// higher-priority one does not change is no interface at all. Until then, scenes that use
+/// `priority` are left out (and named) by the test below.
 #[derive(Clone, Debug, Default)]
 struct Media(Vec<Medium>);
 
@@ -641,8 +642,26 @@ fn every_scene_re_shaded_in_f64_from_its_ray_trees_matches_the_render() {
     assert!(scenes.len() >= 15, "found {} scenes", scenes.len());
     let mut report = Vec::new();
     let mut failures = Vec::new();
+    let mut not_re_shaded = Vec::new();
     for scene in &scenes {
         let name = scene.display().to_string();
+        // The oracle's media model (`Media`) knows solids nested in air, not priorities,
+        // false hits or coincident surfaces: scenes that use `priority` are checked by the
+        // tracer's own nested-media tests (crates/tracer/src/tests/media_scenes.rs) until
+        // the oracle learns them. The list is asserted below, so a new scene cannot slip out.
+        let uses_priority = load(&name)
+            .scene
+            .scene()
+            .materials
+            .iter()
+            .any(|(_, m)| m.priority > 0);
+        if uses_priority {
+            report.push(format!(
+                "{name}: not re-shaded (nested media with priorities)"
+            ));
+            not_re_shaded.push(name);
+            continue;
+        }
         let (mut found, largest, failing) = check_scene(&name, 40, 30);
         report.push(format!(
             "{name}: largest error {largest:.2e}, {failing} of 1200 pixels fail"
@@ -650,6 +669,11 @@ fn every_scene_re_shaded_in_f64_from_its_ray_trees_matches_the_render() {
         failures.append(&mut found);
     }
     eprintln!("{}", report.join("\n"));
+    assert_eq!(
+        not_re_shaded,
+        ["scenes/glass-of-water.scene"],
+        "only the glass of water may skip the re-shading oracle"
+    );
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
