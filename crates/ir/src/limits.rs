@@ -12,6 +12,16 @@ pub const MAX_OBJECTS: usize = 5_000_000;
 /// one, so that neither loops nor recursion (`f(n-1) f(n-1)`) can run for days.
 pub const MAX_EVALUATION_STEPS: u64 = 100_000_000;
 
+/// Elements of one array (`[a, b, c]`).
+pub const MAX_ARRAY_LENGTH: usize = 1_000_000;
+
+/// Bytes of one string value or formatted name (`"ball {i}"`).
+pub const MAX_STRING_BYTES: usize = 4_096;
+
+/// Bytes of every array and string made in one compilation: they live until it ends, so a
+/// loop that makes one per iteration is bounded here.
+pub const MAX_VALUE_BYTES: u64 = 256 * 1024 * 1024;
+
 /// Nested calls of user functions.
 pub const MAX_CALL_DEPTH: usize = 256;
 
@@ -146,6 +156,13 @@ pub const ALL: &[Limit] = &[
         "loop iterations and function calls in one compilation",
     ),
     count("call depth", MAX_CALL_DEPTH as u64, "nested function calls"),
+    count("array length", MAX_ARRAY_LENGTH as u64, "elements of one array"),
+    count("string length", MAX_STRING_BYTES as u64, "bytes of one string or formatted name"),
+    count(
+        "value memory",
+        MAX_VALUE_BYTES,
+        "bytes of all arrays and strings made in one compilation",
+    ),
     count("nesting", MAX_NESTING as u64, "nested brackets `(` and `{`"),
     count("import depth", MAX_IMPORT_DEPTH as u64, "nested imports"),
     count("imports", MAX_IMPORTS as u64, "files read in one compilation"),

@@ -31,10 +31,20 @@ pub struct Ident {
     pub span: Span,
 }
 
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug)]
 pub struct StrLit {
     pub value: String,
     pub span: Span,
+    /// The text split at its `{name}` holes (see [`crate::strings`]); empty for a string
+    /// without holes and for strings that are never formatted (import paths).
+    pub parts: Vec<StrPart>,
+}
+
+/// A piece of a formatted string: `"ball {i}"` is `Text("ball ")` then `Hole(i)`.
+#[derive(Clone, Debug)]
+pub enum StrPart {
+    Text(String),
+    Hole(Name),
 }
 
 #[derive(Debug)]
@@ -121,7 +131,19 @@ pub enum ItemKind {
         start: Expr,
         end: Expr,
         inclusive: bool,
+        /// `for i in 0..10 step 2`.
+        step: Option<Expr>,
         body: Block,
+    },
+    /// `while condition { ... }`.
+    While {
+        condition: Expr,
+        body: Block,
+    },
+    /// `name = value;`: a new value for a `let` binding.
+    Assign {
+        target: Name,
+        value: Expr,
     },
     If {
         condition: Expr,
@@ -270,4 +292,13 @@ pub enum ExprKind {
     },
     Call(Box<Call>),
     Material(Box<MaterialBody>),
+    /// `[a, b, c]`.
+    Array(Vec<Expr>),
+    /// `base[index]`.
+    Index {
+        base: Box<Expr>,
+        index: Box<Expr>,
+    },
+    /// `"ball {i}"`.
+    Str(Box<StrLit>),
 }

@@ -54,13 +54,17 @@ impl Dumper<'_> {
                 start,
                 end,
                 inclusive,
+                step,
                 body,
                 ..
             } => {
                 let op = if *inclusive { "..=" } else { ".." };
+                let step = step
+                    .as_ref()
+                    .map_or(String::new(), |s| format!(" step {}", self.expr(s)));
                 let _ = writeln!(
                     out,
-                    "{pad}for {} in {}{op}{}",
+                    "{pad}for {} in {}{op}{}{step}",
                     self.name(var),
                     self.expr(start),
                     self.expr(end)
@@ -89,6 +93,14 @@ impl Dumper<'_> {
                 return;
             }
             ItemKind::Return(value) => format!("return {}", self.expr(value)),
+            ItemKind::While { condition, body } => {
+                let _ = writeln!(out, "{pad}while {}", self.expr(condition));
+                self.block(body, depth + 1, out);
+                return;
+            }
+            ItemKind::Assign { target, value } => {
+                format!("{} = {}", self.name(&target.ident), self.expr(value))
+            }
             ItemKind::Settings(body) => {
                 let _ = writeln!(out, "{pad}settings");
                 self.block(body, depth + 1, out);
@@ -202,6 +214,14 @@ impl Dumper<'_> {
                 let inner: Vec<&str> = inner.lines().map(str::trim).collect();
                 format!("material{} {{ {} }}", self.parent(body), inner.join("; "))
             }
+            ExprKind::Array(items) => {
+                let items: Vec<String> = items.iter().map(|i| self.expr(i)).collect();
+                format!("[{}]", items.join(", "))
+            }
+            ExprKind::Index { base, index } => {
+                format!("{}[{}]", self.expr(base), self.expr(index))
+            }
+            ExprKind::Str(lit) => format!("{:?}", lit.value),
         }
     }
 }

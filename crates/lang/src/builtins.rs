@@ -105,10 +105,12 @@ pub enum Function {
     Srgb,
     Checker,
     Stripes,
+    Len,
+    Rand,
 }
 
 impl Function {
-    pub const ALL: [Function; 29] = [
+    pub const ALL: [Function; 31] = [
         Function::Sqrt,
         Function::Pow,
         Function::Exp,
@@ -138,6 +140,8 @@ impl Function {
         Function::Srgb,
         Function::Checker,
         Function::Stripes,
+        Function::Len,
+        Function::Rand,
     ];
 
     pub fn name(self) -> &'static str {
@@ -171,6 +175,8 @@ impl Function {
             Function::Srgb => "srgb",
             Function::Checker => "checker",
             Function::Stripes => "stripes",
+            Function::Len => "len",
+            Function::Rand => "rand",
         }
     }
 
@@ -183,8 +189,8 @@ impl Function {
         use Function::*;
         match self {
             Sqrt | Exp | Log | Sin | Cos | Tan | Asin | Acos | Atan | Abs | Floor | Ceil
-            | Round | Radians | Degrees | Length | Normalize => (1, 1),
-            Pow | Atan2 | Min | Max | Dot | Cross => (2, 2),
+            | Round | Radians | Degrees | Length | Normalize | Len => (1, 1),
+            Pow | Atan2 | Min | Max | Dot | Cross | Rand => (2, 2),
             Clamp | Mix | Rgb | Srgb => (3, 3),
             Checker | Stripes => (2, 3),
         }
@@ -223,6 +229,8 @@ impl Function {
             Srgb => "srgb(r, g, b)",
             Checker => "checker(a, b, size)",
             Stripes => "stripes(a, b, width)",
+            Len => "len(array)",
+            Rand => "rand(seed, i)",
         }
     }
 }
@@ -388,8 +396,9 @@ pub fn call_math(function: Function, args: &[Value]) -> Result<Value, CallError>
             srgb_to_linear(n(1)?),
             srgb_to_linear(n(2)?),
         ))),
-        Checker | Stripes => Err(CallError::Domain(
-            "patterns are evaluated by the evaluator".into(),
+        Rand => num(crate::random::rand(n(0)?, n(1)?)),
+        Checker | Stripes | Len => Err(CallError::Domain(
+            "patterns and `len` are evaluated by the evaluator".into(),
         )),
     }
 }

@@ -33,10 +33,10 @@ impl Brackets {
 }
 
 fn closer_of(open: u8) -> u8 {
-    if open == b'(' {
-        b')'
-    } else {
-        b'}'
+    match open {
+        b'(' => b')',
+        b'[' => b']',
+        _ => b'}',
     }
 }
 
@@ -148,7 +148,7 @@ pub fn scan(
             }
             b'>' if bytes.get(i + 1) != Some(&b'=') => angle_depth = angle_depth.saturating_sub(1),
             b';' => angle_depth = 0,
-            b @ (b'(' | b'{') => {
+            b @ (b'(' | b'[' | b'{') => {
                 if b == b'{' {
                     angle_depth = 0;
                 }
@@ -165,7 +165,7 @@ pub fn scan(
                 open.push((i, b));
                 operators.push(0);
             }
-            b @ (b')' | b'}') => {
+            b @ (b')' | b']' | b'}') => {
                 if b == b'}' {
                     angle_depth = 0;
                 }

@@ -15,6 +15,8 @@ use crate::intern::Interner;
 use crate::lexical;
 use crate::syntax_error;
 
+mod constructs;
+
 #[derive(pest_derive::Parser)]
 #[grammar = "../../grammar/scene.pest"]
 pub(crate) struct SceneParser;
@@ -143,6 +145,19 @@ fn shift_expr(expr: &mut Expr, offset: usize) {
         // A material literal in a `-D` value is refused by the resolver; its inner spans
         // are never shown.
         ExprKind::Material(_) => {}
+        ExprKind::Array(items) => items.iter_mut().for_each(|i| shift_expr(i, offset)),
+        ExprKind::Index { base, index } => {
+            shift_expr(base, offset);
+            shift_expr(index, offset);
+        }
+        ExprKind::Str(lit) => {
+            shift(&mut lit.span);
+            for part in &mut lit.parts {
+                if let StrPart::Hole(name) = part {
+                    shift(&mut name.ident.span);
+                }
+            }
+        }
     }
 }
 
@@ -224,7 +239,27 @@ impl ParseContext<'_> {
                 }
             }
         }
-        StrLit { value, span }
+        StrLit {
+            value,
+            span,
+            parts: Vec::new(),
+        }
+    }
+
+    /// A string that may hold `{name}` holes (object and light names, string values).
+    fn formatted_string(&mut self, pair: Pair<'_, Rule>) -> StrLit {
+        let raw = pair
+            .clone()
+            .into_inner()
+            .next()
+            .map_or("", |inner| inner.as_str());
+        let mut lit = self.string(pair);
+        let raw_start = lit.span.start as usize + 1;
+        match crate::strings::template(raw, raw_start, self.file, self.interner) {
+            Ok(parts) => lit.parts = parts,
+            Err(error) => self.errors.push(error),
+        }
+        lit
     }
 
     pub(crate) fn item(&mut self, pair: Pair<'_, Rule>) -> Item {
@@ -241,6 +276,7 @@ impl ParseContext<'_> {
                     None => StrLit {
                         value: String::new(),
                         span,
+                        parts: Vec::new(),
                     },
                 };
                 ItemKind::Import { path, file: None }
@@ -261,7 +297,10 @@ impl ParseContext<'_> {
                     .next()
                     .map(|p| p.into_inner().map(|i| self.ident(&i)).collect())
                     .unwrap_or_default();
-                let body = self.next_block(&mut inner, span);
+                let body = match inner.peek() {
+                    Some(p) if p.as_rule() == Rule::fn_expr_body => self.expr_body(p),
+                    _ => self.next_block(&mut inner, span),
+                };
                 self.functions.push(FnDef {
                     name,
                     params,
@@ -277,6 +316,11 @@ impl ParseContext<'_> {
                 let start = self.next_expr(&mut inner, span);
                 let inclusive = inner.next().is_some_and(|op| op.as_str() == "..=");
                 let end = self.next_expr(&mut inner, span);
+                let mut step = None;
+                if inner.peek().is_some_and(|p| p.as_rule() == Rule::kw_step) {
+                    inner.next();
+                    step = Some(self.next_expr(&mut inner, span));
+                }
                 let body = self.next_block(&mut inner, span);
                 ItemKind::For {
                     var,
@@ -284,7 +328,25 @@ impl ParseContext<'_> {
                     start,
                     end,
                     inclusive,
+                    step,
                     body,
+                }
+            }
+            Rule::while_stmt => {
+                inner.next();
+                let condition = self.next_expr(&mut inner, span);
+                let body = self.next_block(&mut inner, span);
+                ItemKind::While { condition, body }
+            }
+            Rule::assign_stmt => {
+                let ident = self.next_ident(&mut inner, span);
+                let value = self.next_expr(&mut inner, span);
+                ItemKind::Assign {
+                    target: Name {
+                        ident,
+                        res: Res::Unresolved,
+                    },
+                    value,
                 }
             }
             Rule::if_stmt => {
@@ -474,7 +536,7 @@ impl ParseContext<'_> {
         let mut body = None;
         for p in inner {
             match p.as_rule() {
-                Rule::string => name = Some(self.string(p)),
+                Rule::string => name = Some(self.formatted_string(p)),
                 _ => body = Some(self.block(p)),
             }
         }
@@ -711,6 +773,10 @@ impl ParseContext<'_> {
             },
         };
         for field in inner {
+            if field.as_rule() == Rule::index {
+                operand = self.index(operand, field);
+                continue;
+            }
             let field_span = self.span(&field);
             let name = match field.into_inner().next() {
                 Some(ident) => self.ident(&ident),
@@ -791,6 +857,14 @@ impl ParseContext<'_> {
             Rule::call => {
                 let call = self.call(pair);
                 leaf(ExprKind::Call(Box::new(call)))
+            }
+            Rule::array => {
+                let items = pair.into_inner().map(|p| self.expr(p)).collect();
+                leaf(ExprKind::Array(items))
+            }
+            Rule::string => {
+                let lit = self.formatted_string(pair);
+                leaf(ExprKind::Str(Box::new(lit)))
             }
             Rule::ident => {
                 let ident = self.ident(&pair);

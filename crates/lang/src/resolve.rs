@@ -13,6 +13,8 @@ use whitted_ir::{Diagnostic, Span};
 
 use crate::ast::*;
 use crate::builtins::{Constant, Function};
+
+mod constructs;
 use crate::intern::{Interner, Sym};
 use crate::schema::{Arity, CameraTag, Context, LightTag, ObjectTag, Prop};
 use crate::suggest::{closest, list_and, list_or};
@@ -507,16 +509,25 @@ impl<'a> Resolver<'a> {
                 slot,
                 start,
                 end,
+                step,
                 body,
                 ..
             } => {
                 self.expr(start, program);
                 self.expr(end, program);
+                if let Some(step) = step {
+                    self.expr(step, program);
+                }
                 let saved = self.push_scope(false);
                 *slot = self.define(*var, DefKind::LoopVariable, None);
                 self.block(body, inner_cx, program);
                 self.pop_scope(saved);
             }
+            ItemKind::While { condition, body } => {
+                self.expr(condition, program);
+                self.block(body, inner_cx, program);
+            }
+            ItemKind::Assign { target, value } => self.assign(target, value, cx, program),
             ItemKind::If {
                 condition,
                 then,
@@ -573,8 +584,12 @@ impl<'a> Resolver<'a> {
                 self.block(body, body_cx, program);
             }
             ItemKind::Light {
-                kind, tag, body, ..
+                kind,
+                tag,
+                body,
+                name,
             } => {
+                self.string_holes(name.as_mut());
                 if !cx.is_statements() {
                     self.misplaced(
                         "a light",
@@ -615,8 +630,12 @@ impl<'a> Resolver<'a> {
                 *slot = self.define(*name, DefKind::Material, None);
             }
             ItemKind::Object {
-                kind, tag, body, ..
+                kind,
+                tag,
+                body,
+                name,
             } => {
+                self.string_holes(name.as_mut());
                 let allowed = match cx {
                     Context::Statements { .. } => true,
                     Context::Object(parent) => parent.is_container(),
@@ -1087,6 +1106,12 @@ impl<'a> Resolver<'a> {
             }
             ExprKind::Call(call) => self.call(call, program),
             ExprKind::Material(body) => self.material_body(body, program),
+            ExprKind::Array(items) => items.iter_mut().for_each(|i| self.expr(i, program)),
+            ExprKind::Index { base, index } => {
+                self.expr(base, program);
+                self.expr(index, program);
+            }
+            ExprKind::Str(lit) => self.string_holes(Some(lit)),
         }
     }
 

@@ -7,6 +7,10 @@ use whitted_ir::DVec3;
 pub type MaterialId = u32;
 /// Index of a pattern in the evaluator's pattern table.
 pub type PatternId = u32;
+/// Index of an array in the evaluator's array table.
+pub type ArrayId = u32;
+/// Index of a string in the evaluator's string table.
+pub type StrId = u32;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Value {
@@ -16,6 +20,10 @@ pub enum Value {
     Vector(DVec3),
     Material(MaterialId),
     Pattern(PatternId),
+    /// `[a, b, c]`: compare with `Evaluator::values_equal`, not `==` (ids, not contents).
+    Array(ArrayId),
+    /// `"ball {i}"`, formatted: compare like arrays.
+    Str(StrId),
     /// The value of a binding whose definition failed (already reported), so that its uses
     /// stay quiet instead of repeating the error.
     Poisoned,
@@ -30,6 +38,8 @@ impl Value {
             Value::Vector(_) => "a vector",
             Value::Material(_) => "a material",
             Value::Pattern(_) => "a pattern",
+            Value::Array(_) => "an array",
+            Value::Str(_) => "a string",
             Value::Poisoned => "an invalid value",
         }
     }

@@ -90,6 +90,9 @@ impl<'a> Evaluator<'a> {
             }
             ExprKind::Call(call) => self.call_value(call)?,
             ExprKind::Material(body) => Value::Material(self.material(body, None)?),
+            ExprKind::Array(items) => self.array_literal(items, expr.span)?,
+            ExprKind::Index { base, index } => self.index_value(base, index, expr.span)?,
+            ExprKind::Str(lit) => self.string_value(lit)?,
         };
         if value == Value::Poisoned {
             return Err(Abort::Reported);
@@ -154,6 +157,9 @@ impl<'a> Evaluator<'a> {
         }
         let left = self.eval(lhs)?;
         let right = self.eval(rhs)?;
+        if let Some(result) = self.compare_stored(op, left, right) {
+            return Ok(result);
+        }
         use BinaryOp::*;
         use Value::{Bool, Number as N, Vector as V};
         let result = match (op, left, right) {
@@ -261,6 +267,9 @@ impl<'a> Evaluator<'a> {
         let count = call.args.len().min(3);
         if matches!(function, Function::Checker | Function::Stripes) {
             return self.pattern(function, call, &args[..count]);
+        }
+        if function == Function::Len {
+            return self.len_call(call, &args[..count]);
         }
         match call_math(function, &args[..count]) {
             Ok(value) => self.finite(value, call.span),

@@ -9,10 +9,13 @@
 //! Errors: a failing statement is reported and skipped, and evaluation goes on so that one
 //! run reports every error it can. Limits (objects, loop iterations, call depth) stop the run.
 
+mod arrays;
 mod builders;
 mod expr;
+mod loops;
 mod materials;
 mod objects;
+mod strings;
 
 use std::collections::HashSet;
 
@@ -94,6 +97,8 @@ pub(crate) struct Evaluator<'a> {
 
     materials: Vec<MaterialDef>,
     patterns: Vec<PatternDef>,
+    /// Arrays and strings.
+    store: arrays::Store,
     default_material: Option<Handle<Material>>,
 
     sinks: Vec<Sink>,
@@ -143,6 +148,7 @@ impl<'a> Evaluator<'a> {
             error_events: 0,
             materials: Vec::new(),
             patterns: Vec::new(),
+            store: arrays::Store::default(),
             default_material: None,
             sinks: vec![Sink::Collect(Vec::new())],
             targets: Vec::new(),
@@ -307,9 +313,20 @@ impl<'a> Evaluator<'a> {
                 start,
                 end,
                 inclusive,
+                step: Some(step),
+                body,
+                ..
+            } => return self.stepped_loop(*slot, start, end, *inclusive, step, body),
+            ItemKind::For {
+                slot,
+                start,
+                end,
+                inclusive,
                 body,
                 ..
             } => return self.for_loop(*slot, start, end, *inclusive, body),
+            ItemKind::While { condition, body } => return self.while_loop(condition, body),
+            ItemKind::Assign { target, value } => self.assign(target, value)?,
             ItemKind::If {
                 condition,
                 then,

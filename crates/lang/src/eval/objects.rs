@@ -90,7 +90,7 @@ impl<'a> Evaluator<'a> {
             },
         };
         let object = Object {
-            name: name.map(|n| n.value.clone()),
+            name: self.object_name(name)?,
             kind,
             world_from_object: builder.placement.transform,
             material: material.unwrap_or_else(inherit),
@@ -367,9 +367,10 @@ impl<'a> Evaluator<'a> {
                 attenuation: builder.attenuation,
             },
         };
+        let name = self.object_name(name)?;
         self.scene.lights.append(
             Light {
-                name: name.map(|n| n.value.clone()),
+                name,
                 color: builder.color,
                 kind,
             },

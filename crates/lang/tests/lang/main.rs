@@ -9,4 +9,5 @@ mod errors;
 mod fuzz;
 mod limits;
 mod scenes;
+mod second_step;
 mod support;

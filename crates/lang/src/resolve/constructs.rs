@@ -1,0 +1,84 @@
+//! Names in the constructs of the language's second step: assignments (`i = i + 1;`, only to
+//! `let` bindings of the same function or file) and the `{name}` holes of formatted strings.
+
+use whitted_ir::Diagnostic;
+
+use super::{DefKind, Resolver};
+use crate::ast::*;
+use crate::schema::Context;
+
+impl Resolver<'_> {
+    /// `name = value;`: the name must be a `let` binding this code owns.
+    pub(super) fn assign(
+        &mut self,
+        target: &mut Name,
+        value: &mut Expr,
+        _cx: Context,
+        program: &mut Program,
+    ) {
+        self.expr(value, program);
+        let sym = target.ident.sym;
+        let text = self.name(sym);
+        target.res = Res::Error;
+        let Some(def) = self.lookup(sym) else {
+            let candidates = self
+                .visible_names()
+                .into_iter()
+                .filter(|(_, kind)| *kind == DefKind::Let)
+                .map(|(n, _)| n)
+                .collect();
+            self.unknown(target.ident, "name", candidates);
+            return;
+        };
+        let definition = &self.definitions[def];
+        let (kind, slot, span) = (definition.kind, definition.slot, definition.span);
+        if kind != DefKind::Let {
+            let hint = match kind {
+                DefKind::Const => "a constant keeps its value; define it with `let` to change it",
+                DefKind::LoopVariable => "a loop variable takes each value of its range in turn; use a `let` inside the loop",
+                DefKind::Parameter => "copy the parameter into a `let` first: `let n = n;` then change `n`",
+                _ => "only names made with `let` can be given a new value",
+            };
+            self.error(
+                Diagnostic::error(
+                    format!(
+                        "`{text}` is {}; it cannot be given a new value",
+                        kind.describe()
+                    ),
+                    target.ident.span,
+                )
+                .with_label("assigned here")
+                .with_secondary(span, "defined here")
+                .with_hint(hint),
+            );
+            return;
+        }
+        if self.current_function.is_some() && matches!(slot, Slot::Global(_)) {
+            self.error(
+                Diagnostic::error(
+                    format!("a function cannot change `{text}`, which is defined outside it"),
+                    target.ident.span,
+                )
+                .with_label("assigned here")
+                .with_secondary(span, "defined here")
+                .with_hint("return the new value from the function instead"),
+            );
+            return;
+        }
+        target.res = match slot {
+            Slot::Local(slot) => Res::Local(slot),
+            Slot::Global(slot) => Res::Global(slot),
+            Slot::None => Res::Error,
+        };
+    }
+
+    /// Resolves the `{name}` holes of a formatted string.
+    pub(super) fn string_holes(&mut self, lit: Option<&mut StrLit>) {
+        let Some(lit) = lit else { return };
+        for part in &mut lit.parts {
+            if let StrPart::Hole(name) = part {
+                self.name_ref(name);
+            }
+        }
+    }
+}
