@@ -64,8 +64,8 @@ impl Expected {
             }
             kw_in => self.punct("in"),
             kw_about => {}
-            kw_import | kw_const | kw_let | kw_fn | kw_for | kw_if | kw_return | kw_settings
-            | kw_camera | kw_light | kw_material | kw_open => self.statement = true,
+            kw_import | kw_const | kw_let | kw_fn | kw_for | kw_while | kw_if | kw_return
+            | kw_settings | kw_camera | kw_light | kw_material | kw_open => self.statement = true,
             or | and | eq | ne | le | ge | lt | gt | add | sub | mul | div | rem | field => {
                 self.operator = true
             }
@@ -85,7 +85,8 @@ impl Expected {
         } else if !self.value && has("a..z") {
             self.name = true;
         }
-        if has("\"") {
+        // Where a value may start, a string is one of the values.
+        if has("\"") && !self.value {
             self.string = true;
         }
         if has("*") {
