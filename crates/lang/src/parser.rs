@@ -60,8 +60,10 @@ pub fn parse_file(
     max_nesting: usize,
 ) -> Result<Vec<Item>, Diagnostic> {
     let brackets = lexical::scan(text, cx.file, max_nesting, cx.max_expression_depth)?;
-    let mut pairs = SceneParser::parse(Rule::file, text)
-        .map_err(|error| syntax_error::translate(&error, text, cx.file, Some(&brackets)))?;
+    let mut pairs = SceneParser::parse(Rule::file, text).map_err(|error| {
+        let diagnostic = syntax_error::translate(&error, text, cx.file, Some(&brackets));
+        constructs::expression_body_hint(diagnostic, text, &brackets)
+    })?;
     let Some(file) = pairs.next() else {
         return Ok(Vec::new());
     };

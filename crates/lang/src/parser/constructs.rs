@@ -3,9 +3,12 @@
 //! `step` and assignments are built in the item and primary matches of the parent module.
 
 use pest::iterators::Pair;
+use pest::Parser as _;
+use whitted_ir::Diagnostic;
 
-use super::{ParseContext, Rule};
+use super::{ParseContext, Rule, SceneParser};
 use crate::ast::*;
+use crate::lexical;
 
 impl ParseContext<'_> {
     /// `= expr ;` after a function's parameters: a body of one `return expr;`.
@@ -50,4 +53,60 @@ impl ParseContext<'_> {
             span,
         }
     }
+}
+
+/// `fn f(x) { x * x }` is a syntax error (a body holds statements); when the body is one
+/// expression, the error gets a hint towards `fn f(x) = x * x;`.
+pub(super) fn expression_body_hint(
+    diagnostic: Diagnostic,
+    text: &str,
+    brackets: &lexical::Brackets,
+) -> Diagnostic {
+    let Some(at) = diagnostic.span.map(|s| s.start) else {
+        return diagnostic;
+    };
+    let Some(pair) = brackets.innermost_brace_around(at) else {
+        return diagnostic;
+    };
+    let (open, close) = (pair.open as usize, pair.close as usize);
+    let (Some(before), Some(body)) = (text.get(..open), text.get(open + 1..close)) else {
+        return diagnostic;
+    };
+    let Some(header) = function_header(before) else {
+        return diagnostic;
+    };
+    let body = body.trim();
+    let is_expression = !body.is_empty() && SceneParser::parse(Rule::define_value, body).is_ok();
+    if !is_expression {
+        return diagnostic;
+    }
+    // A long body is not repeated whole in the hint.
+    let body = if body.len() > 60 || body.contains('\n') {
+        "..."
+    } else {
+        body
+    };
+    diagnostic.with_hint(format!(
+        "a function's block holds statements; for a function that is one expression, write `{header} = {body};` (or `return {body};` in the block)"
+    ))
+}
+
+/// `fn name(params)` when `before` ends with one (spaces allowed between the parts).
+fn function_header(before: &str) -> Option<&str> {
+    let trimmed = before.trim_end();
+    let params_start = trimmed.strip_suffix(')')?.rfind('(')?;
+    let name_part = trimmed[..params_start].trim_end();
+    let name_start = name_part
+        .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .map_or(0, |i| i + 1);
+    let keyword = name_part[..name_start].trim_end();
+    if name_start == name_part.len() || !keyword.ends_with("fn") {
+        return None;
+    }
+    let fn_start = keyword.len() - 2;
+    let boundary = keyword[..fn_start]
+        .chars()
+        .next_back()
+        .is_none_or(|c| !(c.is_ascii_alphanumeric() || c == '_'));
+    boundary.then(|| &trimmed[fn_start..])
 }

@@ -65,3 +65,19 @@ fn smoke() {
     );
     let _ = DVec3::ZERO;
 }
+
+#[test]
+fn scratch_print() {
+    for input in [
+        "fn f(x) { x * x }\nsphere { radius f(2) }\n",
+        "fn f(x) { return x * x; }\nlet v = <1,2,3>;\nsphere { radius v[0] }\n",
+        "let a = [1, 2];\nsphere { radius a[2] }\n",
+        "let s = \"ball {\";\n",
+        "sphere \"ball {i + 1}\" { }\n",
+        "for i in 0..3 step 0 { }\n",
+        "let i = 0;\nwhile i < 1 { }\n",
+        "const k = 1;\nk = 2;\n",
+    ] {
+        eprintln!("{}", errors(input));
+    }
+}
