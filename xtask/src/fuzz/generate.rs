@@ -482,7 +482,17 @@ impl Generator<'_> {
                         self.positive()
                     )
                 };
-                format!("for i in 0..{n} {{ {body} }}")
+                match self.rng.below(4) {
+                    0 => format!("for i in 0..{n} {{ {body} }}"),
+                    // The second step's constructs: `step`, `while` with assignment, arrays
+                    // indexed by the loop variable and names formatted from it.
+                    1 => format!("for i in {n}..0 step -{} {{ {body} }}", self.rng.below(4) + 1),
+                    // In a block of its own, so that two loops do not define `i` twice.
+                    2 => format!("if true {{ let i = 0;\nwhile i < {n} {{ {body} i = i + 1; }} }}"),
+                    _ => format!(
+                        "let rs = [0.1, 0.2, 0.3];\nfor i in 0..{n} {{ sphere \"s{{i}}\" {{ center <rand(1, i), i * 0.01, 0> radius rs[i % len(rs)] }} }}"
+                    ),
+                }
             }
             35 => {
                 // Recursion that doubles: bounded only by the evaluation budget.
@@ -574,6 +584,9 @@ mod tests {
             "rotate",
             "matrix",
             "fn f(n)",
+            "step -",
+            "while i <",
+            "rs[i % len(rs)]",
         ] {
             assert!(all.contains(word), "the generator never writes `{word}`");
         }

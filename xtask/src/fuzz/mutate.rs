@@ -31,6 +31,14 @@ const TOKENS: &[&str] = &[
     "0 / 0",
     "\n",
     "\"",
+    "[",
+    "]",
+    "[1, 2][",
+    "step -1",
+    "while true {",
+    "\"{i}\"",
+    "\"{",
+    "i = i + 1;",
 ];
 
 /// Byte offsets of the numbers in `text` (runs of digits with `.` and `e`).
