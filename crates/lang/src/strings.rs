@@ -106,3 +106,62 @@ pub(crate) fn format_number(x: f64) -> String {
     let x = if x == 0.0 { 0.0 } else { x };
     format!("{x}")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parts(raw: &str) -> Result<Vec<String>, String> {
+        let mut interner = Interner::default();
+        template(raw, 10, FileId(0), &mut interner)
+            .map(|parts| {
+                parts
+                    .iter()
+                    .map(|p| match p {
+                        StrPart::Text(t) => format!("text {t:?}"),
+                        StrPart::Hole(n) => format!(
+                            "hole {} at {}..{}",
+                            interner.name(n.ident.sym),
+                            n.ident.span.start,
+                            n.ident.span.end
+                        ),
+                    })
+                    .collect()
+            })
+            .map_err(|d| d.message)
+    }
+
+    #[test]
+    fn holes_text_and_braces_split_with_their_places() {
+        assert_eq!(parts("plain"), Ok(vec![]));
+        assert_eq!(
+            parts("ball {i}!"),
+            Ok(vec![
+                "text \"ball \"".to_string(),
+                "hole i at 16..17".to_string(),
+                "text \"!\"".to_string()
+            ])
+        );
+        // An escape before a hole shifts the raw text, and the hole's place with it.
+        assert_eq!(
+            parts(r#"\"{name_2}{{}}"#),
+            Ok(vec![
+                "text \"\\\"\"".to_string(),
+                "hole name_2 at 13..19".to_string(),
+                "text \"{}\"".to_string()
+            ])
+        );
+        for bad in ["{", "{}", "{1}", "{a b}", "}", "a{b", "{a.x}", "{é}"] {
+            assert!(parts(bad).is_err(), "{bad:?} was accepted");
+        }
+    }
+
+    #[test]
+    fn numbers_are_written_as_people_write_them() {
+        assert_eq!(format_number(3.0), "3");
+        assert_eq!(format_number(-0.0), "0");
+        assert_eq!(format_number(0.5), "0.5");
+        assert_eq!(format_number(-2.25), "-2.25");
+        assert_eq!(format_number(1e21), "1000000000000000000000");
+    }
+}

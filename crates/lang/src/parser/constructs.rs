@@ -110,3 +110,56 @@ fn function_header(before: &str) -> Option<&str> {
         .is_none_or(|c| !(c.is_ascii_alphanumeric() || c == '_'));
     boundary.then(|| &trimmed[fn_start..])
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::parse_file;
+    use super::*;
+    use crate::intern::Interner;
+
+    /// The tree dump of `input`, which must parse.
+    fn dump(input: &str) -> String {
+        let mut interner = Interner::default();
+        let mut functions = Vec::new();
+        let mut cx = ParseContext::new(whitted_ir::FileId(0), &mut interner, &mut functions, 4096);
+        let items = match parse_file(input, &mut cx, 256) {
+            Ok(items) => items,
+            Err(error) => panic!("{input}: {}", error.message),
+        };
+        assert!(cx.errors.is_empty(), "{:?}", cx.errors);
+        crate::ast_dump::dump(&items, &functions, &interner)
+    }
+
+    #[test]
+    fn the_second_step_parses() {
+        insta::assert_snapshot!(dump(
+            r#"fn sq(x) = x * x;
+let a = [1, [2, 3], "s {a}",];
+let e = [];
+let v = a[1][0] + sq(a[0]) * len(a);
+for i in 10..=0 step -2 { x = i; }
+while i < 3 && a[i] != 0 { i = i + 1; }
+sphere "ball {i}" { }
+"#
+        ));
+    }
+
+    #[test]
+    fn an_index_binds_tighter_than_operators_and_after_fields() {
+        let text = dump("let x = -a[1].y * b[2];");
+        assert!(text.contains("((-a[1].y) * b[2])"), "{text}");
+    }
+
+    #[test]
+    fn function_headers_are_recognised_only_after_fn() {
+        assert_eq!(function_header("fn f(x) "), Some("fn f(x)"));
+        assert_eq!(
+            function_header("\nfn  area (w, h)"),
+            Some("fn  area (w, h)")
+        );
+        assert_eq!(function_header("sphere "), None);
+        assert_eq!(function_header("myfn f(x)"), None);
+        assert_eq!(function_header("ring(3)"), None);
+        assert_eq!(function_header(")"), None);
+    }
+}
