@@ -13,7 +13,7 @@ pub const MAX_OBJECTS: usize = 5_000_000;
 pub const MAX_EVALUATION_STEPS: u64 = 100_000_000;
 
 /// Elements of one array (`[a, b, c]`).
-pub const MAX_ARRAY_LENGTH: usize = 1_000_000;
+pub const MAX_ARRAY_LENGTH: usize = 100_000;
 
 /// Bytes of one string value or formatted name (`"ball {i}"`).
 pub const MAX_STRING_BYTES: usize = 4_096;

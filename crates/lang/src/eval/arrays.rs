@@ -53,7 +53,9 @@ impl<'a> Evaluator<'a> {
                 .with_hint("see \"Limits\" in docs/language.md"),
             );
         }
-        self.charge(items.len() * std::mem::size_of::<Value>(), span)?;
+        // The elements and the array's own header: an empty array still costs memory.
+        let bytes = items.len() * std::mem::size_of::<Value>() + std::mem::size_of::<Vec<Value>>();
+        self.charge(bytes, span)?;
         let mut values = Vec::with_capacity(items.len());
         for item in items {
             values.push(self.eval(item)?);

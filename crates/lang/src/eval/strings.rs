@@ -13,7 +13,7 @@ impl<'a> Evaluator<'a> {
     /// A string in an expression: formatted and stored.
     pub(super) fn string_value(&mut self, lit: &'a StrLit) -> Eval<Value> {
         let text = self.format_string(lit)?;
-        self.charge(text.len(), lit.span)?;
+        self.charge(text.len() + std::mem::size_of::<String>(), lit.span)?;
         let id = self.store.strings.len() as u32;
         self.store.strings.push(text);
         Ok(Value::Str(id))
@@ -23,7 +23,7 @@ impl<'a> Evaluator<'a> {
     pub(super) fn object_name(&mut self, name: Option<&'a StrLit>) -> Eval<Option<String>> {
         let Some(lit) = name else { return Ok(None) };
         let text = self.format_string(lit)?;
-        self.charge(text.len(), lit.span)?;
+        self.charge(text.len() + std::mem::size_of::<String>(), lit.span)?;
         Ok(Some(text))
     }
 

@@ -466,3 +466,31 @@ fn malformed_constructs_are_errors_not_panics() {
         }
     }
 }
+
+#[test]
+fn arrays_made_in_a_loop_stop_at_the_value_memory_limit() {
+    // 1,000 elements of 32 bytes a time: the 256 MiB limit is reached after about 8,000
+    // iterations, long before the loop's 100,000.
+    let zeros = vec!["0"; 1000].join(", ");
+    let input = format!("for i in 0..100000 {{ let a = [{zeros}]; }}\n");
+    let text = errors(&input);
+    assert!(
+        text.contains("the value memory limit (268435456 bytes of arrays and strings) was reached"),
+        "{text}"
+    );
+    assert!(text.contains("test.scene:1:30"), "{text}");
+}
+
+#[test]
+fn an_array_over_the_length_limit_is_an_error() {
+    let over = whitted_ir::limits::MAX_ARRAY_LENGTH + 1;
+    let input = format!("let a = [{}];\n", vec!["0"; over].join(","));
+    let text = errors(&input);
+    assert!(
+        text.contains(&format!(
+            "this array has {over} elements, past the array length limit"
+        )),
+        "{}",
+        &text[..text.len().min(300)]
+    );
+}
