@@ -48,6 +48,14 @@ if 1 < 2 && !false { ellipsoid { radii <2, 1, 1> } } else { hyperboloid2 { } }
 }
 
 const TOKENS: &[&str] = &[
+    "[",
+    "]",
+    "step",
+    "while",
+    "\"{i}\"",
+    "\"{",
+    "len",
+    "rand",
     "sphere",
     "box",
     "union",
