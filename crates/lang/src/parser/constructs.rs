@@ -96,9 +96,12 @@ fn function_header(before: &str) -> Option<&str> {
     let trimmed = before.trim_end();
     let params_start = trimmed.strip_suffix(')')?.rfind('(')?;
     let name_part = trimmed[..params_start].trim_end();
+    // By characters, so that a wide character before the name cannot split a slice.
     let name_start = name_part
-        .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
-        .map_or(0, |i| i + 1);
+        .char_indices()
+        .rev()
+        .find(|&(_, c)| !(c.is_ascii_alphanumeric() || c == '_'))
+        .map_or(0, |(i, c)| i + c.len_utf8());
     let keyword = name_part[..name_start].trim_end();
     if name_start == name_part.len() || !keyword.ends_with("fn") {
         return None;
@@ -161,5 +164,9 @@ sphere "ball {i}" { }
         assert_eq!(function_header("myfn f(x)"), None);
         assert_eq!(function_header("ring(3)"), None);
         assert_eq!(function_header(")"), None);
+        // A wide character just before the name or the keyword.
+        assert_eq!(function_header("é f(x)"), None);
+        assert_eq!(function_header("éf(x)"), None);
+        assert_eq!(function_header("é fn f(x)"), Some("fn f(x)"));
     }
 }
