@@ -496,3 +496,12 @@ fn an_array_over_the_length_limit_is_an_error() {
         &text[..text.len().min(300)]
     );
 }
+
+#[test]
+fn empty_arrays_made_in_a_loop_are_not_free() {
+    // Each empty array still keeps a header (24 bytes), so 20 million of them pass the
+    // 256 MiB limit. Charged by their elements alone, they cost nothing and the loop held
+    // 480 MB when it ended.
+    let text = errors("for i in 0..20000000 { let a = []; }\n");
+    assert!(text.contains("the value memory limit"), "{text}");
+}
