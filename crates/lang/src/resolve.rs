@@ -688,6 +688,9 @@ impl<'a> Resolver<'a> {
                     self.block(block, Context::Modifiers, program);
                 }
             }
+            ItemKind::Property(property) if self.is_unbraced_object(property) => {
+                self.unbraced_object(property)
+            }
             ItemKind::Property(property) => self.property(property, cx, program),
         }
     }

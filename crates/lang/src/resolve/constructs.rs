@@ -81,4 +81,31 @@ impl Resolver<'_> {
             }
         }
     }
+
+    /// `sphere "ball"` without its braces parses as a property named `sphere` whose value
+    /// is a string; no property takes a string, so it is an object missing its `{ }`.
+    pub(super) fn is_unbraced_object(&self, property: &Property) -> bool {
+        matches!(
+            property.values.first().map(|v| &v.kind),
+            Some(ExprKind::Str(_))
+        ) && property.block.is_none()
+            && crate::schema::ObjectTag::ALL
+                .iter()
+                .any(|tag| tag.name() == self.name(property.name.sym))
+    }
+
+    pub(super) fn unbraced_object(&mut self, property: &Property) {
+        let text = self.name(property.name.sym);
+        let span = property
+            .values
+            .first()
+            .map_or(property.name.span, |v| property.name.span.to(v.span));
+        self.error(
+            Diagnostic::error(format!("`{text}` needs `{{ ... }}` after its name"), span)
+                .with_label("an object without its braces")
+                .with_hint(format!(
+                    "write `{text} \"name\" {{ }}`, with its properties inside the braces"
+                )),
+        );
+    }
 }

@@ -395,6 +395,10 @@ fn second_step_errors() {
             ),
             ("a string as a number", "sphere { radius \"1\" }\n"),
             (
+                "an object name without braces",
+                "sphere \"ball\"\nbox { }\n",
+            ),
+            (
                 "a block function that is one expression",
                 "fn f(x) { x * x }\nsphere { radius f(2) }\n",
             ),
