@@ -412,9 +412,6 @@ fn compile_root(
     options: &CompileOptions,
     max_evaluation_depth: usize,
 ) -> Compilation {
-    // Expected-token detail makes syntax errors name punctuation (`,`, `;`); it costs only
-    // on the failing path.
-    pest::set_error_detail(true);
     let limits = &options.limits;
     let mut loading = Loading {
         loader,

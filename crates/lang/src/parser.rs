@@ -52,6 +52,32 @@ impl<'a> ParseContext<'a> {
     }
 }
 
+/// Serialises the detailed re-parses of [`parse_rule`]: pest reads its error-detail switch, a
+/// process-wide flag, when a parse starts, so only one thread may hold it on at a time.
+static ERROR_DETAIL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Parses `text` as `rule`. Pest's tracking of every attempted token (what makes a syntax
+/// error say "expected `,` or `;`") costs more than the parse itself on large files, so the
+/// first parse runs without it; only a text that fails is parsed again with it on, which gives
+/// exactly the error the tracked parse would have given, since the grammar is deterministic.
+fn parse_rule(
+    rule: Rule,
+    text: &str,
+) -> Result<pest::iterators::Pairs<'_, Rule>, pest::error::Error<Rule>> {
+    let fast = SceneParser::parse(rule, text);
+    if fast.is_ok() {
+        return fast;
+    }
+    // A poisoned lock only means another parse panicked; the flag is still ours to set.
+    let _detail = ERROR_DETAIL
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
+    pest::set_error_detail(true);
+    let detailed = SceneParser::parse(rule, text);
+    pest::set_error_detail(false);
+    detailed
+}
+
 /// Parses a whole file. On a syntax error, returns that one error (pest stops at the first);
 /// otherwise the items, with any tree-building errors left in `cx.errors`.
 pub fn parse_file(
@@ -60,7 +86,7 @@ pub fn parse_file(
     max_nesting: usize,
 ) -> Result<Vec<Item>, Diagnostic> {
     let brackets = lexical::scan(text, cx.file, max_nesting, cx.max_expression_depth)?;
-    let mut pairs = SceneParser::parse(Rule::file, text).map_err(|error| {
+    let mut pairs = parse_rule(Rule::file, text).map_err(|error| {
         let diagnostic = syntax_error::translate(&error, text, cx.file, Some(&brackets));
         constructs::expression_body_hint(diagnostic, text, &brackets)
     })?;
@@ -96,7 +122,7 @@ pub fn parse_define_value(
     };
     let brackets =
         lexical::scan(value, cx.file, max_nesting, cx.max_expression_depth).map_err(shift)?;
-    let mut pairs = SceneParser::parse(Rule::define_value, value).map_err(|error| {
+    let mut pairs = parse_rule(Rule::define_value, value).map_err(|error| {
         shift(syntax_error::translate(
             &error,
             value,
@@ -903,7 +929,6 @@ mod tests {
         let mut functions = Vec::new();
         let mut sources = whitted_ir::SourceMap::new();
         let file = sources.add(whitted_ir::SourceFile::new("test.scene", input));
-        pest::set_error_detail(true);
         let mut cx = ParseContext::new(file, &mut interner, &mut functions, 4096);
         let result = parse_file(input, &mut cx, 256);
         let errors = std::mem::take(&mut cx.errors);

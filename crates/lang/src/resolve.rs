@@ -77,10 +77,41 @@ pub struct Resolution {
 }
 
 struct Scope {
+    /// Every definition in the order it was made (for suggestions and exports).
     names: Vec<(Sym, DefId)>,
+    /// For each name: its first definition (what "already defined here" points at) and its
+    /// latest (what a use finds). A script's file scope can hold 100,000 names, so finding one
+    /// must not scan them all.
+    index: HashMap<Sym, (DefId, DefId)>,
     /// Names in scopes below this one (except the file scope) are not visible: a function
     /// body sees its own locals and the file's top level, nothing in between.
     barrier: bool,
+}
+
+impl Scope {
+    fn new(barrier: bool) -> Scope {
+        Scope {
+            names: Vec::new(),
+            index: HashMap::new(),
+            barrier,
+        }
+    }
+
+    fn add(&mut self, sym: Sym, def: DefId) {
+        self.names.push((sym, def));
+        self.index
+            .entry(sym)
+            .and_modify(|(_, latest)| *latest = def)
+            .or_insert((def, def));
+    }
+
+    fn first(&self, sym: Sym) -> Option<DefId> {
+        self.index.get(&sym).map(|&(first, _)| first)
+    }
+
+    fn latest(&self, sym: Sym) -> Option<DefId> {
+        self.index.get(&sym).map(|&(_, latest)| latest)
+    }
 }
 
 /// Per-call-frame slot allocation: slots are reused once their scope ends.
@@ -158,10 +189,7 @@ impl<'a> Resolver<'a> {
             return;
         }
         let saved = std::mem::take(&mut self.scopes);
-        self.scopes.push(Scope {
-            names: Vec::new(),
-            barrier: true,
-        });
+        self.scopes.push(Scope::new(true));
         self.expr(expr, program);
         self.scopes = saved;
     }
@@ -178,10 +206,7 @@ impl<'a> Resolver<'a> {
         let saved_file = std::mem::replace(&mut self.file, index);
         let saved_later = std::mem::take(&mut self.later);
 
-        self.scopes.push(Scope {
-            names: Vec::new(),
-            barrier: false,
-        });
+        self.scopes.push(Scope::new(false));
         let mut items = std::mem::take(&mut program.files[index].items);
         for item in &items {
             if let Some((sym, span)) = top_level_name(&item.kind, &program.functions) {
@@ -227,13 +252,9 @@ impl<'a> Resolver<'a> {
             return;
         };
         for (sym, def) in names {
-            match self
-                .scopes
-                .first()
-                .and_then(|s| s.names.iter().find(|(n, _)| *n == sym))
-            {
-                Some(&(_, existing)) if existing == def => {}
-                Some(&(_, existing)) => {
+            match self.scopes.first().and_then(|s| s.first(sym)) {
+                Some(existing) if existing == def => {}
+                Some(existing) => {
                     let first = self.definitions[existing].span;
                     let name = self.name(sym);
                     self.error(
@@ -248,7 +269,7 @@ impl<'a> Resolver<'a> {
                 }
                 None => {
                     if let Some(scope) = self.scopes.first_mut() {
-                        scope.names.push((sym, def));
+                        scope.add(sym, def);
                     }
                 }
             }
@@ -258,10 +279,7 @@ impl<'a> Resolver<'a> {
     // ---- scopes and slots ------------------------------------------------------------------
 
     fn push_scope(&mut self, barrier: bool) -> Frame {
-        self.scopes.push(Scope {
-            names: Vec::new(),
-            barrier,
-        });
+        self.scopes.push(Scope::new(barrier));
         self.frame
     }
 
@@ -297,11 +315,7 @@ impl<'a> Resolver<'a> {
             }
             _ => self.new_local(),
         };
-        let existing = self
-            .scopes
-            .last()
-            .and_then(|s| s.names.iter().find(|(n, _)| *n == ident.sym))
-            .map(|&(_, def)| def);
+        let existing = self.scopes.last().and_then(|s| s.first(ident.sym));
         if let Some(existing) = existing {
             let name = self.name(ident.sym);
             let first = &self.definitions[existing];
@@ -325,7 +339,7 @@ impl<'a> Resolver<'a> {
             uses: 0,
         });
         if let Some(scope) = self.scopes.last_mut() {
-            scope.names.push((ident.sym, def));
+            scope.add(ident.sym, def);
         }
         slot
     }
@@ -334,15 +348,11 @@ impl<'a> Resolver<'a> {
     /// file scope.
     fn lookup(&self, sym: Sym) -> Option<DefId> {
         for (depth, scope) in self.scopes.iter().enumerate().rev() {
-            if let Some(&(_, def)) = scope.names.iter().rev().find(|(n, _)| *n == sym) {
+            if let Some(def) = scope.latest(sym) {
                 return Some(def);
             }
             if scope.barrier && depth > 0 {
-                return self
-                    .scopes
-                    .first()
-                    .and_then(|s| s.names.iter().rev().find(|(n, _)| *n == sym))
-                    .map(|&(_, def)| def);
+                return self.scopes.first().and_then(|s| s.latest(sym));
             }
         }
         None
