@@ -35,8 +35,9 @@ pub const MAX_IMPORT_DEPTH: usize = 64;
 /// through a symbolic-link loop cannot fan out without end.
 pub const MAX_IMPORTS: usize = 10_000;
 
-/// Source text over every file of a compilation, in bytes; reads stop at this size.
-pub const MAX_SOURCE_BYTES: usize = 64 * 1024 * 1024;
+/// Source text over every file of a compilation, in bytes; reads stop at this size. Scenes
+/// written by programs are big: a million literal spheres is about 70 MB.
+pub const MAX_SOURCE_BYTES: usize = 256 * 1024 * 1024;
 
 /// Lights in a scene: every shading point visits every light.
 pub const MAX_LIGHTS: usize = 10_000;

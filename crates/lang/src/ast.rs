@@ -107,10 +107,11 @@ pub struct MaterialBody {
 pub struct Property {
     pub name: Ident,
     pub values: Vec<Expr>,
-    /// `rotate 30 about <1, 1, 0>`.
-    pub about: Option<Expr>,
+    /// `rotate 30 about <1, 1, 0>`. Boxed, like the other rare parts of items, so that an
+    /// item stays small: scenes written by programs hold millions of them.
+    pub about: Option<Box<Expr>>,
     /// `diffuse checker(a, b, 1) { rotate <0, 45, 0> }`.
-    pub block: Option<Block>,
+    pub block: Option<Box<Block>>,
     /// Filled by the resolver when the name is valid in its block.
     pub prop: Option<Prop>,
 }
@@ -118,7 +119,7 @@ pub struct Property {
 #[derive(Debug)]
 pub enum ItemKind {
     Import {
-        path: StrLit,
+        path: Box<StrLit>,
         /// Filled by the loader: which file the path names.
         file: Option<FileIndex>,
     },
@@ -128,16 +129,16 @@ pub enum ItemKind {
     For {
         var: Ident,
         slot: Slot,
-        start: Expr,
-        end: Expr,
+        start: Box<Expr>,
+        end: Box<Expr>,
         inclusive: bool,
         /// `for i in 0..10 step 2`.
-        step: Option<Expr>,
+        step: Option<Box<Expr>>,
         body: Block,
     },
     /// `while condition { ... }`.
     While {
-        condition: Expr,
+        condition: Box<Expr>,
         body: Block,
     },
     /// `name = value;`: a new value for a `let` binding.
@@ -146,9 +147,9 @@ pub enum ItemKind {
         value: Expr,
     },
     If {
-        condition: Expr,
+        condition: Box<Expr>,
         then: Block,
-        otherwise: Option<Else>,
+        otherwise: Option<Box<Else>>,
     },
     Return(Expr),
     Settings(Block),
@@ -160,22 +161,22 @@ pub enum ItemKind {
     Light {
         kind: Ident,
         tag: Option<LightTag>,
-        name: Option<StrLit>,
+        name: Option<Box<StrLit>>,
         body: Block,
     },
     Material {
         name: Ident,
         slot: Slot,
-        body: MaterialBody,
+        body: Box<MaterialBody>,
     },
     Object {
         kind: Ident,
         tag: Option<ObjectTag>,
-        name: Option<StrLit>,
+        name: Option<Box<StrLit>>,
         body: Block,
     },
     Call {
-        call: Call,
+        call: Box<Call>,
         modifiers: Option<Block>,
     },
     Property(Property),

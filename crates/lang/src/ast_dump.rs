@@ -79,7 +79,7 @@ impl Dumper<'_> {
             } => {
                 let _ = writeln!(out, "{pad}if {}", self.expr(condition));
                 self.block(then, depth + 1, out);
-                match otherwise {
+                match otherwise.as_deref() {
                     Some(Else::If(inner)) => {
                         let _ = writeln!(out, "{pad}else");
                         self.item(inner, depth + 1, out);

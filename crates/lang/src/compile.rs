@@ -15,7 +15,7 @@ use crate::ast::{FileAst, FileIndex, ItemKind, Program};
 use crate::intern::Interner;
 use crate::parser::{self, ParseContext};
 use crate::resolve::{Define, Resolver};
-use crate::{Compilation, CompileOptions, Limits, SourceLoader};
+use crate::{Compilation, CompileOptions, Limits, SourceLoader, WorkCounts};
 
 /// Stacks to try for the compile thread, largest first. Only the pages actually touched are
 /// committed; the deepest legal nesting uses a fraction of the first. The smaller one is for
@@ -44,6 +44,7 @@ pub fn compile_file(
             Err(error) => Compilation {
                 sources: SourceMap::new(),
                 scene: None,
+                work: WorkCounts::default(),
                 diagnostics: vec![Diagnostic::new(
                     Severity::Error,
                     format!("cannot read `{display}`: {error}"),
@@ -153,6 +154,7 @@ where
                 return Compilation {
                     sources: SourceMap::new(),
                     scene: None,
+                    work: WorkCounts::default(),
                     diagnostics: vec![Diagnostic::new(
                         Severity::Error,
                         format!("cannot start the compiler thread: {error}"),
@@ -176,6 +178,7 @@ where
             Ok(None) => Compilation {
                 sources: SourceMap::new(),
                 scene: None,
+                work: WorkCounts::default(),
                 diagnostics: vec![Diagnostic::new(
                     Severity::Error,
                     "the compiler thread started without its work",
@@ -222,6 +225,8 @@ struct Loading<'a> {
     /// The chain of files being loaded, for cycle detection: (identity, path as written).
     stack: Vec<(PathBuf, PathBuf)>,
     total_bytes: usize,
+    /// Parse steps over every file (see [`WorkCounts`]).
+    parse_steps: u64,
     /// Set once the imports limit is reported, so later imports fail quietly.
     imports_exhausted: bool,
     /// Bracket nesting and syntax-tree depth allowed, within what the stack can take.
@@ -287,6 +292,7 @@ impl Loading<'_> {
             self.max_tree_depth,
         );
         let parsed = parser::parse_file(&text, &mut cx, self.max_nesting);
+        self.parse_steps += cx.steps;
         let build_errors = std::mem::take(&mut cx.errors);
         self.diagnostics.extend(build_errors);
         let mut items = match parsed {
@@ -423,6 +429,7 @@ fn compile_root(
         loaded: HashMap::new(),
         stack: Vec::new(),
         total_bytes: 0,
+        parse_steps: 0,
         imports_exhausted: false,
         // Limits raised far past their defaults stay within what this thread's stack can
         // take: every recursive pass is bounded by the tree depth.
@@ -446,6 +453,7 @@ fn compile_root(
                 ),
                 None,
             )],
+            WorkCounts::default(),
         );
     }
     let identity = loading.loader.identify(path);
@@ -457,13 +465,18 @@ fn compile_root(
         mut program,
         interner,
         mut diagnostics,
+        parse_steps,
         ..
     } = loading;
+    let mut work = WorkCounts {
+        parse_steps,
+        name_probes: 0,
+    };
     let Some(mut defines) = defines else {
-        return finish(sources, None, diagnostics);
+        return finish(sources, None, diagnostics, work);
     };
     if has_error(&diagnostics) {
-        return finish(sources, None, diagnostics);
+        return finish(sources, None, diagnostics, work);
     }
 
     let (resolution, resolve_diagnostics) = {
@@ -478,6 +491,7 @@ fn compile_root(
         resolver.resolve_program(&mut program)
     };
     diagnostics.extend(resolve_diagnostics);
+    work.name_probes = resolution.name_probes;
     // Evaluation runs even after resolution errors (unresolved names evaluate quietly to
     // nothing), so that one run reports every error it can find.
 
@@ -493,13 +507,13 @@ fn compile_root(
     let (scene, eval_diagnostics, failed) = evaluator.run();
     diagnostics.extend(eval_diagnostics);
     if failed || has_error(&diagnostics) {
-        return finish(sources, None, diagnostics);
+        return finish(sources, None, diagnostics, work);
     }
     match whitted_ir::validate(scene) {
-        Ok(valid) => finish(sources, Some(valid), diagnostics),
+        Ok(valid) => finish(sources, Some(valid), diagnostics, work),
         Err(invalid) => {
             diagnostics.extend(invalid.diagnostics);
-            finish(sources, None, diagnostics)
+            finish(sources, None, diagnostics, work)
         }
     }
 }
@@ -581,6 +595,7 @@ fn finish(
     sources: SourceMap,
     scene: Option<whitted_ir::ValidScene>,
     diagnostics: Vec<Diagnostic>,
+    work: WorkCounts,
 ) -> Compilation {
     let mut seen = HashSet::new();
     // With errors, warnings and notes are mostly their echoes (a material whose definition
@@ -596,6 +611,7 @@ fn finish(
         sources,
         scene,
         diagnostics,
+        work,
     }
 }
 

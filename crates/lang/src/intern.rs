@@ -9,7 +9,9 @@ pub struct Sym(u32);
 
 #[derive(Default, Debug)]
 pub struct Interner {
-    ids: HashMap<Box<str>, Sym>,
+    /// Hashed with foldhash, not SipHash: a scene written by a program interns a name for
+    /// every word of a million statements, and no one chooses these keys to collide.
+    ids: HashMap<Box<str>, Sym, foldhash::fast::FixedState>,
     names: Vec<Box<str>>,
 }
 
@@ -22,6 +24,25 @@ impl Interner {
         self.names.push(name.into());
         self.ids.insert(name.into(), sym);
         sym
+    }
+
+    /// How many names are interned: a mark for [`Self::forget_after`].
+    pub fn mark(&self) -> usize {
+        self.names.len()
+    }
+
+    /// Forgets every name interned after `mark` (a parse that was abandoned), so the
+    /// symbols of a second attempt are numbered as if the first had never run.
+    pub fn forget_after(&mut self, mark: usize) {
+        for name in self.names.drain(mark.min(self.names.len())..) {
+            self.ids.remove(&name);
+        }
+    }
+
+    /// Every interned name, in the order of their symbols (for tests comparing two parses).
+    #[cfg(test)]
+    pub(crate) fn names(&self) -> &[Box<str>] {
+        &self.names
     }
 
     pub fn name(&self, sym: Sym) -> &str {

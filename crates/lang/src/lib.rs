@@ -105,6 +105,20 @@ pub struct Compilation {
     pub scene: Option<whitted_ir::ValidScene>,
     /// Errors, warnings and notes, in source order within each phase.
     pub diagnostics: Vec<Diagnostic>,
+    /// How much work the compilation did, counted deterministically.
+    pub work: WorkCounts,
+}
+
+/// Deterministic counts of a compilation's work, for tests that check it grows linearly
+/// with the input (scenes written by programs are big; wall-clock time is too noisy to
+/// test).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WorkCounts {
+    /// Rules the fast reader entered, backtracked attempts included (none for a text it
+    /// left to pest).
+    pub parse_steps: u64,
+    /// Definitions the resolver examined while defining and looking up names.
+    pub name_probes: u64,
 }
 
 impl Compilation {

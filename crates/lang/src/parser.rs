@@ -16,6 +16,7 @@ use crate::lexical;
 use crate::syntax_error;
 
 mod constructs;
+mod fast;
 
 #[derive(pest_derive::Parser)]
 #[grammar = "../../grammar/scene.pest"]
@@ -32,6 +33,9 @@ pub struct ParseContext<'a> {
     pub max_expression_depth: usize,
     /// How deep the builder is in nested expressions right now.
     depth: usize,
+    /// Rules the fast reader entered, backtracked attempts included: a deterministic
+    /// measure of parsing work (see [`crate::WorkCounts`]).
+    pub steps: u64,
 }
 
 impl<'a> ParseContext<'a> {
@@ -48,6 +52,7 @@ impl<'a> ParseContext<'a> {
             errors: Vec::new(),
             max_expression_depth,
             depth: 0,
+            steps: 0,
         }
     }
 }
@@ -86,9 +91,22 @@ pub fn parse_file(
     max_nesting: usize,
 ) -> Result<Vec<Item>, Diagnostic> {
     let brackets = lexical::scan(text, cx.file, max_nesting, cx.max_expression_depth)?;
+    if let Some(items) = fast::parse_file(text, cx) {
+        return Ok(items);
+    }
+    parse_file_with_pest(text, cx, &brackets)
+}
+
+/// [`parse_file`] by pest alone, after the lexical pass: the grammar's reference, and the
+/// maker of every syntax error.
+fn parse_file_with_pest(
+    text: &str,
+    cx: &mut ParseContext<'_>,
+    brackets: &lexical::Brackets,
+) -> Result<Vec<Item>, Diagnostic> {
     let mut pairs = parse_rule(Rule::file, text).map_err(|error| {
-        let diagnostic = syntax_error::translate(&error, text, cx.file, Some(&brackets));
-        constructs::expression_body_hint(diagnostic, text, &brackets)
+        let diagnostic = syntax_error::translate(&error, text, cx.file, Some(brackets));
+        constructs::expression_body_hint(diagnostic, text, brackets)
     })?;
     let Some(file) = pairs.next() else {
         return Ok(Vec::new());
@@ -189,6 +207,113 @@ fn shift_expr(expr: &mut Expr, offset: usize) {
     }
 }
 
+/// `#rrggbb`: an sRGB colour, stored linear.
+pub(super) fn hex_color(text: &str, span: Span) -> Expr {
+    let hex = text.trim_start_matches('#');
+    let channel = |i: usize| {
+        let byte = hex
+            .get(i..i + 2)
+            .and_then(|h| u8::from_str_radix(h, 16).ok())
+            .unwrap_or(0);
+        srgb_to_linear(f64::from(byte) / 255.0)
+    };
+    Expr {
+        kind: ExprKind::Color(DVec3::new(channel(0), channel(2), channel(4))),
+        span,
+    }
+}
+
+/// `base.name`; `field_span` covers the `.` and the name.
+pub(super) fn field_expr(base: Expr, name: Ident, field_span: Span) -> Expr {
+    let span = base.span.to(field_span);
+    Expr {
+        kind: ExprKind::Field {
+            base: Box::new(base),
+            field: name,
+            component: None,
+        },
+        span,
+    }
+}
+
+/// One element of an expression as written: the precedence climb ([`combine`]) turns a
+/// list of them into a tree.
+pub(super) enum ExprPart {
+    Prefix(UnaryOp, Span),
+    Operand(Expr),
+    Infix(BinaryOp, Span),
+}
+
+/// The precedence climb, with explicit stacks instead of recursion. `span` is the whole
+/// expression's, for the fallback that well-formed input never reaches.
+pub(super) fn combine(parts: impl IntoIterator<Item = ExprPart>, span: Span) -> Expr {
+    let mut operands: Vec<Expr> = Vec::new();
+    let mut operators: Vec<(BinaryOp, Span)> = Vec::new();
+    let mut prefixes: Vec<(UnaryOp, Span)> = Vec::new();
+
+    fn reduce(operands: &mut Vec<Expr>, op: BinaryOp, op_span: Span) {
+        let (Some(rhs), Some(lhs)) = (operands.pop(), operands.pop()) else {
+            return;
+        };
+        let span = lhs.span.to(rhs.span);
+        operands.push(Expr {
+            kind: ExprKind::Binary {
+                op,
+                op_span,
+                lhs: Box::new(lhs),
+                rhs: Box::new(rhs),
+            },
+            span,
+        });
+    }
+
+    for part in parts {
+        match part {
+            ExprPart::Prefix(op, op_span) => prefixes.push((op, op_span)),
+            ExprPart::Operand(mut operand) => {
+                while let Some((op, op_span)) = prefixes.pop() {
+                    let span = op_span.to(operand.span);
+                    operand = match (op, operand.kind) {
+                        // Fold `-2` into a literal so dumps and the evaluator see a number.
+                        (UnaryOp::Neg, ExprKind::Number(x)) => Expr {
+                            kind: ExprKind::Number(-x),
+                            span,
+                        },
+                        (op, kind) => Expr {
+                            kind: ExprKind::Unary(
+                                op,
+                                Box::new(Expr {
+                                    kind,
+                                    span: operand.span,
+                                }),
+                            ),
+                            span,
+                        },
+                    };
+                }
+                operands.push(operand);
+            }
+            ExprPart::Infix(op, op_span) => {
+                while let Some(&(top, top_span)) = operators.last() {
+                    if precedence(top) < precedence(op) {
+                        break;
+                    }
+                    operators.pop();
+                    reduce(&mut operands, top, top_span);
+                }
+                operators.push((op, op_span));
+            }
+        }
+    }
+    while let Some((op, op_span)) = operators.pop() {
+        reduce(&mut operands, op, op_span);
+    }
+    operands.pop().unwrap_or(Expr {
+        kind: ExprKind::Number(0.0),
+        span,
+    })
+}
+
 /// Operator precedence, loosest first. All binary operators are left-associative.
 fn precedence(op: BinaryOp) -> u8 {
     match op {
@@ -241,6 +366,11 @@ impl ParseContext<'_> {
             .next()
             .map(|inner| inner.as_str())
             .unwrap_or("");
+        self.string_lit(raw, span)
+    }
+
+    /// A string literal from its raw text (between the quotes) and its span (with them).
+    pub(super) fn string_lit(&mut self, raw: &str, span: Span) -> StrLit {
         let mut value = String::with_capacity(raw.len());
         let mut chars = raw.char_indices();
         while let Some((i, c)) = chars.next() {
@@ -276,12 +406,14 @@ impl ParseContext<'_> {
 
     /// A string that may hold `{name}` holes (object and light names, string values).
     fn formatted_string(&mut self, pair: Pair<'_, Rule>) -> StrLit {
-        let raw = pair
-            .clone()
-            .into_inner()
-            .next()
-            .map_or("", |inner| inner.as_str());
-        let mut lit = self.string(pair);
+        let span = self.span(&pair);
+        let raw = pair.into_inner().next().map_or("", |inner| inner.as_str());
+        self.formatted_lit(raw, span)
+    }
+
+    /// [`Self::string_lit`] with its `{name}` holes split out.
+    pub(super) fn formatted_lit(&mut self, raw: &str, span: Span) -> StrLit {
+        let mut lit = self.string_lit(raw, span);
         let raw_start = lit.span.start as usize + 1;
         match crate::strings::template(raw, raw_start, self.file, self.interner) {
             Ok(parts) => lit.parts = parts,
@@ -307,7 +439,10 @@ impl ParseContext<'_> {
                         parts: Vec::new(),
                     },
                 };
-                ItemKind::Import { path, file: None }
+                ItemKind::Import {
+                    path: Box::new(path),
+                    file: None,
+                }
             }
             Rule::const_stmt | Rule::let_stmt => {
                 inner.next();
@@ -353,10 +488,10 @@ impl ParseContext<'_> {
                 ItemKind::For {
                     var,
                     slot: Slot::None,
-                    start,
-                    end,
+                    start: Box::new(start),
+                    end: Box::new(end),
                     inclusive,
-                    step,
+                    step: step.map(Box::new),
                     body,
                 }
             }
@@ -364,7 +499,10 @@ impl ParseContext<'_> {
                 inner.next();
                 let condition = self.next_expr(&mut inner, span);
                 let body = self.next_block(&mut inner, span);
-                ItemKind::While { condition, body }
+                ItemKind::While {
+                    condition: Box::new(condition),
+                    body,
+                }
             }
             Rule::assign_stmt => {
                 let ident = self.next_ident(&mut inner, span);
@@ -387,9 +525,9 @@ impl ParseContext<'_> {
                     _ => Else::Block(self.block(p)),
                 });
                 ItemKind::If {
-                    condition,
+                    condition: Box::new(condition),
                     then,
-                    otherwise,
+                    otherwise: otherwise.map(Box::new),
                 }
             }
             Rule::return_stmt => {
@@ -417,7 +555,7 @@ impl ParseContext<'_> {
                 ItemKind::Light {
                     kind,
                     tag: None,
-                    name,
+                    name: name.map(Box::new),
                     body,
                 }
             }
@@ -441,11 +579,11 @@ impl ParseContext<'_> {
                 ItemKind::Material {
                     name,
                     slot: Slot::None,
-                    body: MaterialBody {
+                    body: Box::new(MaterialBody {
                         header: Span::new(self.file, span.start as usize, header_end as usize),
                         parent,
                         block: block.unwrap_or_else(|| self.empty_block(span)),
-                    },
+                    }),
                 }
             }
             Rule::material_prop => {
@@ -493,7 +631,10 @@ impl ParseContext<'_> {
                     },
                 };
                 let modifiers = inner.next().map(|b| self.block(b));
-                ItemKind::Call { call, modifiers }
+                ItemKind::Call {
+                    call: Box::new(call),
+                    modifiers,
+                }
             }
             Rule::object_stmt => {
                 let kind = self.next_ident(&mut inner, span);
@@ -501,7 +642,7 @@ impl ParseContext<'_> {
                 ItemKind::Object {
                     kind,
                     tag: None,
-                    name,
+                    name: name.map(Box::new),
                     body,
                 }
             }
@@ -536,8 +677,8 @@ impl ParseContext<'_> {
                 ItemKind::Property(Property {
                     name,
                     values,
-                    about,
-                    block,
+                    about: about.map(Box::new),
+                    block: block.map(Box::new),
                     prop: None,
                 })
             }
@@ -573,7 +714,6 @@ impl ParseContext<'_> {
 
     /// `keyword` is the span of the `material` keyword that precedes the body.
     fn material_body(&mut self, pair: Pair<'_, Rule>, keyword: Span) -> MaterialBody {
-        let span = keyword;
         let mut parent: Option<Name> = None;
         let mut block = None;
         for p in pair.into_inner() {
@@ -587,11 +727,21 @@ impl ParseContext<'_> {
                 _ => block = Some(self.block(p)),
             }
         }
+        self.material_body_of(parent, block, keyword)
+    }
+
+    /// A material body from its parts; `keyword` is the `material` before it.
+    pub(super) fn material_body_of(
+        &self,
+        parent: Option<Name>,
+        block: Option<Block>,
+        keyword: Span,
+    ) -> MaterialBody {
         let header_end = parent.as_ref().map_or(keyword.end, |p| p.ident.span.end);
         MaterialBody {
             header: Span::new(self.file, keyword.start as usize, header_end as usize),
             parent,
-            block: block.unwrap_or_else(|| self.empty_block(span)),
+            block: block.unwrap_or_else(|| self.empty_block(keyword)),
         }
     }
 
@@ -716,78 +866,24 @@ impl ParseContext<'_> {
         }
     }
 
-    /// The precedence climb, with explicit stacks instead of recursion.
+    /// The parts of an `expr` or `arith` pair, combined by precedence.
     fn expr_inner(&mut self, pair: Pair<'_, Rule>) -> Expr {
         let span = self.span(&pair);
-        let mut operands: Vec<Expr> = Vec::new();
-        let mut operators: Vec<(BinaryOp, Span)> = Vec::new();
-        let mut prefixes: Vec<(UnaryOp, Span)> = Vec::new();
-
-        fn reduce(operands: &mut Vec<Expr>, op: BinaryOp, op_span: Span) {
-            let (Some(rhs), Some(lhs)) = (operands.pop(), operands.pop()) else {
-                return;
-            };
-            let span = lhs.span.to(rhs.span);
-            operands.push(Expr {
-                kind: ExprKind::Binary {
-                    op,
-                    op_span,
-                    lhs: Box::new(lhs),
-                    rhs: Box::new(rhs),
-                },
-                span,
-            });
-        }
-
+        let mut parts = Vec::new();
         for part in pair.into_inner() {
             let rule = part.as_rule();
             match rule {
-                Rule::neg => prefixes.push((UnaryOp::Neg, self.span(&part))),
-                Rule::not => prefixes.push((UnaryOp::Not, self.span(&part))),
-                Rule::postfix => {
-                    let mut operand = self.postfix(part);
-                    while let Some((op, op_span)) = prefixes.pop() {
-                        let span = op_span.to(operand.span);
-                        operand = match (op, operand.kind) {
-                            // Fold `-2` into a literal so dumps and the evaluator see a number.
-                            (UnaryOp::Neg, ExprKind::Number(x)) => Expr {
-                                kind: ExprKind::Number(-x),
-                                span,
-                            },
-                            (op, kind) => Expr {
-                                kind: ExprKind::Unary(
-                                    op,
-                                    Box::new(Expr {
-                                        kind,
-                                        span: operand.span,
-                                    }),
-                                ),
-                                span,
-                            },
-                        };
-                    }
-                    operands.push(operand);
-                }
+                Rule::neg => parts.push(ExprPart::Prefix(UnaryOp::Neg, self.span(&part))),
+                Rule::not => parts.push(ExprPart::Prefix(UnaryOp::Not, self.span(&part))),
+                Rule::postfix => parts.push(ExprPart::Operand(self.postfix(part))),
                 _ => {
-                    let Some(op) = binary_op(rule) else { continue };
-                    while let Some(&(top, top_span)) = operators.last() {
-                        if precedence(top) < precedence(op) {
-                            break;
-                        }
-                        operators.pop();
-                        reduce(&mut operands, top, top_span);
+                    if let Some(op) = binary_op(rule) {
+                        parts.push(ExprPart::Infix(op, self.span(&part)));
                     }
-                    operators.push((op, self.span(&part)));
                 }
             }
         }
-        while let Some((op, op_span)) = operators.pop() {
-            reduce(&mut operands, op, op_span);
-        }
-        operands.pop().unwrap_or(Expr {
-            kind: ExprKind::Number(0.0),
-            span,
-        })
+        combine(parts, span)
     }
 
     fn postfix(&mut self, pair: Pair<'_, Rule>) -> Expr {
@@ -810,52 +906,32 @@ impl ParseContext<'_> {
                 Some(ident) => self.ident(&ident),
                 None => self.missing_ident(field_span),
             };
-            let span = operand.span.to(field_span);
-            operand = Expr {
-                kind: ExprKind::Field {
-                    base: Box::new(operand),
-                    field: name,
-                    component: None,
-                },
-                span,
-            };
+            operand = field_expr(operand, name, field_span);
         }
         operand
+    }
+
+    /// A number literal; one too large for f64 is an error (and reads as 0).
+    pub(super) fn number(&mut self, text: &str, span: Span) -> Expr {
+        let value = text.parse::<f64>().unwrap_or(f64::INFINITY);
+        if !value.is_finite() {
+            self.errors.push(
+                Diagnostic::error("this number is too large", span)
+                    .with_label("larger than the largest number (about 1.8e308)"),
+            );
+        }
+        Expr {
+            kind: ExprKind::Number(if value.is_finite() { value } else { 0.0 }),
+            span,
+        }
     }
 
     fn primary(&mut self, pair: Pair<'_, Rule>) -> Expr {
         let span = self.span(&pair);
         let leaf = |kind| Expr { kind, span };
         match pair.as_rule() {
-            Rule::number => {
-                let value = pair.as_str().parse::<f64>().unwrap_or(f64::INFINITY);
-                if !value.is_finite() {
-                    self.errors.push(
-                        Diagnostic::error("this number is too large", span)
-                            .with_label("larger than the largest number (about 1.8e308)"),
-                    );
-                }
-                leaf(ExprKind::Number(if value.is_finite() {
-                    value
-                } else {
-                    0.0
-                }))
-            }
-            Rule::hex_color => {
-                let hex = pair.as_str().trim_start_matches('#');
-                let channel = |i: usize| {
-                    let byte = hex
-                        .get(i..i + 2)
-                        .and_then(|h| u8::from_str_radix(h, 16).ok())
-                        .unwrap_or(0);
-                    srgb_to_linear(f64::from(byte) / 255.0)
-                };
-                leaf(ExprKind::Color(DVec3::new(
-                    channel(0),
-                    channel(2),
-                    channel(4),
-                )))
-            }
+            Rule::number => self.number(pair.as_str(), span),
+            Rule::hex_color => hex_color(pair.as_str(), span),
             Rule::kw_true => leaf(ExprKind::Bool(true)),
             Rule::kw_false => leaf(ExprKind::Bool(false)),
             Rule::vector => {

@@ -7,6 +7,7 @@
 //! the wrong place, wrong argument counts, unused materials and functions, `-D` names that
 //! match no constant.
 
+use std::cell::Cell;
 use std::collections::HashMap;
 
 use whitted_ir::{Diagnostic, Span};
@@ -74,6 +75,9 @@ pub struct Resolution {
     pub global_count: u32,
     /// For each overridden `const` (by global slot): which define replaces its value.
     pub overrides: HashMap<u32, usize>,
+    /// Definitions examined while defining and looking up names: a deterministic measure of
+    /// the resolver's work, which must grow linearly with the number of names.
+    pub name_probes: u64,
 }
 
 struct Scope {
@@ -105,11 +109,13 @@ impl Scope {
             .or_insert((def, def));
     }
 
-    fn first(&self, sym: Sym) -> Option<DefId> {
+    fn first(&self, sym: Sym, probes: &Cell<u64>) -> Option<DefId> {
+        probes.set(probes.get() + 1);
         self.index.get(&sym).map(|&(first, _)| first)
     }
 
-    fn latest(&self, sym: Sym) -> Option<DefId> {
+    fn latest(&self, sym: Sym, probes: &Cell<u64>) -> Option<DefId> {
+        probes.set(probes.get() + 1);
         self.index.get(&sym).map(|&(_, latest)| latest)
     }
 }
@@ -140,6 +146,8 @@ pub struct Resolver<'a> {
     /// Which files are being resolved (an import of one of these is a cycle the loader
     /// already reported).
     in_progress: Vec<bool>,
+    /// See [`Resolution::name_probes`]; a cell because lookups only read.
+    name_probes: Cell<u64>,
 }
 
 impl<'a> Resolver<'a> {
@@ -158,6 +166,7 @@ impl<'a> Resolver<'a> {
             define_used: vec![false; defines.len()],
             resolution: Resolution::default(),
             in_progress: vec![false; file_count],
+            name_probes: Cell::new(0),
         }
     }
 
@@ -176,6 +185,7 @@ impl<'a> Resolver<'a> {
         }
         self.report_unused();
         self.report_unused_defines();
+        self.resolution.name_probes = self.name_probes.get();
         (self.resolution, self.diagnostics)
     }
 
@@ -252,7 +262,11 @@ impl<'a> Resolver<'a> {
             return;
         };
         for (sym, def) in names {
-            match self.scopes.first().and_then(|s| s.first(sym)) {
+            match self
+                .scopes
+                .first()
+                .and_then(|s| s.first(sym, &self.name_probes))
+            {
                 Some(existing) if existing == def => {}
                 Some(existing) => {
                     let first = self.definitions[existing].span;
@@ -315,7 +329,10 @@ impl<'a> Resolver<'a> {
             }
             _ => self.new_local(),
         };
-        let existing = self.scopes.last().and_then(|s| s.first(ident.sym));
+        let existing = self
+            .scopes
+            .last()
+            .and_then(|s| s.first(ident.sym, &self.name_probes));
         if let Some(existing) = existing {
             let name = self.name(ident.sym);
             let first = &self.definitions[existing];
@@ -348,11 +365,14 @@ impl<'a> Resolver<'a> {
     /// file scope.
     fn lookup(&self, sym: Sym) -> Option<DefId> {
         for (depth, scope) in self.scopes.iter().enumerate().rev() {
-            if let Some(def) = scope.latest(sym) {
+            if let Some(def) = scope.latest(sym, &self.name_probes) {
                 return Some(def);
             }
             if scope.barrier && depth > 0 {
-                return self.scopes.first().and_then(|s| s.latest(sym));
+                return self
+                    .scopes
+                    .first()
+                    .and_then(|s| s.latest(sym, &self.name_probes));
             }
         }
         None
@@ -545,7 +565,7 @@ impl<'a> Resolver<'a> {
             } => {
                 self.expr(condition, program);
                 self.block(then, inner_cx, program);
-                match otherwise {
+                match otherwise.as_deref_mut() {
                     Some(Else::If(item)) => self.item(item, inner_cx, program),
                     Some(Else::Block(block)) => self.block(block, inner_cx, program),
                     None => {}
@@ -599,7 +619,7 @@ impl<'a> Resolver<'a> {
                 body,
                 name,
             } => {
-                self.string_holes(name.as_mut());
+                self.string_holes(name.as_deref_mut());
                 if !cx.is_statements() {
                     self.misplaced(
                         "a light",
@@ -645,7 +665,7 @@ impl<'a> Resolver<'a> {
                 body,
                 name,
             } => {
-                self.string_holes(name.as_mut());
+                self.string_holes(name.as_deref_mut());
                 let allowed = match cx {
                     Context::Statements { .. } => true,
                     Context::Object(parent) => parent.is_container(),

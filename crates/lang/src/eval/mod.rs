@@ -336,7 +336,7 @@ impl<'a> Evaluator<'a> {
                 if go {
                     return self.items(&then.items);
                 }
-                match otherwise {
+                match otherwise.as_deref() {
                     Some(Else::If(item)) => return self.item(item),
                     Some(Else::Block(block)) => return self.items(&block.items),
                     None => {}
@@ -366,7 +366,7 @@ impl<'a> Evaluator<'a> {
                 if let Some(tag) = tag {
                     let end = name.as_ref().map_or(kind.span.end, |n| n.span.end);
                     let header = Span::new(kind.span.file, item.span.start as usize, end as usize);
-                    self.light(*tag, header, name.as_ref(), body)?;
+                    self.light(*tag, header, name.as_deref(), body)?;
                 }
             }
             ItemKind::Material { name, slot, body } => {
@@ -382,7 +382,7 @@ impl<'a> Evaluator<'a> {
                 body,
             } => {
                 if let Some(tag) = tag {
-                    self.object(*tag, *kind, name.as_ref(), body)?;
+                    self.object(*tag, *kind, name.as_deref(), body)?;
                 }
             }
             ItemKind::Call { call, modifiers } => self.call_statement(call, modifiers.as_ref())?,

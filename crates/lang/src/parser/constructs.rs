@@ -4,7 +4,7 @@
 
 use pest::iterators::Pair;
 use pest::Parser as _;
-use whitted_ir::Diagnostic;
+use whitted_ir::{Diagnostic, Span};
 
 use super::{ParseContext, Rule, SceneParser};
 use crate::ast::*;
@@ -44,14 +44,19 @@ impl ParseContext<'_> {
                 span: index_span,
             },
         };
-        let span = base.span.to(index_span);
-        Expr {
-            kind: ExprKind::Index {
-                base: Box::new(base),
-                index: Box::new(index),
-            },
-            span,
-        }
+        index_expr(base, index, index_span)
+    }
+}
+
+/// `base[index]`; `index_span` covers the brackets.
+pub(super) fn index_expr(base: Expr, index: Expr, index_span: Span) -> Expr {
+    let span = base.span.to(index_span);
+    Expr {
+        kind: ExprKind::Index {
+            base: Box::new(base),
+            index: Box::new(index),
+        },
+        span,
     }
 }
 

@@ -6,6 +6,7 @@ mod budgets;
 mod constructs;
 mod docs;
 mod errors;
+mod exporter_scale;
 mod fuzz;
 mod limits;
 mod scenes;
