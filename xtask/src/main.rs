@@ -22,7 +22,8 @@ commands:
   deps     only the dependency-direction checks
   golden   render the golden scenes and compare with tests/golden/ (--bless to update;
            --scenes DIR --refs DIR for your own folders)
-  bench    release build, then time the benchmark scenes (prints Mrays/s)
+  bench    release build, then time the benchmark scenes (prints Mrays/s);
+           --size WxH, --programs (only the scenes-written-by-programs table)
   fuzz     the whole-pipeline fuzzer: --cases N (1000), --seed S (from the clock),
            --case K (only case K of the seed), --save (shrink new failures into
            tests/fuzz-regressions/), --replay (only the regression inputs)";

@@ -339,7 +339,12 @@ impl<'t> Reader<'t, '_, '_> {
             }
             if matches!(self.byte(self.pos), None | Some(b'}')) {
                 self.pos = before;
-                let items = self.pending.drain(first..).collect();
+                // The file's own list is all of `pending`: taken whole, not copied.
+                let items = if first == 0 {
+                    std::mem::take(&mut self.pending)
+                } else {
+                    self.pending.drain(first..).collect()
+                };
                 return Some((items, depth));
             }
             let Some((item, item_depth)) = self.item() else {

@@ -12,6 +12,8 @@ use serde::Deserialize;
 
 use crate::{run_cargo, workspace_root};
 
+mod programs;
+
 /// One benchmark render: a scene, its `-D` overrides and what to print it as.
 struct Case {
     label: &'static str,
@@ -73,6 +75,7 @@ struct Stats {
 pub fn run(args: &[String]) -> anyhow::Result<()> {
     let mut width = 640;
     let mut height = 480;
+    let mut only_programs = false;
     let mut iter = args.iter();
     while let Some(arg) = iter.next() {
         match arg.as_str() {
@@ -84,7 +87,8 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
                 width = w.parse().context("bad width")?;
                 height = h.parse().context("bad height")?;
             }
-            other => bail!("unknown bench option `{other}` (known: --size WxH)"),
+            "--programs" => only_programs = true,
+            other => bail!("unknown bench option `{other}` (known: --size WxH, --programs)"),
         }
     }
     run_cargo(&["build", "--release", "--locked", "--bin", "whitted"])?;
@@ -93,6 +97,9 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     let out_dir = root.join("target/bench");
     std::fs::create_dir_all(&out_dir)?;
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if only_programs {
+        return programs::run(&exe, &out_dir, RUNS);
+    }
 
     println!(
         "\nrenders ({width}x{height}, max depth 5, 1 spp; release build; best of {RUNS} runs)"
@@ -247,7 +254,7 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         });
         println!("{:<34} {:>7.3}s {:>12}", case.label, wall, memory);
     }
-    Ok(())
+    programs::run(&exe, &out_dir, RUNS)
 }
 
 /// Wall time and, where /usr/bin/time exists, peak resident memory of `whitted check`.
