@@ -106,7 +106,7 @@ pub struct MaterialBody {
 #[derive(Debug)]
 pub struct Property {
     pub name: Ident,
-    pub values: Vec<Expr>,
+    pub values: PropertyValues,
     /// `rotate 30 about <1, 1, 0>`. Boxed, like the other rare parts of items, so that an
     /// item stays small: scenes written by programs hold millions of them.
     pub about: Option<Box<Expr>>,
@@ -114,6 +114,73 @@ pub struct Property {
     pub block: Option<Box<Block>>,
     /// Filled by the resolver when the name is valid in its block.
     pub prop: Option<Prop>,
+}
+
+/// A property's values: almost always exactly one, kept inline rather than in a vector of
+/// its own (a scene written by a program has millions of properties). Reads as a slice.
+#[derive(Debug)]
+pub enum PropertyValues {
+    One(Expr),
+    Many(Vec<Expr>),
+}
+
+impl PropertyValues {
+    pub fn from_vec(mut values: Vec<Expr>) -> Self {
+        match values.pop() {
+            Some(only) if values.is_empty() => PropertyValues::One(only),
+            Some(last) => {
+                values.push(last);
+                PropertyValues::Many(values)
+            }
+            None => PropertyValues::Many(values),
+        }
+    }
+
+    pub fn as_slice(&self) -> &[Expr] {
+        match self {
+            PropertyValues::One(only) => std::slice::from_ref(only),
+            PropertyValues::Many(values) => values,
+        }
+    }
+
+    pub fn as_mut_slice(&mut self) -> &mut [Expr] {
+        match self {
+            PropertyValues::One(only) => std::slice::from_mut(only),
+            PropertyValues::Many(values) => values,
+        }
+    }
+}
+
+impl std::ops::Deref for PropertyValues {
+    type Target = [Expr];
+
+    fn deref(&self) -> &[Expr] {
+        self.as_slice()
+    }
+}
+
+impl std::ops::DerefMut for PropertyValues {
+    fn deref_mut(&mut self) -> &mut [Expr] {
+        self.as_mut_slice()
+    }
+}
+
+impl<'a> IntoIterator for &'a PropertyValues {
+    type Item = &'a Expr;
+    type IntoIter = std::slice::Iter<'a, Expr>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.as_slice().iter()
+    }
+}
+
+impl<'a> IntoIterator for &'a mut PropertyValues {
+    type Item = &'a mut Expr;
+    type IntoIter = std::slice::IterMut<'a, Expr>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.as_mut_slice().iter_mut()
+    }
 }
 
 #[derive(Debug)]

@@ -614,7 +614,7 @@ impl ParseContext<'_> {
                 };
                 ItemKind::Property(Property {
                     name,
-                    values,
+                    values: PropertyValues::from_vec(values),
                     about: None,
                     block: None,
                     prop: None,
@@ -653,7 +653,7 @@ impl ParseContext<'_> {
                 };
                 ItemKind::Property(Property {
                     name,
-                    values: Vec::new(),
+                    values: PropertyValues::Many(Vec::new()),
                     about: None,
                     block: None,
                     prop: None,
@@ -676,7 +676,7 @@ impl ParseContext<'_> {
                 }
                 ItemKind::Property(Property {
                     name,
-                    values,
+                    values: PropertyValues::from_vec(values),
                     about: about.map(Box::new),
                     block: block.map(Box::new),
                     prop: None,

@@ -415,7 +415,12 @@ impl<'t> Reader<'t, '_, '_> {
                     span,
                 };
                 (
-                    ItemKind::Property(property(name, Vec::new(), None, None)),
+                    ItemKind::Property(property(
+                        name,
+                        PropertyValues::Many(Vec::new()),
+                        None,
+                        None,
+                    )),
                     0,
                 )
             }
@@ -774,7 +779,7 @@ impl<'t> Reader<'t, '_, '_> {
                 self.expr(false)?
             }
         };
-        let kind = ItemKind::Property(property(name, vec![value], None, None));
+        let kind = ItemKind::Property(property(name, PropertyValues::One(value), None, None));
         Some((kind, depth))
     }
 
@@ -842,7 +847,7 @@ impl<'t> Reader<'t, '_, '_> {
         let name = self.ident()?;
         self.skip();
         let (first, mut depth) = self.expr(false)?;
-        let mut values = vec![first];
+        let mut values = PropertyValues::One(first);
         self.skip();
         loop {
             let checkpoint = self.checkpoint();
@@ -857,7 +862,13 @@ impl<'t> Reader<'t, '_, '_> {
             };
             match next {
                 Some((value, value_depth)) => {
-                    values.push(value);
+                    values = match values {
+                        PropertyValues::One(first) => PropertyValues::Many(vec![first, value]),
+                        PropertyValues::Many(mut list) => {
+                            list.push(value);
+                            PropertyValues::Many(list)
+                        }
+                    };
                     depth = depth.max(value_depth);
                 }
                 None => {
@@ -1270,7 +1281,12 @@ impl<'t> Reader<'t, '_, '_> {
     }
 }
 
-fn property(name: Ident, values: Vec<Expr>, about: Option<Expr>, block: Option<Block>) -> Property {
+fn property(
+    name: Ident,
+    values: PropertyValues,
+    about: Option<Expr>,
+    block: Option<Block>,
+) -> Property {
     Property {
         name,
         values,
