@@ -5,6 +5,8 @@
 //! records the biggest of those trees 1000 times.
 //!
 //! `cargo run --release --example ray_tree_cost [-- SCENE [MAX_DEPTH]]`
+// A program, not a library: it prints its results and sets its exit status.
+#![allow(clippy::print_stdout, clippy::print_stderr, clippy::exit)]
 
 use std::path::Path;
 use std::process::ExitCode;

@@ -1,5 +1,7 @@
 //! The one integration-test binary: runs the real `whitted` executable and the libraries
 //! together, the way a user does.
+// A program, not a library: it prints its results and sets its exit status.
+#![allow(clippy::print_stdout, clippy::print_stderr, clippy::exit)]
 
 mod cli;
 mod conventions;

@@ -3,6 +3,8 @@
 //!
 //! `cargo run -p whitted-tracer --example preview -- SCENE OUT.ppm [WIDTH HEIGHT SPP]`
 //! where SCENE is `whitted`, `spheres` or `grid`.
+// A program, not a library: it prints its results and sets its exit status.
+#![allow(clippy::print_stdout, clippy::print_stderr, clippy::exit)]
 
 use std::io::Write;
 

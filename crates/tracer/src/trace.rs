@@ -199,7 +199,7 @@ impl<'a> Tracer<'a> {
 
     /// Counts a ray about to be traced (its caller has reported it to the recorder).
     #[inline(always)]
-    fn count(&mut self, path: &Path) {
+    fn count(&mut self, path: &Path<'_>) {
         match path.kind {
             RayKind::Camera => self.counters.camera += 1,
             RayKind::Reflected => self.counters.reflected += 1,
@@ -212,7 +212,7 @@ impl<'a> Tracer<'a> {
 
     /// The body of [`Tracer::trace`], once the recorder has heard of the ray: the recursion
     /// passes only what the colour depends on, and each caller reports the rest.
-    fn trace_started<R: Recorder>(&mut self, ray: &Ray, path: &Path, rec: &mut R) -> Vec3A {
+    fn trace_started<R: Recorder>(&mut self, ray: &Ray, path: &Path<'_>, rec: &mut R) -> Vec3A {
         let scene = self.scene;
         // Most rays travel in air; then nothing is absorbed and multiplying by the
         // transmittance (exactly 1) can be skipped without changing a bit.
@@ -410,7 +410,7 @@ impl<'a> Tracer<'a> {
 
     /// A ray that left the scene: the background, through the medium it travels in.
     #[inline(always)]
-    fn missed<R: Recorder>(&self, path: &Path, rec: &mut R) -> Vec3A {
+    fn missed<R: Recorder>(&self, path: &Path<'_>, rec: &mut R) -> Vec3A {
         let scene = self.scene;
         let color = if path.medium == Vec3A::ZERO {
             scene.background
@@ -701,7 +701,7 @@ impl<'a> Tracer<'a> {
     fn spawn<R: Recorder>(
         &mut self,
         ray: &Ray,
-        child: &Path,
+        child: &Path<'_>,
         split: &Split,
         outcome: &mut Outcome,
         rec: &mut R,
@@ -744,7 +744,7 @@ impl<'a> Tracer<'a> {
 
     /// `None` when the secondary ray may be traced; otherwise why not.
     #[inline]
-    fn secondary_verdict(&self, child: &Path) -> Option<Termination> {
+    fn secondary_verdict(&self, child: &Path<'_>) -> Option<Termination> {
         if child.depth > self.max_depth {
             Some(Termination::MaxDepth)
         } else if max_channel(child.weight) < self.min_weight {

@@ -8,6 +8,8 @@
 //!     ior-1 box filters shadows as the same box built from twelve triangles does (each
 //!     surface a shadow ray crosses filters it, exactly as for camera rays);
 //! (d) raising max_depth changes only pixels whose ray tree was cut by max_depth.
+// A program, not a library: it prints its results and sets its exit status.
+#![allow(clippy::print_stdout, clippy::print_stderr, clippy::exit)]
 
 use whitted_ir::{
     Attenuation, Color, DMat4, DVec3, Fresnel, Light, LightKind, Material, ShadowMode, Shape,

@@ -88,7 +88,7 @@ impl RenderObserver for Cancel<'_> {
 }
 
 /// Runs one case. Panics are not caught here: the runner catches them.
-pub fn run(text: &str, cancel: &Cancel) -> Result<Passed, Failure> {
+pub fn run(text: &str, cancel: &Cancel<'_>) -> Result<Passed, Failure> {
     let options = CompileOptions {
         defines: Vec::new(),
         limits: limits(),

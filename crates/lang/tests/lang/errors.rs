@@ -304,7 +304,7 @@ fn define_errors() {
     let mut out = String::new();
     /// (title, scene, -D pairs)
     type Case<'a> = (&'a str, &'a str, &'a [(&'a str, &'a str)]);
-    let cases: &[Case] = &[
+    let cases: &[Case<'_>] = &[
         (
             "an undefined constant, with a close one",
             scene,
