@@ -12,4 +12,5 @@ mod guards;
 mod json_schema;
 mod ray_trees;
 mod reshade;
+mod tidy;
 mod trace_cli;
