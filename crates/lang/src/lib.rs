@@ -14,6 +14,7 @@ mod ast_dump;
 mod builtins;
 mod compile;
 mod eval;
+mod hints;
 mod intern;
 mod lexical;
 mod parser;

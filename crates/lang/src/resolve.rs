@@ -429,6 +429,9 @@ impl<'a> Resolver<'a> {
         if let Some(best) = closest(name, candidates.iter().copied()) {
             diagnostic = diagnostic.with_hint(format!("did you mean `{best}`?"));
         }
+        if let Some(advice) = crate::hints::unknown_name(name) {
+            diagnostic = diagnostic.with_hint(advice);
+        }
         self.error(diagnostic);
     }
 
@@ -742,6 +745,9 @@ impl<'a> Resolver<'a> {
             Some(best) => diagnostic.with_hint(format!("did you mean `{best}`?")),
             None => diagnostic.with_hint(format!("the kinds are {}", list_or(names))),
         };
+        if let Some(advice) = crate::hints::foreign(name) {
+            diagnostic = diagnostic.with_hint(advice);
+        }
         self.error(diagnostic);
     }
 
@@ -845,6 +851,9 @@ impl<'a> Resolver<'a> {
                         list_and(&names)
                     )),
                 };
+                if let Some(advice) = crate::hints::foreign(name) {
+                    diagnostic = diagnostic.with_hint(advice);
+                }
                 self.error(diagnostic);
             }
         }

@@ -305,9 +305,16 @@ fn hints(expected: &Expected, text: &str, pos: usize, found: &str) -> Vec<String
         hints.push("`let`, `const` and `return` end with `;`".to_string());
     }
     let starts_value = next.starts_with(|c: char| c.is_ascii_digit() || c == '<' || c == '-');
+    let comma_before_property = crate::hints::comma_before_property(text.get(..pos).unwrap_or(""));
     if expected.punctuation.contains(&",") {
         if expected.in_vector {
             hints.push("vectors are written `<x, y, z>`, with commas".to_string());
+        } else if let (Some(property), true) = (comma_before_property, expected.statement) {
+            hints.push(format!(
+                "a comma separates the values of one property, not properties: remove the `,` before `{property}`"
+            ));
+        } else if expected.statement && starts_value && crate::hints::foreign(previous).is_some() {
+            // `color rgb 0.9`: the advice for the foreign word below says what to write.
         } else if expected.statement && starts_value {
             hints.push(
                 "a property takes one value; several values need commas between them".to_string(),
@@ -345,6 +352,7 @@ fn hints(expected: &Expected, text: &str, pos: usize, found: &str) -> Vec<String
             "a light is `light point`, `light directional` or `light spot`, then `{ ... }`".into(),
         );
     }
+    hints.extend(crate::hints::syntax(text, pos));
     hints
 }
 

@@ -395,3 +395,54 @@ fn limits_are_errors_that_name_the_limit() {
         &options,
     );
 }
+
+/// Words and habits brought from POV-Ray and elsewhere, each answered with the whitted way
+/// (crates/lang/src/hints.rs), and a comma put between two properties.
+#[test]
+fn foreign_words_and_habits() {
+    check_errors(
+        "foreign_words",
+        &[
+            (
+                "a POV-Ray colour in a material",
+                "material m { color rgb 0.9 }\n",
+            ),
+            (
+                "a POV-Ray colour in a light",
+                "light point { position <0, 1, 0> color rgb 0.9 }\n",
+            ),
+            (
+                "a comma between properties",
+                "sphere { center <0, 0, 0>, radius 1 }\n",
+            ),
+            ("an axis name as a vector", "plane { normal y }\n"),
+            (
+                "an axis times a vector",
+                "sphere { center <1, 0, 0> * x }\n",
+            ),
+            ("a per-object no_shadow", "sphere { radius 1 no_shadow }\n"),
+            ("a mesh", "mesh { }\n"),
+            ("#declare", "#declare R = 1;\n"),
+            ("#include", "#include \"colors.inc\"\n"),
+            (
+                "a filter channel",
+                "material m { diffuse rgbf <1, 1, 1, 0.5> }\n",
+            ),
+            (
+                "phong and phong_size",
+                "material m { phong 0.5 phong_size 40 }\n",
+            ),
+            ("a pigment block", "sphere { pigment { color red } }\n"),
+            (
+                "a camera location",
+                "camera perspective { location <0, 0, -5> }\n",
+            ),
+            (
+                "a light_source",
+                "light_source { <0, 10, 0> color white }\n",
+            ),
+            ("a positional sphere", "sphere { <0, 0, 0>, 1 }\n"),
+            ("a positional box", "box { <0, 0, 0>, <1, 1, 1> }\n"),
+        ],
+    );
+}
