@@ -18,6 +18,7 @@ mod hints;
 mod intern;
 mod lexical;
 mod parser;
+mod properties;
 mod random;
 mod render;
 mod resolve;

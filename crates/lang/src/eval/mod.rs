@@ -11,6 +11,7 @@
 
 mod arrays;
 mod builders;
+mod convert;
 mod expr;
 mod loops;
 mod materials;

@@ -13,6 +13,7 @@ use whitted_ir::{
 use super::builders::*;
 use super::{inherit, Abort, Eval, Evaluator, Sink};
 use crate::ast::*;
+use crate::properties::{self, Family};
 use crate::schema::{Arity, LightTag, ObjectTag, Prop};
 use crate::value::Value;
 
@@ -497,151 +498,8 @@ impl<'a> Evaluator<'a> {
 
     // ---- value conversions, each with its own message --------------------------------------
 
-    fn as_number(&mut self, value: Value, span: Span, prop: Prop) -> Eval<f64> {
-        match value {
-            Value::Number(x) => Ok(x),
-            other => self.fail(
-                Diagnostic::error(
-                    format!(
-                        "`{}` must be a number, not {}",
-                        prop.name(),
-                        other.type_name()
-                    ),
-                    span,
-                )
-                .with_label(format!("{} here", other.type_name())),
-            ),
-        }
-    }
-
-    fn as_vector(&mut self, value: Value, span: Span, prop: Prop) -> Eval<DVec3> {
-        match value {
-            Value::Vector(v) => Ok(v),
-            other => self.fail(
-                Diagnostic::error(
-                    format!(
-                        "`{}` must be a vector `<x, y, z>`, not {}",
-                        prop.name(),
-                        other.type_name()
-                    ),
-                    span,
-                )
-                .with_label(format!("{} here", other.type_name())),
-            ),
-        }
-    }
-
-    /// A colour: a vector of red, green, blue, or one number for a grey. Never negative.
-    fn as_color(&mut self, value: Value, span: Span, prop: Prop) -> Eval<Color> {
-        let v = match value {
-            Value::Number(x) => DVec3::splat(x),
-            Value::Vector(v) => v,
-            other => {
-                return self.fail(
-                    Diagnostic::error(
-                        format!(
-                            "`{}` must be a colour (`rgb(r, g, b)` or a number), not {}",
-                            prop.name(),
-                            other.type_name()
-                        ),
-                        span,
-                    )
-                    .with_label(format!("{} here", other.type_name())),
-                )
-            }
-        };
-        if v.cmplt(DVec3::ZERO).any() {
-            return self.fail(
-                Diagnostic::error(format!("`{}` cannot be negative", prop.name()), span)
-                    .with_label(format!("this is <{}, {}, {}>", v.x, v.y, v.z)),
-            );
-        }
-        Ok(Color::new(v.x, v.y, v.z))
-    }
-
-    /// A colour of light (background, ambient): at most the largest intensity limit.
-    fn light_color(&mut self, value: Value, span: Span, prop: Prop) -> Eval<Color> {
-        let color = self.as_color(value, span, prop)?;
-        let largest = color.components().into_iter().fold(0.0, f64::max);
-        if largest > limits::MAX_INTENSITY {
-            return self.fail(
-                Diagnostic::error(
-                    format!(
-                        "`{}` must be at most the largest intensity limit ({:e}), not {largest:e}",
-                        prop.name(),
-                        limits::MAX_INTENSITY
-                    ),
-                    span,
-                )
-                .with_label("too bright"),
-            );
-        }
-        Ok(color)
-    }
-
     /// A number within `low..=high` (or `low < x` when `low_open`), with a message naming
     /// the property and the range.
-    fn in_range(
-        &mut self,
-        value: Value,
-        span: Span,
-        prop: Prop,
-        low: f64,
-        low_open: bool,
-        high: f64,
-    ) -> Eval<f64> {
-        let x = self.as_number(value, span, prop)?;
-        let ok = if low_open { x > low } else { x >= low } && x <= high;
-        if ok {
-            return Ok(x);
-        }
-        let wanted = match (low_open, high.is_finite()) {
-            (true, false) => format!("greater than {low}"),
-            (false, false) => format!("at least {low}"),
-            (true, true) => format!("greater than {low} and at most {high}"),
-            (false, true) => format!("from {low} to {high}"),
-        };
-        self.fail(
-            Diagnostic::error(format!("`{}` must be {wanted}, not {x}", prop.name()), span)
-                .with_label("out of range"),
-        )
-    }
-
-    fn whole_in_range(
-        &mut self,
-        value: Value,
-        span: Span,
-        prop: Prop,
-        low: f64,
-        high: f64,
-    ) -> Eval<u32> {
-        let x = self.in_range(value, span, prop, low, false, high)?;
-        if x.fract() != 0.0 {
-            return self.fail(
-                Diagnostic::error(
-                    format!("`{}` must be a whole number, not {x}", prop.name()),
-                    span,
-                )
-                .with_label("not a whole number"),
-            );
-        }
-        Ok(x as u32)
-    }
-
-    fn nonzero_vector(&mut self, value: Value, span: Span, prop: Prop) -> Eval<DVec3> {
-        let v = self.as_vector(value, span, prop)?;
-        if v.length() < 1e-12 {
-            return self.fail(
-                Diagnostic::error(
-                    format!("`{}` must not be the zero vector", prop.name()),
-                    span,
-                )
-                .with_label("a direction needs a length"),
-            );
-        }
-        Ok(v)
-    }
-
     /// Numbers and vectors flattened into exactly `n` numbers.
     fn numbers(&mut self, values: &Values, span: Span, prop: Prop, n: usize) -> Eval<Vec<f64>> {
         let mut out = Vec::with_capacity(n);
@@ -871,49 +729,21 @@ impl<'a> Evaluator<'a> {
     ) -> Eval<()> {
         let span = property.name.span;
         let (value, value_span) = one(values, span);
-        let s = &self.scene.settings;
-        let mut settings = s.clone();
+        let Some(row) = properties::row(prop, Family::Settings) else {
+            return Ok(());
+        };
+        let value = self.convert(row, value, value_span)?;
+        let mut settings = self.scene.settings.clone();
+        // What each setting means: the field it sets (its kind and range are its row's).
         match prop {
-            Prop::Width => {
-                settings.width = self.whole_in_range(
-                    value,
-                    value_span,
-                    prop,
-                    1.0,
-                    limits::MAX_IMAGE_SIDE.into(),
-                )?
-            }
-            Prop::Height => {
-                settings.height = self.whole_in_range(
-                    value,
-                    value_span,
-                    prop,
-                    1.0,
-                    limits::MAX_IMAGE_SIDE.into(),
-                )?
-            }
-            Prop::MaxDepth => {
-                settings.max_depth =
-                    self.whole_in_range(value, value_span, prop, 0.0, limits::MAX_DEPTH.into())?
-            }
-            Prop::Samples => {
-                settings.samples_per_pixel = self.whole_in_range(
-                    value,
-                    value_span,
-                    prop,
-                    1.0,
-                    limits::MAX_SAMPLES_PER_PIXEL.into(),
-                )?
-            }
-            Prop::MinWeight => {
-                settings.min_weight = self.in_range(value, value_span, prop, 0.0, false, 1.0)?
-            }
-            Prop::Epsilon => {
-                settings.epsilon =
-                    Some(self.in_range(value, value_span, prop, limits::MIN_SIZE, false, 1.0)?)
-            }
-            Prop::Background => settings.background = self.light_color(value, value_span, prop)?,
-            Prop::Ambient => settings.ambient = self.light_color(value, value_span, prop)?,
+            Prop::Width => settings.width = value.number() as u32,
+            Prop::Height => settings.height = value.number() as u32,
+            Prop::MaxDepth => settings.max_depth = value.number() as u32,
+            Prop::Samples => settings.samples_per_pixel = value.number() as u32,
+            Prop::MinWeight => settings.min_weight = value.number(),
+            Prop::Epsilon => settings.epsilon = Some(value.number()),
+            Prop::Background => settings.background = value.color(),
+            Prop::Ambient => settings.ambient = value.color(),
             Prop::Shadows => {
                 settings.shadows = if word(property) == Some("filtered") {
                     ShadowMode::Filtered
@@ -945,19 +775,17 @@ impl<'a> Evaluator<'a> {
 
     fn camera_property(&mut self, prop: Prop, values: &Values, span: Span) -> Eval<()> {
         let (value, value_span) = one(values, span);
-        let converted = match prop {
-            Prop::Eye | Prop::LookAt => Ok(self.as_vector(value, value_span, prop)?),
-            Prop::Up => Ok(self.nonzero_vector(value, value_span, prop)?),
-            Prop::Fov => Err(self.in_range(value, value_span, prop, 0.0, true, 179.0)?),
-            _ => Err(self.in_range(value, value_span, prop, 0.0, true, f64::INFINITY)?),
+        let Some(row) = properties::row(prop, Family::Camera) else {
+            return Ok(());
         };
+        let value = self.convert(row, value, value_span)?;
         if let Some(Target::Camera(b)) = self.targets.last_mut() {
-            match (prop, converted) {
-                (Prop::Eye, Ok(v)) => b.eye = v,
-                (Prop::LookAt, Ok(v)) => b.look_at = v,
-                (Prop::Up, Ok(v)) => b.up = v,
-                (Prop::Fov, Err(x)) => b.fov = x,
-                (Prop::Height, Err(x)) => b.height = x,
+            match prop {
+                Prop::Eye => b.eye = value.vector(),
+                Prop::LookAt => b.look_at = value.vector(),
+                Prop::Up => b.up = value.vector(),
+                Prop::Fov => b.fov = value.number(),
+                Prop::Height => b.height = value.number(),
                 _ => {}
             }
         }
@@ -977,10 +805,14 @@ impl<'a> Evaluator<'a> {
             },
             _ => return Ok(()),
         };
+        let Some(row) = properties::row(prop, Family::Light) else {
+            return Ok(());
+        };
+        let converted = self.convert(row, value, value_span)?;
         match prop {
-            Prop::Position => light.position = self.as_vector(value, value_span, prop)?,
-            Prop::Direction => light.direction = self.nonzero_vector(value, value_span, prop)?,
-            Prop::Color => light.color = self.as_color(value, value_span, prop)?,
+            Prop::Position => light.position = converted.vector(),
+            Prop::Direction => light.direction = converted.vector(),
+            Prop::Color => light.color = converted.color(),
             Prop::Attenuation => {
                 let v = self.as_vector(value, value_span, prop)?;
                 if v.cmplt(DVec3::ZERO).any() || v == DVec3::ZERO {
@@ -999,12 +831,8 @@ impl<'a> Evaluator<'a> {
                     quadratic: v.z,
                 };
             }
-            Prop::Inner => {
-                light.inner = self.in_range(value, value_span, prop, 0.0, false, 179.0)?
-            }
-            Prop::Outer => {
-                light.outer = self.in_range(value, value_span, prop, 0.0, false, 179.0)?
-            }
+            Prop::Inner => light.inner = converted.number(),
+            Prop::Outer => light.outer = converted.number(),
             _ => {}
         }
         if let Some(Target::Light(b)) = self.targets.last_mut() {
@@ -1051,27 +879,13 @@ impl<'a> Evaluator<'a> {
                     color = self.as_color(other, value_span, prop)?;
                 }
             },
-            Prop::Ambient
-            | Prop::Specular
-            | Prop::Reflective
-            | Prop::Transmissive
-            | Prop::Absorption => color = self.as_color(value, value_span, prop)?,
-            Prop::Shininess => {
-                number = self.in_range(value, value_span, prop, 0.0, false, f64::INFINITY)?
+            _ => {
+                if let Some(row) = properties::row(prop, Family::Material) {
+                    let converted = self.convert(row, value, value_span)?;
+                    color = converted.color();
+                    number = converted.number();
+                }
             }
-            Prop::Ior => {
-                number = self.in_range(value, value_span, prop, 0.0, true, f64::INFINITY)?
-            }
-            Prop::Priority => {
-                number = f64::from(self.whole_in_range(
-                    value,
-                    value_span,
-                    prop,
-                    0.0,
-                    limits::MAX_PRIORITY.into(),
-                )?)
-            }
-            _ => {}
         }
         let Some(Target::Material(b)) = self.targets.last_mut() else {
             return Ok(());

@@ -1,0 +1,441 @@
+//! The one table of properties: for every property, each block that accepts it, the value it
+//! takes there (with its range), its default and a line of documentation.
+//!
+//! Resolution (unknown properties with suggestions, arity, words), evaluation (converting a
+//! value and checking its range: `eval/convert.rs`), the CLI's `--set NAME=VALUE` and the docs
+//! test all read these rows. **To add a property**, add its row here (a new name gets its
+//! variant from the same line), then give it meaning: the field it sets in the evaluator
+//! (`eval/objects.rs`, one match arm) and what the tracer does with that field. Nothing else
+//! needs to know about it.
+//!
+//! Rows are in the order the docs list each block's properties, so that "a sphere takes
+//! `center`, `radius`, ..." reads in that order.
+
+use whitted_ir::limits;
+
+use crate::schema::{CameraTag, Context, LightTag, ObjectTag};
+
+/// Where a row's property is accepted.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Block {
+    /// The shape parameters of these object kinds.
+    Shape(&'static [ObjectTag]),
+    /// Every object, and the block after a call statement.
+    AnyObject,
+    /// Every object, the block after a call statement and a pattern's block.
+    Transforms,
+    Settings,
+    Camera(&'static [CameraTag]),
+    Light(&'static [LightTag]),
+    Material,
+}
+
+impl Block {
+    fn accepts(self, cx: Context) -> bool {
+        match (self, cx) {
+            (Block::Shape(tags), Context::Object(tag)) => tags.contains(&tag),
+            (Block::AnyObject, Context::Object(_) | Context::Modifiers) => true,
+            (
+                Block::Transforms,
+                Context::Object(_) | Context::Modifiers | Context::PatternTransform,
+            ) => true,
+            (Block::Settings, Context::Settings) => true,
+            (Block::Camera(tags), Context::Camera(tag)) => tags.contains(&tag),
+            (Block::Light(tags), Context::Light(tag)) => tags.contains(&tag),
+            (Block::Material, Context::Material) => true,
+            _ => false,
+        }
+    }
+}
+
+/// The value a property takes in a block.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Kind {
+    /// A number from `min` to `max` (`min` itself excluded when `open`).
+    Number { min: f64, open: bool, max: f64 },
+    /// A whole number from `min` to `max`.
+    Whole { min: f64, max: f64 },
+    /// Any vector (a position).
+    Vector,
+    /// A vector that is not zero (a direction).
+    Direction,
+    /// A colour (a vector, or one number for a grey).
+    Color,
+    /// A colour of light: up to the largest intensity.
+    LightColor,
+    /// A colour, or a pattern with an optional block of transforms.
+    ColorOrPattern,
+    /// `<constant, linear, quadratic>`, each at least 0 and not all zero.
+    Attenuation,
+    /// One of these words.
+    Word(&'static [&'static str]),
+    /// No value: the name alone (`open`).
+    Flag,
+    /// A material.
+    MaterialValue,
+    /// Exactly this many vectors, separated by commas.
+    Points(usize),
+    /// Numbers and vectors adding up to this many numbers.
+    Numbers(usize),
+    /// A transform (`translate`, `rotate`, `scale`, `matrix`), each with its own forms.
+    Transform,
+    /// Shape parameters whose ranges the shape's builder and validation check together.
+    ShapeParameter,
+}
+
+/// How many values a property takes after its name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Arity {
+    /// No value at all (`open`).
+    Flag,
+    /// Exactly one expression.
+    One,
+    /// Exactly this many expressions, separated by commas (`vertices a, b, c`).
+    Exactly(usize),
+    /// Numbers and vectors, separated by commas, that add up to this many numbers
+    /// (`coefficients <1, 1, 1>, <0, 0, 0>, <0, 0, 0>, -1`).
+    Numbers(usize),
+}
+
+impl Kind {
+    pub fn arity(self) -> Arity {
+        match self {
+            Kind::Flag => Arity::Flag,
+            Kind::Points(n) => Arity::Exactly(n),
+            Kind::Numbers(n) => Arity::Numbers(n),
+            _ => Arity::One,
+        }
+    }
+}
+
+/// One property in one kind of block.
+#[derive(Clone, Copy, Debug)]
+pub struct Row {
+    pub prop: Prop,
+    pub block: Block,
+    pub kind: Kind,
+    /// The default as the docs write it ("" when there is none: the property is required or
+    /// has no default, like a transform).
+    pub default: &'static str,
+    pub doc: &'static str,
+}
+
+/// The table: the `Prop` enum, its names and the rows, all from one list.
+macro_rules! properties {
+    ($( $prop:ident $name:literal {
+        $( $block:expr => $kind:expr, $default:literal, $doc:literal; )+
+    } )+) => {
+        /// Every property name the language knows. Which blocks accept each, and what it
+        /// takes there, is in [`ROWS`]; `height` and `ambient` mean different things in
+        /// different blocks.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum Prop {
+            $( $prop, )+
+        }
+
+        impl Prop {
+            pub const ALL: &'static [Prop] = &[ $( Prop::$prop, )+ ];
+
+            pub fn name(self) -> &'static str {
+                match self {
+                    $( Prop::$prop => $name, )+
+                }
+            }
+        }
+
+        pub const ROWS: &[Row] = &[
+            $( $( Row {
+                prop: Prop::$prop,
+                block: $block,
+                kind: $kind,
+                default: $default,
+                doc: $doc,
+            }, )+ )+
+        ];
+    };
+}
+
+use Block::*;
+use Kind::*;
+
+const ANY: f64 = f64::INFINITY;
+const CAMERAS: &[CameraTag] = &[CameraTag::Perspective, CameraTag::Orthographic];
+const POSITIONED: &[LightTag] = &[LightTag::Point, LightTag::Spot];
+const AIMED: &[LightTag] = &[LightTag::Directional, LightTag::Spot];
+const ALL_LIGHTS: &[LightTag] = &[LightTag::Point, LightTag::Directional, LightTag::Spot];
+
+properties! {
+    Eye "eye" {
+        Camera(CAMERAS) => Vector, "<0, 0, 5>", "where the camera is";
+    }
+    LookAt "look_at" {
+        Camera(CAMERAS) => Vector, "<0, 0, 0>", "the point at the centre of the image";
+    }
+    Up "up" {
+        Camera(CAMERAS) => Direction, "<0, 1, 0>", "which way is up in the image";
+    }
+    Fov "fov" {
+        Camera(&[CameraTag::Perspective]) => Number { min: 0.0, open: true, max: 179.0 }, "45", "vertical field of view in degrees";
+    }
+    Width "width" {
+        Settings => Whole { min: 1.0, max: limits::MAX_IMAGE_SIDE as f64 }, "640", "image width in pixels";
+    }
+    Height "height" {
+        Camera(&[CameraTag::Orthographic]) => Number { min: 0.0, open: true, max: ANY }, "4", "height of the view in scene units";
+        Settings => Whole { min: 1.0, max: limits::MAX_IMAGE_SIDE as f64 }, "480", "image height in pixels";
+    }
+    MaxDepth "max_depth" {
+        Settings => Whole { min: 0.0, max: limits::MAX_DEPTH as f64 }, "5", "rays deeper than this are not traced (the camera ray is depth 0)";
+    }
+    MinWeight "min_weight" {
+        Settings => Number { min: 0.0, open: false, max: 1.0 }, "0.001", "a reflected or refracted ray contributing less is not traced";
+    }
+    Samples "samples" {
+        Settings => Whole { min: 1.0, max: limits::MAX_SAMPLES_PER_PIXEL as f64 }, "1", "samples per pixel";
+    }
+    Background "background" {
+        Settings => LightColor, "black", "the colour of rays that hit nothing";
+    }
+    Ambient "ambient" {
+        Settings => LightColor, "white", "the global ambient light";
+        Material => Color, "0.1", "ka: how much of the global ambient light it reflects";
+    }
+    Epsilon "epsilon" {
+        Settings => Number { min: limits::MIN_SIZE, open: false, max: 1.0 }, "automatic", "how far off a surface secondary rays start";
+    }
+    Shadows "shadows" {
+        Settings => Word(&["opaque", "filtered"]), "opaque", "whether transparent objects let light through to what they shadow";
+    }
+    Position "position" {
+        Light(POSITIONED) => Vector, "", "where the light is";
+    }
+    Direction "direction" {
+        Light(AIMED) => Direction, "", "the direction the light travels";
+    }
+    Inner "inner" {
+        Light(&[LightTag::Spot]) => Number { min: 0.0, open: false, max: 179.0 }, "20", "full light inside this cone angle, in degrees";
+    }
+    Outer "outer" {
+        Light(&[LightTag::Spot]) => Number { min: 0.0, open: false, max: 179.0 }, "30", "no light outside this cone angle, in degrees";
+    }
+    Color "color" {
+        Light(ALL_LIGHTS) => Color, "white", "the light's colour and intensity";
+    }
+    Attenuation "attenuation" {
+        Light(POSITIONED) => Attenuation, "<1, 0, 0>", "fall-off with distance: <constant, linear, quadratic>";
+    }
+    Diffuse "diffuse" {
+        Material => ColorOrPattern, "0.8", "kd: a colour, or a pattern";
+    }
+    Specular "specular" {
+        Material => Color, "0", "ks: the Phong highlight's colour";
+    }
+    Shininess "shininess" {
+        Material => Number { min: 0.0, open: false, max: ANY }, "32", "the Phong exponent";
+    }
+    Reflective "reflective" {
+        Material => Color, "0", "kr: mirror reflection";
+    }
+    Transmissive "transmissive" {
+        Material => Color, "0", "kt: refraction";
+    }
+    Ior "ior" {
+        Material => Number { min: 0.0, open: true, max: ANY }, "1", "index of refraction";
+    }
+    Fresnel "fresnel" {
+        Material => Word(&["off", "schlick", "exact"]), "off", "how kr and kt vary with the angle";
+    }
+    Absorption "absorption" {
+        Material => Color, "0", "Beer-Lambert absorption per unit of distance inside";
+    }
+    Priority "priority" {
+        Material => Whole { min: 0.0, max: limits::MAX_PRIORITY as f64 }, "0", "nested media: which solid fills an overlap";
+    }
+    Center "center" {
+        Shape(&[ObjectTag::Sphere, ObjectTag::Disk]) => ShapeParameter, "<0, 0, 0>", "the centre";
+    }
+    Base "base" {
+        Shape(&[ObjectTag::Cylinder, ObjectTag::Cone]) => ShapeParameter, "<0, 0, 0>", "the centre of the bottom end";
+    }
+    BaseRadius "base_radius" {
+        Shape(&[ObjectTag::Cone]) => ShapeParameter, "1", "the radius at the base";
+    }
+    Apex "apex" {
+        Shape(&[ObjectTag::Cylinder, ObjectTag::Cone]) => ShapeParameter, "<0, 1, 0>", "the centre of the top end";
+    }
+    ApexRadius "apex_radius" {
+        Shape(&[ObjectTag::Cone]) => ShapeParameter, "0", "the radius at the apex";
+    }
+    Normal "normal" {
+        Shape(&[ObjectTag::Plane, ObjectTag::Disk]) => ShapeParameter, "<0, 1, 0>", "the direction the surface faces";
+    }
+    Offset "offset" {
+        Shape(&[ObjectTag::Plane]) => ShapeParameter, "0", "the plane's distance from the origin along its normal";
+    }
+    Radius "radius" {
+        Shape(&[ObjectTag::Sphere, ObjectTag::Cylinder, ObjectTag::Disk]) => ShapeParameter, "1", "the radius";
+    }
+    Open "open" {
+        Shape(&[ObjectTag::Cylinder, ObjectTag::Cone]) => Flag, "", "without end caps (a tube, not a solid)";
+    }
+    Min "min" {
+        Shape(&[ObjectTag::Box]) => ShapeParameter, "<-1, -1, -1>", "the smallest corner";
+    }
+    Max "max" {
+        Shape(&[ObjectTag::Box]) => ShapeParameter, "<1, 1, 1>", "the largest corner";
+    }
+    Vertices "vertices" {
+        Shape(&[ObjectTag::Triangle]) => Points(3), "", "the three corners";
+    }
+    Coefficients "coefficients" {
+        Shape(&[ObjectTag::Quadric]) => Numbers(10), "", "A, B, C, D, E, F, G, H, I, J of the quadric's equation";
+    }
+    Radii "radii" {
+        Shape(&[
+            ObjectTag::Ellipsoid,
+            ObjectTag::Paraboloid,
+            ObjectTag::Hyperboloid,
+            ObjectTag::Hyperboloid2,
+        ]) => ShapeParameter, "<1, 1, 1>", "the semi-axes";
+    }
+    Translate "translate" {
+        Transforms => Transform, "", "move";
+    }
+    Rotate "rotate" {
+        Transforms => Transform, "", "turn, in degrees";
+    }
+    Scale "scale" {
+        Transforms => Transform, "", "scale uniformly or per axis";
+    }
+    Matrix "matrix" {
+        Transforms => Numbers(16), "", "any invertible 4x4 matrix, row by row";
+    }
+    Material "material" {
+        AnyObject => MaterialValue, "", "the object's material";
+    }
+}
+
+impl Prop {
+    /// Every row of this property (one per kind of block that accepts it).
+    pub fn rows(self) -> impl Iterator<Item = &'static Row> {
+        ROWS.iter().filter(move |row| row.prop == self)
+    }
+
+    /// How many values it takes: the same in every block that accepts it.
+    pub fn arity(self) -> Arity {
+        self.rows()
+            .next()
+            .map_or(Arity::One, |row| row.kind.arity())
+    }
+
+    /// The words it takes, when its value is one of a few words rather than an expression.
+    pub fn words(self) -> Option<&'static [&'static str]> {
+        self.rows().find_map(|row| match row.kind {
+            Kind::Word(words) => Some(words),
+            _ => None,
+        })
+    }
+
+    /// Transforms may be given any number of times; every other property once per block.
+    pub fn is_transform(self) -> bool {
+        self.rows().any(|row| row.block == Block::Transforms)
+    }
+}
+
+/// The families of blocks whose properties the evaluator converts by their rows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Family {
+    Settings,
+    Camera,
+    Light,
+    Material,
+}
+
+/// The row of `prop` in a family of blocks (a property has at most one row per family).
+pub fn row(prop: Prop, family: Family) -> Option<&'static Row> {
+    ROWS.iter().find(|row| {
+        row.prop == prop
+            && matches!(
+                (row.block, family),
+                (Block::Settings, Family::Settings)
+                    | (Block::Camera(_), Family::Camera)
+                    | (Block::Light(_), Family::Light)
+                    | (Block::Material, Family::Material)
+            )
+    })
+}
+
+/// The properties the block `cx` accepts, in the docs' order: an object's shape parameters
+/// first, then the transforms, then `material`.
+pub fn accepted(cx: Context) -> Vec<Prop> {
+    let mut list: Vec<Prop> = Vec::new();
+    for pass in [Pass::Own, Pass::Transforms, Pass::Material] {
+        for row in ROWS.iter().filter(|row| row.block.accepts(cx)) {
+            let in_pass = match row.block {
+                Block::Transforms => pass == Pass::Transforms,
+                Block::AnyObject => pass == Pass::Material,
+                _ => pass == Pass::Own,
+            };
+            if in_pass && !list.contains(&row.prop) {
+                list.push(row.prop);
+            }
+        }
+    }
+    list
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Pass {
+    Own,
+    Transforms,
+    Material,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_property_has_a_row_and_every_row_a_doc_line() {
+        for prop in Prop::ALL {
+            assert!(prop.rows().next().is_some(), "`{}` has no row", prop.name());
+        }
+        for row in ROWS {
+            assert!(!row.doc.is_empty(), "`{}` has no doc line", row.prop.name());
+        }
+    }
+
+    #[test]
+    fn a_property_takes_the_same_number_of_values_wherever_it_goes() {
+        for prop in Prop::ALL {
+            let arities: Vec<Arity> = prop.rows().map(|row| row.kind.arity()).collect();
+            assert!(
+                arities.windows(2).all(|w| w[0] == w[1]),
+                "`{}` has arities {arities:?}",
+                prop.name()
+            );
+        }
+    }
+
+    #[test]
+    fn no_block_accepts_a_property_twice() {
+        let mut contexts = vec![Context::Settings, Context::Material, Context::Modifiers];
+        contexts.extend(ObjectTag::ALL.map(Context::Object));
+        contexts.extend(LightTag::ALL.map(Context::Light));
+        contexts.extend(CameraTag::ALL.map(Context::Camera));
+        for cx in contexts {
+            for prop in Prop::ALL {
+                let rows = ROWS
+                    .iter()
+                    .filter(|row| row.prop == *prop && row.block.accepts(cx))
+                    .count();
+                assert!(
+                    rows <= 1,
+                    "{} has {rows} rows for `{}`",
+                    cx.describe(),
+                    prop.name()
+                );
+            }
+        }
+    }
+}
