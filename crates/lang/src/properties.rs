@@ -405,6 +405,24 @@ mod tests {
         }
     }
 
+    /// The reference must document every property (the docs test compiles its examples; this
+    /// checks none is missing).
+    #[test]
+    fn docs_language_md_names_every_property() {
+        let docs = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/language.md"),
+        )
+        .unwrap_or_default();
+        assert!(docs.len() > 10_000, "docs/language.md not found");
+        for prop in Prop::ALL {
+            assert!(
+                docs.contains(&format!("`{}", prop.name())),
+                "docs/language.md never mentions `{}`",
+                prop.name()
+            );
+        }
+    }
+
     #[test]
     fn a_property_takes_the_same_number_of_values_wherever_it_goes() {
         for prop in Prop::ALL {
