@@ -16,7 +16,8 @@
 //! failure. The child colours are the re-shader's own, bottom-up: no recorded colour is used.
 
 use whitted_ir::{
-    DMat4, DVec3, Fresnel, Handle, LightKind, Material, ObjectKind, PatternKind, Scene, ShadowMode,
+    DMat4, DVec3, Fresnel, Handle, Highlight, LightKind, Material, ObjectKind, PatternKind, Scene,
+    ShadowMode,
 };
 use whitted_tracer::ray_tree::{trace_pixel, RayNode, SampleChoice, ShadowOutcome};
 use whitted_tracer::{render, NoObserver, RayKind, RenderOptions, Termination};
@@ -322,9 +323,15 @@ impl Reshader<'_> {
             };
             let light_in = c(&light.color) * fatt * spot * passed;
             let diffuse = light_in * kd * n_dot_l.max(0.0);
-            let r = -l + 2.0 * n_dot_l * n; // L mirrored about N
-            let r_dot_v = r.dot(-d).max(0.0);
-            let specular = light_in * ks * r_dot_v.powf(m.shininess);
+            let cosine = match self.scene.settings.highlight {
+                Highlight::Phong => {
+                    let r = -l + 2.0 * n_dot_l * n; // L mirrored about N
+                    r.dot(-d)
+                }
+                // H halfway between the light and the viewer.
+                Highlight::Blinn => n.dot((l - d).normalize_or_zero()),
+            };
+            let specular = light_in * ks * cosine.max(0.0).powf(m.shininess);
             local += diffuse + specular;
         }
 

@@ -18,8 +18,9 @@ pub use diagnostic::{Diagnostic, Label, Severity};
 pub use json::{document as json_document, to_json, IrDocument};
 pub use print::print;
 pub use scene::{
-    Attenuation, Camera, Color, CsgOp, Fresnel, Light, LightKind, Material, Object, ObjectKind,
-    Pattern, PatternKind, Projection, Quadric, QuadricForm, Scene, Settings, ShadowMode, Shape,
+    Attenuation, Camera, Color, CsgOp, Fresnel, Highlight, Light, LightKind, Material, Object,
+    ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, Scene, Settings,
+    ShadowMode, Shape,
 };
 pub use source::{FileId, LineCol, SourceFile, SourceMap, Span};
 pub use validate::{validate, InvalidScene, ValidScene};

@@ -21,11 +21,16 @@ pub fn print(scene: &Scene) -> String {
     );
     let _ = writeln!(
         out,
-        "  background {}, ambient {}, epsilon {}, shadows {:?}",
+        "  background {}, ambient {}, epsilon {}, shadows {:?}{}",
         color(&s.background),
         color(&s.ambient),
         s.epsilon.map_or("auto".to_string(), |e| e.to_string()),
-        s.shadows
+        s.shadows,
+        // Shown when it is not the classic Phong, so that older dumps read the same.
+        match s.highlight {
+            crate::scene::Highlight::Phong => "",
+            crate::scene::Highlight::Blinn => ", highlight Blinn",
+        }
     );
     let c = &scene.camera;
     let projection = match c.projection {

@@ -49,6 +49,16 @@ pub enum ShadowMode {
     Filtered,
 }
 
+/// The specular highlight's model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Highlight {
+    /// Phong: `ks·(R·V)^n`, with R the light direction mirrored about the normal.
+    Phong,
+    /// Blinn-Phong: `ks·(N·H)^n`, with H halfway between the light and the viewer.
+    Blinn,
+}
+
 /// Render settings. Defaults live here so that the language, the CLI and tests agree.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Settings {
@@ -67,6 +77,7 @@ pub struct Settings {
     /// when not, the tracer uses the floating-point error bound of each hit point.
     pub epsilon: Option<f64>,
     pub shadows: ShadowMode,
+    pub highlight: Highlight,
 }
 
 impl Default for Settings {
@@ -81,6 +92,7 @@ impl Default for Settings {
             ambient: Color::WHITE,
             epsilon: None,
             shadows: ShadowMode::Opaque,
+            highlight: Highlight::Phong,
         }
     }
 }

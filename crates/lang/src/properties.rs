@@ -206,6 +206,9 @@ properties! {
     Shadows "shadows" {
         Settings => Word(&["opaque", "filtered"]), "opaque", "whether transparent objects let light through to what they shadow";
     }
+    Highlight "highlight" {
+        Settings => Word(&["phong", "blinn"]), "phong", "the specular model: Phong ks·(R·V)^n or Blinn-Phong ks·(N·H)^n";
+    }
     Position "position" {
         Light(POSITIONED) => Vector, "", "where the light is";
     }

@@ -13,7 +13,7 @@
 //! ray stays in its parent's media; Beer-Lambert absorption follows the current medium.
 
 use glam::Vec3A;
-use whitted_ir::{Fresnel, Handle, Material, ShadowMode};
+use whitted_ir::{Fresnel, Handle, Highlight, Material, ShadowMode};
 
 use crate::material::PreparedMaterial;
 use crate::media::{same_medium, Medium, MediumStack};
@@ -603,7 +603,8 @@ impl<'a> Tracer<'a> {
     }
 
     /// `ka·Ia·kd` plus, for every light on the visible side, `fatt·spot·Ii·(kd·(N·L) +
-    /// ks·(R·V)^n)` times what the shadow ray lets through. `outside` is the hit point
+    /// ks·(R·V)^n)` (or `ks·(N·H)^n` with `highlight blinn`) times what the shadow ray lets
+    /// through. `outside` is the hit point
     /// already moved off the surface along `n`, which faces the viewer. The order of the
     /// additions is part of the recorder contract (see `recorder.rs`): keep it.
     fn local_illumination<R: Recorder>(
@@ -653,8 +654,11 @@ impl<'a> Tracer<'a> {
                 let light_in = light.intensity * strength * passed;
                 sample.diffuse = light_in * m.diffuse * n_dot_l;
                 if m.specular != Vec3A::ZERO {
-                    let mirrored = reflect(-incidence.to_light, n);
-                    sample.specular = light_in * m.specular * m.phong(mirrored.dot(view));
+                    let cosine = match scene.settings.highlight {
+                        Highlight::Phong => reflect(-incidence.to_light, n).dot(view),
+                        Highlight::Blinn => n.dot((incidence.to_light + view).normalize_or_zero()),
+                    };
+                    sample.specular = light_in * m.specular * m.phong(cosine);
                 }
                 color += sample.diffuse + sample.specular;
             }

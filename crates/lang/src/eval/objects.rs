@@ -6,8 +6,8 @@
 //! which reports them at the object's header.
 
 use whitted_ir::{
-    Attenuation, Color, DMat4, DVec3, Diagnostic, Light, LightKind, Object, ObjectKind, Quadric,
-    QuadricForm, ShadowMode, Shape, Span,
+    Attenuation, Color, DMat4, DVec3, Diagnostic, Highlight, Light, LightKind, Object, ObjectKind,
+    Quadric, QuadricForm, ShadowMode, Shape, Span,
 };
 
 use super::builders::*;
@@ -749,6 +749,13 @@ impl<'a> Evaluator<'a> {
                     ShadowMode::Filtered
                 } else {
                     ShadowMode::Opaque
+                }
+            }
+            Prop::Highlight => {
+                settings.highlight = if word(property) == Some("blinn") {
+                    Highlight::Blinn
+                } else {
+                    Highlight::Phong
                 }
             }
             _ => {}

@@ -4,7 +4,9 @@
 //! stopping criteria.
 
 use glam::{DMat4, DVec3, Vec3A};
-use whitted_ir::{Attenuation, Color, Fresnel, Light, LightKind, Material, ShadowMode, Shape};
+use whitted_ir::{
+    Attenuation, Color, Fresnel, Highlight, Light, LightKind, Material, ShadowMode, Shape,
+};
 
 use super::{prepare, trace_tree, Node};
 use crate::optics;
@@ -472,6 +474,44 @@ fn phong_highlight_matches_the_formula() {
     // The colour is ambient plus the light's terms.
     let total = root.ambient + sample.diffuse + sample.specular;
     assert!(root.color.abs_diff_eq(total, 1e-6));
+}
+
+#[test]
+fn blinn_highlight_matches_the_formula_and_is_broader_than_phong() {
+    let specular_of = |highlight: Highlight| {
+        let mut b = SceneBuilder::new();
+        b.settings().highlight = highlight;
+        b.point_light(DVec3::new(2.0, 3.0, 6.0), 1.0);
+        let shiny = b.material(Material {
+            specular: Color::gray(0.7),
+            shininess: 25.0,
+            ..matte(0.3, 0.3, 0.3)
+        });
+        b.add(sphere(0.0, 0.0, 0.0, 1.0), DMat4::IDENTITY, shiny);
+        shoot(b, DVec3::new(0.0, 0.0, 5.0), DVec3::new(0.2, 0.3, 0.0), 0)
+    };
+    let root = specular_of(Highlight::Blinn);
+    let hit = root.hit.unwrap_or_else(|| panic!("no hit"));
+    let sample = root.lights[0];
+    // By hand, in f64: H halfway between the light and the viewer.
+    let l = sample.to_light.as_dvec3();
+    let n = hit.shading_normal.as_dvec3();
+    let v = -root.start.direction.as_dvec3();
+    let h = (l + v).normalize();
+    let expected = 0.7 * n.dot(h).max(0.0).powf(25.0);
+    assert!(
+        (f64::from(sample.specular.x) - expected).abs() < 1e-5,
+        "{} vs {expected}",
+        sample.specular.x
+    );
+    // The half-angle is half the angle between R and V, so for the same exponent the
+    // Blinn-Phong highlight is brighter away from its centre.
+    let phong = specular_of(Highlight::Phong).lights[0].specular.x;
+    assert!(
+        sample.specular.x > phong && phong > 0.0,
+        "blinn {} vs phong {phong}",
+        sample.specular.x
+    );
 }
 
 #[test]
