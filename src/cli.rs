@@ -38,6 +38,11 @@ pub struct SceneArgs {
     /// Override a top-level `const`: -D N=316 (VALUE is an expression).
     #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
     pub define: Vec<(String, String)>,
+    /// Replace a setting of the scene: --set max_depth=8, --set highlight=blinn,
+    /// --set background=rgb(0,0,0.2) (any setting of docs/language.md; checked like the
+    /// scene's own).
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_setting)]
+    pub set: Vec<(String, String)>,
 }
 
 #[derive(Args)]
@@ -150,6 +155,20 @@ fn parse_define(text: &str) -> Result<(String, String), String> {
         return Err(format!("-D {name}= needs a value after `=`"));
     }
     Ok((name.to_string(), value.to_string()))
+}
+
+/// `NAME=VALUE` of a `--set`; the name and value are checked by the compiler, which knows
+/// the settings and points into the text in its diagnostics.
+fn parse_setting(text: &str) -> Result<(String, String), String> {
+    let Some((name, value)) = text.split_once('=') else {
+        return Err(format!(
+            "`{text}` is not NAME=VALUE (for example --set max_depth=8)"
+        ));
+    };
+    if value.trim().is_empty() {
+        return Err(format!("--set {name}= needs a value after `=`"));
+    }
+    Ok((name.trim().to_string(), value.to_string()))
 }
 
 /// The image formats `render` can write, chosen by the output's extension.

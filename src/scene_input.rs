@@ -110,6 +110,7 @@ pub fn load_scene(args: &SceneArgs, quiet: bool) -> Result<Loaded, Failure> {
     }
     let options = CompileOptions {
         defines: args.define.clone(),
+        settings: args.set.clone(),
         ..CompileOptions::default()
     };
     let compilation = compile_file(&args.scene, &mut FileLoader, &options);

@@ -227,6 +227,48 @@ fn ir_prints_text_and_versioned_json() {
 }
 
 #[test]
+fn set_replaces_a_setting_for_every_command_and_reports_mistakes_in_its_text() {
+    let output = run(&[
+        "ir",
+        "scenes/whitted.scene",
+        "--set",
+        "highlight=blinn",
+        "--set",
+        "max_depth=9",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = stdout(&output);
+    assert!(
+        text.contains("highlight Blinn") && text.contains("max depth 9"),
+        "{text}"
+    );
+
+    let output = run(&["check", "scenes/whitted.scene", "--set", "max_dept=9"]);
+    assert_eq!(output.status.code(), Some(1));
+    let message = stderr(&output);
+    assert!(
+        message.contains("there is no setting `max_dept`")
+            && message.contains("<--set max_dept=9>")
+            && message.contains("did you mean `max_depth`?"),
+        "{message}"
+    );
+
+    // The render uses the replaced setting: a tree traced with max_depth 0 has one ray.
+    let output = run(&[
+        "trace",
+        "scenes/whitted.scene",
+        "--pixel",
+        "320,240",
+        "--set",
+        "max_depth=0",
+        "--json",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(json["max_depth"], 0);
+}
+
+#[test]
 fn stats_report_ray_counts_as_text_and_json() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("s.png");

@@ -14,7 +14,9 @@ use whitted_ir::{Diagnostic, FileId, Severity, SourceFile, SourceMap, Span};
 use crate::ast::{FileAst, FileIndex, ItemKind, Program};
 use crate::intern::Interner;
 use crate::parser::{self, ParseContext};
+use crate::properties::{self, Family, Kind, Prop};
 use crate::resolve::{Define, Resolver};
+use crate::suggest::{closest, list_and, list_or};
 use crate::{Compilation, CompileOptions, Limits, SourceLoader, WorkCounts};
 
 /// Stacks to try for the compile thread, largest first. Only the pages actually touched are
@@ -459,6 +461,7 @@ fn compile_root(
     let identity = loading.loader.identify(path);
     loading.add_file(path.to_path_buf(), identity, display, bytes);
     let defines = parse_defines(&mut loading, &options.defines);
+    let overrides = parse_setting_overrides(&mut loading, &options.settings);
 
     let Loading {
         sources,
@@ -472,7 +475,7 @@ fn compile_root(
         parse_steps,
         name_probes: 0,
     };
-    let Some(mut defines) = defines else {
+    let (Some(mut defines), Some(mut overrides)) = (defines, overrides) else {
         return finish(sources, None, diagnostics, work);
     };
     if has_error(&diagnostics) {
@@ -484,6 +487,11 @@ fn compile_root(
         let mut resolver = Resolver::new(&interner, program.files.len(), &[]);
         for value in values.iter_mut() {
             resolver.resolve_define_value(value, &mut program);
+        }
+        for setting in &mut overrides {
+            if let OverrideValue::Expr(value) = &mut setting.value {
+                resolver.resolve_define_value(value, &mut program);
+            }
         }
         let define_errors = std::mem::take(&mut resolver.diagnostics);
         diagnostics.extend(define_errors);
@@ -501,6 +509,7 @@ fn compile_root(
         limits,
         &resolution,
         &defines,
+        &overrides,
         sources.clone(),
         max_evaluation_depth,
     );
@@ -585,6 +594,115 @@ fn parse_defines(loading: &mut Loading<'_>, defines: &[(String, String)]) -> Opt
                 ok = false;
             }
         }
+    }
+    ok.then_some(parsed)
+}
+
+/// A `--set NAME=VALUE`: a setting that replaces the scene's, after the scene has run.
+pub(crate) struct SettingOverride {
+    pub prop: Prop,
+    pub value: OverrideValue,
+    /// The VALUE part in the override's pseudo-file.
+    pub value_span: Span,
+}
+
+pub(crate) enum OverrideValue {
+    /// For settings that take a word (`--set shadows=filtered`).
+    Word(&'static str),
+    /// An expression with only the built-ins in scope (`--set background=rgb(0, 0, 0.2)`).
+    Expr(crate::ast::Expr),
+}
+
+/// Reads each `--set NAME=VALUE` in a pseudo-file of its own, against the settings rows of
+/// the property table. `None` if any is malformed (each problem is reported).
+fn parse_setting_overrides(
+    loading: &mut Loading<'_>,
+    settings: &[(String, String)],
+) -> Option<Vec<SettingOverride>> {
+    let mut parsed = Vec::new();
+    let mut ok = true;
+    let mut seen: HashMap<&str, Span> = HashMap::new();
+    let setting_names: Vec<&str> = Prop::ALL
+        .iter()
+        .filter(|p| properties::row(**p, Family::Settings).is_some())
+        .map(|p| p.name())
+        .collect();
+    for (name, value) in settings {
+        let text = format!("{name}={value}");
+        let file: FileId = loading
+            .sources
+            .add(SourceFile::new(format!("<--set {text}>"), text.clone()));
+        let name_span = Span::new(file, 0, name.len());
+        let value_span = Span::new(file, name.len() + 1, text.len());
+        let row = Prop::ALL
+            .iter()
+            .find(|p| p.name() == name)
+            .and_then(|p| properties::row(*p, Family::Settings));
+        let Some(row) = row else {
+            let mut diagnostic =
+                Diagnostic::error(format!("there is no setting `{name}`"), name_span)
+                    .with_label("not a setting");
+            diagnostic = match closest(name, setting_names.iter().copied()) {
+                Some(best) => diagnostic.with_hint(format!("did you mean `{best}`?")),
+                None => {
+                    diagnostic.with_hint(format!("the settings are {}", list_and(&setting_names)))
+                }
+            };
+            loading.diagnostics.push(diagnostic);
+            ok = false;
+            continue;
+        };
+        if let Some(&first) = seen.get(name.as_str()) {
+            loading.diagnostics.push(
+                Diagnostic::error(format!("`--set {name}` is given twice"), name_span)
+                    .with_label("given again here")
+                    .with_secondary(first, "first given here"),
+            );
+            ok = false;
+            continue;
+        }
+        seen.insert(name, name_span);
+        let value = match row.kind {
+            Kind::Word(words) => match words.iter().find(|w| **w == value.trim()) {
+                Some(word) => OverrideValue::Word(word),
+                None => {
+                    loading.diagnostics.push(
+                        Diagnostic::error(
+                            format!("`{name}` is {}, not `{value}`", list_or(words)),
+                            value_span,
+                        )
+                        .with_label("not one of its words"),
+                    );
+                    ok = false;
+                    continue;
+                }
+            },
+            _ => {
+                let mut cx = ParseContext::new(
+                    file,
+                    &mut loading.interner,
+                    &mut loading.program.functions,
+                    loading.max_tree_depth,
+                );
+                let result =
+                    parser::parse_define_value(&text, name.len() + 1, &mut cx, loading.max_nesting);
+                let build_errors = std::mem::take(&mut cx.errors);
+                loading.diagnostics.extend(build_errors);
+                match result {
+                    Ok(expr) => OverrideValue::Expr(expr),
+                    Err(diagnostic) => {
+                        loading.diagnostics.push(diagnostic);
+                        ok = false;
+                        continue;
+                    }
+                }
+            }
+        };
+        parsed.push(SettingOverride {
+            prop: row.prop,
+            value,
+            value_span,
+        });
     }
     ok.then_some(parsed)
 }

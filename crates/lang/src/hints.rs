@@ -137,13 +137,19 @@ pub(crate) fn foreign(word: &str) -> Option<&'static str> {
         .map(|(_, hint)| *hint)
 }
 
-/// The advice for an unknown name: `x`, `y` and `z` are not predefined axis vectors here.
+/// The advice for an unknown name (a value): `x`, `y` and `z` are not predefined axis
+/// vectors here, and POV-Ray's colour words are not values. Other foreign words are
+/// properties or blocks, whose advice would mislead where a value was expected.
 pub(crate) fn unknown_name(word: &str) -> Option<String> {
+    const VALUE_WORDS: [&str; 7] = [
+        "color", "colour", "rgb", "rgbf", "rgbt", "filter", "transmit",
+    ];
     let axis = match word {
         "x" => "<1, 0, 0>",
         "y" => "<0, 1, 0>",
         "z" => "<0, 0, 1>",
-        _ => return foreign(word).map(str::to_string),
+        _ if VALUE_WORDS.contains(&word) => return foreign(word).map(str::to_string),
+        _ => return None,
     };
     Some(format!(
         "whitted has no predefined axis vectors: write `{axis}` for {word} (`let {word} = {axis};` defines one)"

@@ -95,6 +95,9 @@ impl Default for Limits {
 pub struct CompileOptions {
     /// `-D NAME=VALUE` from the command line, in order: (NAME, VALUE source text).
     pub defines: Vec<(String, String)>,
+    /// `--set NAME=VALUE` from the command line: settings that replace the scene's, by the
+    /// rows of the property table (NAME, VALUE source text).
+    pub settings: Vec<(String, String)>,
     pub limits: Limits,
 }
 

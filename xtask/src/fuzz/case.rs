@@ -90,8 +90,8 @@ impl RenderObserver for Cancel<'_> {
 /// Runs one case. Panics are not caught here: the runner catches them.
 pub fn run(text: &str, cancel: &Cancel<'_>) -> Result<Passed, Failure> {
     let options = CompileOptions {
-        defines: Vec::new(),
         limits: limits(),
+        ..CompileOptions::default()
     };
     let compilation = compile_source("fuzz.scene", text, &mut Files, &options);
     let errors = compilation

@@ -79,6 +79,8 @@ pub(crate) struct Evaluator<'a> {
     limits: &'a Limits,
     resolution: &'a Resolution,
     defines: &'a [Define],
+    /// `--set NAME=VALUE`: applied after the scene has run, so they win.
+    overrides: &'a [crate::compile::SettingOverride],
 
     globals: Vec<Value>,
     /// Call frames, each `frame_size` values; `base` is where the current frame starts.
@@ -125,6 +127,7 @@ impl<'a> Evaluator<'a> {
         limits: &'a Limits,
         resolution: &'a Resolution,
         defines: &'a [Define],
+        overrides: &'a [crate::compile::SettingOverride],
         sources: whitted_ir::SourceMap,
         max_depth: usize,
     ) -> Self {
@@ -138,6 +141,7 @@ impl<'a> Evaluator<'a> {
             limits,
             resolution,
             defines,
+            overrides,
             globals: vec![Value::Poisoned; resolution.global_count as usize],
             stack: Vec::with_capacity(256),
             base: 0,
@@ -168,7 +172,7 @@ impl<'a> Evaluator<'a> {
     /// Runs the root file (and its imports), then gives every object without a material the
     /// default one. Returns the scene; errors are in `diagnostics`.
     pub(crate) fn run(mut self) -> (Scene, Vec<Diagnostic>, bool) {
-        let outcome = self.run_file(0);
+        let outcome = self.run_file(0).and_then(|()| self.apply_overrides());
         let failed = outcome.is_err() || self.unique_errors > 0;
         if let Some(Sink::Collect(roots)) = self.sinks.pop() {
             self.scene.roots = roots;
@@ -180,6 +184,19 @@ impl<'a> Evaluator<'a> {
             self.scene.camera_span = span;
         }
         (self.scene, self.diagnostics, failed)
+    }
+
+    /// Applies the command line's `--set NAME=VALUE`s to the settings the scene made.
+    fn apply_overrides(&mut self) -> Eval<()> {
+        let overrides = self.overrides;
+        for setting in overrides {
+            let (value, word) = match &setting.value {
+                crate::compile::OverrideValue::Word(word) => (Value::Poisoned, Some(*word)),
+                crate::compile::OverrideValue::Expr(expr) => (self.eval(expr)?, None),
+            };
+            self.apply_setting(setting.prop, value, setting.value_span, word)?;
+        }
+        Ok(())
     }
 
     fn name(&self, sym: crate::intern::Sym) -> &'a str {

@@ -729,6 +729,18 @@ impl<'a> Evaluator<'a> {
     ) -> Eval<()> {
         let span = property.name.span;
         let (value, value_span) = one(values, span);
+        self.apply_setting(prop, value, value_span, word(property))
+    }
+
+    /// Sets one setting from its value (or its word, for settings that take one): from a
+    /// `settings` block, or from the command line's `--set NAME=VALUE`.
+    pub(super) fn apply_setting(
+        &mut self,
+        prop: Prop,
+        value: Value,
+        value_span: Span,
+        word: Option<&str>,
+    ) -> Eval<()> {
         let Some(row) = properties::row(prop, Family::Settings) else {
             return Ok(());
         };
@@ -745,14 +757,14 @@ impl<'a> Evaluator<'a> {
             Prop::Background => settings.background = value.color(),
             Prop::Ambient => settings.ambient = value.color(),
             Prop::Shadows => {
-                settings.shadows = if word(property) == Some("filtered") {
+                settings.shadows = if word == Some("filtered") {
                     ShadowMode::Filtered
                 } else {
                     ShadowMode::Opaque
                 }
             }
             Prop::Highlight => {
-                settings.highlight = if word(property) == Some("blinn") {
+                settings.highlight = if word == Some("blinn") {
                     Highlight::Blinn
                 } else {
                     Highlight::Phong

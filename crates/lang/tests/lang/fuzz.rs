@@ -153,6 +153,7 @@ const TOKENS: &[&str] = &[
 fn options() -> CompileOptions {
     CompileOptions {
         defines: Vec::new(),
+        settings: Vec::new(),
         limits: Limits {
             max_objects: 5_000,
             max_evaluation_steps: 20_000,

@@ -9,6 +9,7 @@ mod errors;
 mod exporter_scale;
 mod fuzz;
 mod limits;
+mod overrides;
 mod scenes;
 mod second_step;
 mod support;
