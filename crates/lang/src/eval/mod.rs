@@ -172,6 +172,19 @@ impl<'a> Evaluator<'a> {
     /// Runs the root file (and its imports), then gives every object without a material the
     /// default one. Returns the scene; errors are in `diagnostics`.
     pub(crate) fn run(mut self) -> (Scene, Vec<Diagnostic>, bool) {
+        // A scene written by a program is mostly top-level objects: room for them at once,
+        // rather than arenas that grow by copying a million objects several times.
+        let literal_objects = self
+            .program
+            .files
+            .iter()
+            .flat_map(|file| &file.items)
+            .filter(|item| matches!(item.kind, ItemKind::Object { .. }))
+            .count()
+            .min(self.limits.max_objects);
+        if literal_objects > self.scene.objects.len() {
+            self.scene.objects = whitted_ir::Arena::with_capacity(literal_objects);
+        }
         let outcome = self.run_file(0).and_then(|()| self.apply_overrides());
         let failed = outcome.is_err() || self.unique_errors > 0;
         if let Some(Sink::Collect(roots)) = self.sinks.pop() {
