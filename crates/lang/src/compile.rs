@@ -508,8 +508,10 @@ fn compile_root(
         &interner,
         limits,
         &resolution,
-        &defines,
-        &overrides,
+        crate::eval::CommandLine {
+            defines: &defines,
+            overrides: &overrides,
+        },
         sources.clone(),
         max_evaluation_depth,
     );

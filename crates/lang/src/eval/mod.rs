@@ -16,6 +16,7 @@ mod expr;
 mod loops;
 mod materials;
 mod objects;
+mod properties;
 mod strings;
 
 use std::collections::HashSet;
@@ -120,17 +121,23 @@ pub(crate) struct Evaluator<'a> {
     settings_set: Vec<(crate::schema::Prop, Span)>,
 }
 
+/// What the command line adds to a scene: `-D` constants and `--set` settings.
+pub(crate) struct CommandLine<'a> {
+    pub defines: &'a [Define],
+    pub overrides: &'a [crate::compile::SettingOverride],
+}
+
 impl<'a> Evaluator<'a> {
     pub(crate) fn new(
         program: &'a Program,
         interner: &'a Interner,
         limits: &'a Limits,
         resolution: &'a Resolution,
-        defines: &'a [Define],
-        overrides: &'a [crate::compile::SettingOverride],
+        command_line: CommandLine<'a>,
         sources: whitted_ir::SourceMap,
         max_depth: usize,
     ) -> Self {
+        let CommandLine { defines, overrides } = command_line;
         let scene = Scene {
             sources,
             ..Scene::default()
