@@ -204,6 +204,7 @@ fn shape_text(shape: &Shape) -> String {
             v(*normal)
         ),
         Shape::Triangle { a, b, c } => format!("triangle {} {} {}", v(*a), v(*b), v(*c)),
+        Shape::Torus { major, minor } => format!("torus major {major} minor {minor}"),
         Shape::Quadric { quadric, .. } => {
             let c = quadric.coefficients();
             let list: Vec<String> = c.iter().map(|x| x.to_string()).collect();

@@ -316,6 +316,15 @@ impl Ranges<'_> {
                 }
                 None
             }
+            Shape::Torus { major, minor } => {
+                self.size("torus's `major` radius", *major, span);
+                self.size("torus's `minor` radius", *minor, span);
+                let outer = major + minor;
+                Some((
+                    DVec3::new(-outer, -minor, -outer),
+                    DVec3::new(outer, *minor, outer),
+                ))
+            }
         };
         // The tracer intersects most shapes in their own unit space: the inverse of the shape's
         // size under the transform. Its smallest size in world space bounds those coordinates.
@@ -332,6 +341,8 @@ impl Ranges<'_> {
                 apex_radius,
                 ..
             } => Some(base_radius.max(*apex_radius).min((*apex - *base).length())),
+            // Intersected in the space where the major radius is 1.
+            Shape::Torus { major, minor } => Some(major.min(*minor)),
             Shape::Plane { .. } | Shape::Triangle { .. } | Shape::Quadric { .. } => None,
         };
         if let Some(size) = smallest.filter(|s| *s >= MIN_SIZE && m.is_finite()) {

@@ -384,6 +384,12 @@ pub enum Shape {
         form: QuadricForm,
         quadric: Quadric,
     },
+    /// A ring around the y axis, centred at the origin: the points within `minor` of the
+    /// circle of radius `major` in the xz plane (as POV-Ray's torus). A quartic; a solid.
+    Torus {
+        major: f64,
+        minor: f64,
+    },
 }
 
 impl Shape {
@@ -405,6 +411,7 @@ impl Shape {
             Shape::Cone { .. } => "cone",
             Shape::Disk { .. } => "disk",
             Shape::Triangle { .. } => "triangle",
+            Shape::Torus { .. } => "torus",
             Shape::Quadric { form, .. } => match form {
                 QuadricForm::General => "quadric",
                 QuadricForm::Ellipsoid => "ellipsoid",

@@ -475,6 +475,18 @@ impl Checker {
                     self,
                 );
             }
+            Shape::Torus { major, minor } => {
+                bad(
+                    major.is_finite() && *major > 0.0,
+                    "a torus's `major` radius must be > 0",
+                    self,
+                );
+                bad(
+                    minor.is_finite() && *minor > 0.0,
+                    "a torus's `minor` radius must be > 0",
+                    self,
+                );
+            }
             Shape::Quadric { quadric, .. } => {
                 let c = quadric.coefficients();
                 bad(

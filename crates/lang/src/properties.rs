@@ -301,6 +301,12 @@ properties! {
             ObjectTag::Hyperboloid2,
         ]) => ShapeParameter, "<1, 1, 1>", "the semi-axes";
     }
+    Major "major" {
+        Shape(&[ObjectTag::Torus]) => Number { min: 0.0, open: true, max: ANY }, "1", "the radius of the ring, from the centre to the middle of the tube";
+    }
+    Minor "minor" {
+        Shape(&[ObjectTag::Torus]) => Number { min: 0.0, open: true, max: ANY }, "0.25", "the radius of the tube";
+    }
     Translate "translate" {
         Transforms => Transform, "", "move";
     }
@@ -348,6 +354,8 @@ impl Prop {
 /// The families of blocks whose properties the evaluator converts by their rows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Family {
+    /// Shape parameters (most keep dedicated checks; see [`Kind::ShapeParameter`]).
+    Shape,
     Settings,
     Camera,
     Light,
@@ -360,7 +368,8 @@ pub fn row(prop: Prop, family: Family) -> Option<&'static Row> {
         row.prop == prop
             && matches!(
                 (row.block, family),
-                (Block::Settings, Family::Settings)
+                (Block::Shape(_), Family::Shape)
+                    | (Block::Settings, Family::Settings)
                     | (Block::Camera(_), Family::Camera)
                     | (Block::Light(_), Family::Light)
                     | (Block::Material, Family::Material)

@@ -20,6 +20,7 @@ pub enum ObjectTag {
     Paraboloid,
     Hyperboloid,
     Hyperboloid2,
+    Torus,
     Union,
     Intersection,
     Difference,
@@ -27,7 +28,7 @@ pub enum ObjectTag {
 }
 
 impl ObjectTag {
-    pub const ALL: [ObjectTag; 16] = [
+    pub const ALL: [ObjectTag; 17] = [
         ObjectTag::Sphere,
         ObjectTag::Plane,
         ObjectTag::Box,
@@ -40,6 +41,7 @@ impl ObjectTag {
         ObjectTag::Paraboloid,
         ObjectTag::Hyperboloid,
         ObjectTag::Hyperboloid2,
+        ObjectTag::Torus,
         ObjectTag::Union,
         ObjectTag::Intersection,
         ObjectTag::Difference,
@@ -60,6 +62,7 @@ impl ObjectTag {
             ObjectTag::Paraboloid => "paraboloid",
             ObjectTag::Hyperboloid => "hyperboloid",
             ObjectTag::Hyperboloid2 => "hyperboloid2",
+            ObjectTag::Torus => "torus",
             ObjectTag::Union => "union",
             ObjectTag::Intersection => "intersection",
             ObjectTag::Difference => "difference",

@@ -26,6 +26,7 @@ mod scene;
 mod shapes;
 mod solve;
 pub mod testing;
+mod torus;
 mod trace;
 
 #[cfg(test)]

@@ -104,6 +104,8 @@ pub enum Canonical {
     Cone { r0: f32, r1: f32, capped: bool },
     /// The unit disk in the plane `z = 0`, facing +z.
     Disk,
+    /// The torus of major radius 1 around the y axis, tube radius `minor` (see `torus.rs`).
+    Torus { minor: f32 },
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -295,6 +297,15 @@ impl Geometry {
                 }));
                 (geometry, Bound::from_f64(a.min(b).min(c), a.max(b).max(c)))
             }
+            Shape::Torus { major, minor } => {
+                let world_from_canonical = *m * DAffine3::from_scale(DVec3::splat(*major));
+                let r = minor / major;
+                let extent = DVec3::new(1.0 + r, r, 1.0 + r);
+                (
+                    Geometry::local(&world_from_canonical, Canonical::Torus { minor: r as f32 }),
+                    Bound::transformed_box(&world_from_canonical, -extent, extent),
+                )
+            }
             Shape::Quadric { quadric, .. } => {
                 let object_matrix = quadric_matrix(quadric);
                 let object_from_world = DMat4::from(m.inverse());
@@ -325,7 +336,7 @@ impl Geometry {
             Geometry::Local(local) => match local.shape {
                 Canonical::Disk => false,
                 Canonical::Cylinder { capped } | Canonical::Cone { capped, .. } => capped,
-                Canonical::Sphere | Canonical::Cube => true,
+                Canonical::Sphere | Canonical::Cube | Canonical::Torus { .. } => true,
             },
             Geometry::Sphere { .. } | Geometry::Plane { .. } | Geometry::Quadric(_) => true,
         }
@@ -746,6 +757,24 @@ fn canonical_spans(shape: Canonical, o: Vec3A, d: Vec3A) -> ShapeSpans {
             one(result)
         }
         Canonical::Disk => ShapeSpans::NONE,
+        Canonical::Torus { minor } => {
+            let (spans, n) = crate::torus::spans(
+                o.as_dvec3().to_array(),
+                d.as_dvec3().to_array(),
+                f64::from(minor),
+            );
+            let mut out = ShapeSpans::NONE;
+            for &(t_in, t_out) in &spans[..n] {
+                out.spans[out.len as usize] = RawSpan {
+                    t_in: t_in as f32,
+                    part_in: WALL,
+                    t_out: t_out as f32,
+                    part_out: WALL,
+                };
+                out.len += 1;
+            }
+            out
+        }
     }
 }
 
@@ -791,6 +820,10 @@ fn canonical_normal(shape: Canonical, p: Vec3A, part: Part) -> Vec3A {
             n
         }
         Canonical::Disk => Vec3A::Z,
+        Canonical::Torus { minor } => {
+            let n = crate::torus::normal(p.as_dvec3().to_array(), f64::from(minor));
+            Vec3A::new(n[0] as f32, n[1] as f32, n[2] as f32)
+        }
         Canonical::Cylinder { .. } | Canonical::Cone { .. } if part == BASE_CAP => -Vec3A::Z,
         Canonical::Cylinder { .. } | Canonical::Cone { .. } if part == APEX_CAP => Vec3A::Z,
         Canonical::Cylinder { .. } => Vec3A::new(p.x, p.y, 0.0),

@@ -435,6 +435,11 @@ fn mirror(v: DVec3) -> DVec3 {
 
 fn mirror_shape(shape: &Shape) -> Shape {
     match shape {
+        // Symmetric about x = 0 already.
+        Shape::Torus { major, minor } => Shape::Torus {
+            major: *major,
+            minor: *minor,
+        },
         Shape::Sphere { center, radius } => Shape::Sphere {
             center: mirror(*center),
             radius: *radius,

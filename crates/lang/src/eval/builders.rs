@@ -79,6 +79,8 @@ pub(super) struct ShapeFields {
     pub vertices: [DVec3; 3],
     pub coefficients: [f64; 10],
     pub radii: DVec3,
+    pub major: f64,
+    pub minor: f64,
     pub open: bool,
 }
 
@@ -98,6 +100,8 @@ impl ShapeFields {
             vertices: [DVec3::ZERO; 3],
             coefficients: [0.0; 10],
             radii: DVec3::ONE,
+            major: 1.0,
+            minor: 0.25,
             open: false,
         }
     }

@@ -150,6 +150,10 @@ impl<'a> Evaluator<'a> {
                 apex_radius: f.apex_radius,
                 capped: !f.open,
             },
+            ObjectTag::Torus => Shape::Torus {
+                major: f.major,
+                minor: f.minor,
+            },
             ObjectTag::Disk => Shape::Disk {
                 center: f.center,
                 normal: f.normal,

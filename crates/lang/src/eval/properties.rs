@@ -302,6 +302,10 @@ impl<'a> Evaluator<'a> {
             }
             Prop::Normal => Set::Vector(self.nonzero_vector(value, value_span, prop)?),
             Prop::Offset => Set::Number(self.as_number(value, value_span, prop)?),
+            Prop::Major | Prop::Minor => match properties::row(prop, Family::Shape) {
+                Some(row) => Set::Number(self.convert(row, value, value_span)?.number()),
+                None => return Ok(()),
+            },
             Prop::Radius => {
                 let x = self.as_number(value, value_span, prop)?;
                 if x <= 0.0 {
@@ -362,6 +366,8 @@ impl<'a> Evaluator<'a> {
             (Prop::Normal, Set::Vector(v)) => f.normal = v,
             (Prop::Radii, Set::Vector(v)) => f.radii = v,
             (Prop::Offset, Set::Number(x)) => f.offset = x,
+            (Prop::Major, Set::Number(x)) => f.major = x,
+            (Prop::Minor, Set::Number(x)) => f.minor = x,
             (Prop::Radius, Set::Number(x)) => f.radius = x,
             (Prop::BaseRadius, Set::Number(x)) => f.base_radius = x,
             (Prop::ApexRadius, Set::Number(x)) => f.apex_radius = x,
