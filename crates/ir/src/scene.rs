@@ -199,6 +199,12 @@ pub enum PatternKind {
     Checker,
     /// Alternating slabs of width `scale` along pattern-space x.
     Stripes,
+    /// Bands across pattern-space x, bent by turbulence (deterministic noise).
+    Marble,
+    /// Rings around pattern-space y, made irregular by turbulence.
+    Wood,
+    /// Blotches where fractal noise is at least 0.
+    Turbulence,
 }
 
 /// A procedural choice between two materials at each surface point.

@@ -105,12 +105,15 @@ pub enum Function {
     Srgb,
     Checker,
     Stripes,
+    Marble,
+    Wood,
+    Turbulence,
     Len,
     Rand,
 }
 
 impl Function {
-    pub const ALL: [Function; 31] = [
+    pub const ALL: [Function; 34] = [
         Function::Sqrt,
         Function::Pow,
         Function::Exp,
@@ -140,6 +143,9 @@ impl Function {
         Function::Srgb,
         Function::Checker,
         Function::Stripes,
+        Function::Marble,
+        Function::Wood,
+        Function::Turbulence,
         Function::Len,
         Function::Rand,
     ];
@@ -175,6 +181,9 @@ impl Function {
             Function::Srgb => "srgb",
             Function::Checker => "checker",
             Function::Stripes => "stripes",
+            Function::Marble => "marble",
+            Function::Wood => "wood",
+            Function::Turbulence => "turbulence",
             Function::Len => "len",
             Function::Rand => "rand",
         }
@@ -192,7 +201,7 @@ impl Function {
             | Round | Radians | Degrees | Length | Normalize | Len => (1, 1),
             Pow | Atan2 | Min | Max | Dot | Cross | Rand => (2, 2),
             Clamp | Mix | Rgb | Srgb => (3, 3),
-            Checker | Stripes => (2, 3),
+            Checker | Stripes | Marble | Wood | Turbulence => (2, 3),
         }
     }
 
@@ -229,6 +238,9 @@ impl Function {
             Srgb => "srgb(r, g, b)",
             Checker => "checker(a, b, size)",
             Stripes => "stripes(a, b, width)",
+            Marble => "marble(a, b, size)",
+            Wood => "wood(a, b, size)",
+            Turbulence => "turbulence(a, b, size)",
             Len => "len(array)",
             Rand => "rand(seed, i)",
         }
@@ -397,7 +409,7 @@ pub fn call_math(function: Function, args: &[Value]) -> Result<Value, CallError>
             srgb_to_linear(n(2)?),
         ))),
         Rand => num(crate::random::rand(n(0)?, n(1)?)),
-        Checker | Stripes | Len => Err(CallError::Domain(
+        Checker | Stripes | Marble | Wood | Turbulence | Len => Err(CallError::Domain(
             "patterns and `len` are evaluated by the evaluator".into(),
         )),
     }

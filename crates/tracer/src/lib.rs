@@ -15,6 +15,7 @@ pub mod display;
 mod light;
 mod material;
 mod media;
+mod noise;
 pub mod optics;
 mod query;
 mod ray;

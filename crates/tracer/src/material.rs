@@ -107,11 +107,16 @@ impl PreparedPattern {
     #[inline]
     pub fn choose(&self, object_point: Vec3A) -> Handle<Material> {
         let p = self.cell_from_object.transform_point3a(object_point);
-        let cells = match self.kind {
-            PatternKind::Checker => cell(p.x).wrapping_add(cell(p.y)).wrapping_add(cell(p.z)),
-            PatternKind::Stripes => cell(p.x),
+        let first = match self.kind {
+            PatternKind::Checker => {
+                cell(p.x).wrapping_add(cell(p.y)).wrapping_add(cell(p.z)) & 1 == 0
+            }
+            PatternKind::Stripes => cell(p.x) & 1 == 0,
+            PatternKind::Marble => crate::noise::marble(p.x, p.y, p.z),
+            PatternKind::Wood => crate::noise::wood(p.x, p.y, p.z),
+            PatternKind::Turbulence => crate::noise::blotches(p.x, p.y, p.z),
         };
-        if cells & 1 == 0 {
+        if first {
             self.a
         } else {
             self.b

@@ -265,7 +265,14 @@ impl<'a> Evaluator<'a> {
             *slot = self.eval(arg)?;
         }
         let count = call.args.len().min(3);
-        if matches!(function, Function::Checker | Function::Stripes) {
+        if matches!(
+            function,
+            Function::Checker
+                | Function::Stripes
+                | Function::Marble
+                | Function::Wood
+                | Function::Turbulence
+        ) {
             return self.pattern(function, call, &args[..count]);
         }
         if function == Function::Len {
@@ -293,7 +300,8 @@ impl<'a> Evaluator<'a> {
         }
     }
 
-    /// `checker(a, b, size)` and `stripes(a, b, width)`: each side a colour or a material.
+    /// `checker(a, b, size)`, `stripes(a, b, width)` and the noise patterns `marble`, `wood`
+    /// and `turbulence`: each side a colour or a material.
     fn pattern(&mut self, function: Function, call: &'a Call, args: &[Value]) -> Eval<Value> {
         let mut parts = [PatternPart::Color(DVec3::ZERO); 2];
         for (index, part) in parts.iter_mut().enumerate() {
@@ -340,10 +348,12 @@ impl<'a> Evaluator<'a> {
                 );
             }
         };
-        let kind = if function == Function::Checker {
-            whitted_ir::PatternKind::Checker
-        } else {
-            whitted_ir::PatternKind::Stripes
+        let kind = match function {
+            Function::Checker => whitted_ir::PatternKind::Checker,
+            Function::Marble => whitted_ir::PatternKind::Marble,
+            Function::Wood => whitted_ir::PatternKind::Wood,
+            Function::Turbulence => whitted_ir::PatternKind::Turbulence,
+            _ => whitted_ir::PatternKind::Stripes,
         };
         Ok(Value::Pattern(self.add_pattern(PatternDef {
             kind,
