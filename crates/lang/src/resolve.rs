@@ -506,9 +506,7 @@ impl<'a> Resolver<'a> {
                     _ => false,
                 };
                 let callee = self.name(call.callee.sym);
-                if cx.properties().iter().any(|p| p.name() == callee)
-                    && self.lookup(call.callee.sym).is_none()
-                {
+                if cx.property_named(callee).is_some() && self.lookup(call.callee.sym).is_none() {
                     // `scale(2)`: a property written like a call.
                     self.error(
                         Diagnostic::error(
