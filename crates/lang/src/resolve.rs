@@ -96,7 +96,7 @@ pub struct Resolver<'a> {
     frame: Frame,
     file: FileIndex,
     /// Top-level names of the file being resolved, for "used before it is defined".
-    later: HashMap<Sym, Span>,
+    later: HashMap<Sym, Span, foldhash::fast::FixedState>,
     /// The function whose body is being resolved (its own recursive calls are not "uses").
     current_function: Option<FnId>,
     defines: &'a [Define],
@@ -119,7 +119,7 @@ impl<'a> Resolver<'a> {
             scopes: Vec::new(),
             frame: Frame::default(),
             file: 0,
-            later: HashMap::new(),
+            later: HashMap::default(),
             current_function: None,
             defines,
             define_used: vec![false; defines.len()],
@@ -177,6 +177,8 @@ impl<'a> Resolver<'a> {
 
         self.scopes.push(Scope::new(false));
         let mut items = std::mem::take(&mut program.files[index].items);
+        // A script's file can define 100,000 names: sized once, not rehashed as it grows.
+        self.later.reserve(items.len());
         for item in &items {
             if let Some((sym, span)) = top_level_name(&item.kind, &program.functions) {
                 self.later.entry(sym).or_insert(span);
@@ -506,9 +508,7 @@ impl<'a> Resolver<'a> {
                     _ => false,
                 };
                 let callee = self.name(call.callee.sym);
-                if cx.properties().iter().any(|p| p.name() == callee)
-                    && self.lookup(call.callee.sym).is_none()
-                {
+                if cx.property_named(callee).is_some() && self.lookup(call.callee.sym).is_none() {
                     // `scale(2)`: a property written like a call.
                     self.error(
                         Diagnostic::error(

@@ -148,6 +148,11 @@ impl Context {
         crate::properties::accepted(self)
     }
 
+    /// The property called `name` if this block accepts it, without building the list.
+    pub fn property_named(self, name: &str) -> Option<Prop> {
+        crate::properties::accepted_named(self, name)
+    }
+
     /// "a sphere", "the settings", ...: how messages name the block.
     pub fn describe(self) -> String {
         match self {

@@ -6,8 +6,7 @@ use super::*;
 impl Resolver<'_> {
     pub(super) fn property(&mut self, property: &mut Property, cx: Context, program: &mut Program) {
         let name = self.name(property.name.sym);
-        let allowed = cx.properties();
-        let prop = allowed.iter().copied().find(|p| p.name() == name);
+        let prop = cx.property_named(name);
         match (prop, cx) {
             (_, Context::Unknown) => {}
             (Some(prop), _) => property.prop = Some(prop),
@@ -21,6 +20,7 @@ impl Resolver<'_> {
                 );
             }
             (None, _) => {
+                let allowed = cx.properties();
                 let names: Vec<&str> = allowed.iter().map(|p| p.name()).collect();
                 let mut diagnostic = Diagnostic::error(
                     format!("`{name}` is not a property of {}", cx.describe()),

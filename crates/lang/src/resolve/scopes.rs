@@ -4,6 +4,10 @@
 use std::cell::Cell;
 use std::collections::HashMap;
 
+// Symbols are small numbers made by the interner, not text an attacker chooses the hashes
+// of: the fast hash the interner uses is safe here and cheaper than SipHash on 100,000 names.
+use foldhash::fast::FixedState;
+
 use super::*;
 
 pub(super) struct Scope {
@@ -12,7 +16,7 @@ pub(super) struct Scope {
     /// For each name: its first definition (what "already defined here" points at) and its
     /// latest (what a use finds). A script's file scope can hold 100,000 names, so finding one
     /// must not scan them all.
-    pub(super) index: HashMap<Sym, (DefId, DefId)>,
+    pub(super) index: HashMap<Sym, (DefId, DefId), FixedState>,
     /// Names in scopes below this one (except the file scope) are not visible: a function
     /// body sees its own locals and the file's top level, nothing in between.
     pub(super) barrier: bool,
@@ -22,7 +26,7 @@ impl Scope {
     pub(super) fn new(barrier: bool) -> Scope {
         Scope {
             names: Vec::new(),
-            index: HashMap::new(),
+            index: HashMap::default(),
             barrier,
         }
     }
