@@ -4,7 +4,9 @@
 
 use crate::schema::Prop;
 
-/// A foreign word and the advice for it.
+/// A foreign word and the advice for it. Syntax errors consult this table for every word on
+/// the line, so words that are as likely to be a scene's own names (`text`, `right`,
+/// `parallel`) are left out: their advice would mislead more often than help.
 const FOREIGN: &[(&str, &str)] = &[
     (
         "color",
@@ -126,6 +128,103 @@ const FOREIGN: &[(&str, &str)] = &[
     (
         "macro",
         "functions are `fn name(a, b) { ... }` (POV-Ray's `#macro`)",
+    ),
+    // POV-Ray shapes whitted lacks, each with the nearest whitted construction.
+    (
+        "smooth_triangle",
+        "whitted's triangles are flat: write `triangle { vertices <...>, <...>, <...> }` (the vertex normals have no counterpart)",
+    ),
+    (
+        "prism",
+        "whitted has no prisms: a `difference` or `intersection` of `box`es, or `triangle`s in a `group`, makes one",
+    ),
+    (
+        "height_field",
+        "whitted has no height fields: write the surface as `triangle { vertices ... }` objects, in a `group`",
+    ),
+    (
+        "lathe",
+        "whitted has no surfaces of revolution: stack `cone`s and `cylinder`s in a `union`, or use a `quadric`",
+    ),
+    (
+        "sor",
+        "whitted has no surfaces of revolution: stack `cone`s and `cylinder`s in a `union`, or use a `quadric`",
+    ),
+    (
+        "blob",
+        "whitted has no blobs: overlapping `sphere`s in a `union` come nearest",
+    ),
+    (
+        "superellipsoid",
+        "whitted has no superellipsoids: the nearest shapes are `box`, `ellipsoid` and their `intersection`",
+    ),
+    (
+        "isosurface",
+        "whitted has no isosurfaces: an implicit surface of degree two is a `quadric { coefficients ... }`; a ring is a `torus`",
+    ),
+    // Object modifiers.
+    (
+        "clipped_by",
+        "to cut an object by a shape, write `intersection { object shape }` (or `difference` to cut the shape away)",
+    ),
+    (
+        "bounded_by",
+        "whitted bounds every object itself (a bounding volume hierarchy): leave `bounded_by` out",
+    ),
+    (
+        "hollow",
+        "whitted has no media, so nothing is hollow or filled: leave `hollow` out",
+    ),
+    // Finish words.
+    (
+        "roughness",
+        "the highlight's tightness is the material's `shininess`, a Phong exponent (about 1 / POV-Ray's `roughness`)",
+    ),
+    (
+        "metallic",
+        "for a metal's tinted highlight, give the material's `specular` the metal's colour (`specular <0.9, 0.7, 0.3>`)",
+    ),
+    (
+        "brilliance",
+        "whitted's diffuse shading is Lambert's, with no `brilliance`: leave it out",
+    ),
+    (
+        "emission",
+        "whitted has no emitting surfaces: a material's `ambient` keeps its colour in shadow, and a `light` is what lights the scene",
+    ),
+    // Lights.
+    (
+        "area_light",
+        "whitted's lights are `point`, `directional` and `spot`, with sharp shadows (Whitted's model): there are no area lights",
+    ),
+    (
+        "spotlight",
+        "a spot light is its own kind: `light spot { position <0, 5, 0> direction <0, -1, 0> inner 20 outer 30 }`",
+    ),
+    (
+        "point_at",
+        "a spot light aims along its `direction`, a vector: POV-Ray's `point_at` minus the light's `position`",
+    ),
+    (
+        "falloff",
+        "a spot light fades out at `outer`, in degrees from its axis like POV-Ray's `falloff` (POV-Ray's `radius` is `inner`)",
+    ),
+    (
+        "fade_distance",
+        "fall-off with distance is the light's `attenuation <constant, linear, quadratic>`",
+    ),
+    (
+        "fade_power",
+        "fall-off with distance is the light's `attenuation <constant, linear, quadratic>`",
+    ),
+    // Global illumination.
+    (
+        "radiosity",
+        "whitted traces Whitted's model, without indirect diffuse light: `settings { ambient ... }` stands in for it",
+    ),
+    (
+        "photons",
+        "whitted traces Whitted's model, without caustics: light reaches a surface only straight from a light (through transparent objects with `settings { shadows filtered }`)",
     ),
 ];
 

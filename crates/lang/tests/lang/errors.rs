@@ -446,3 +446,42 @@ fn foreign_words_and_habits() {
         ],
     );
 }
+
+/// More of POV-Ray's words: shapes, modifiers, finish and light words and global
+/// illumination, each answered with the nearest whitted construction (crates/lang/src/hints.rs).
+#[test]
+fn more_foreign_words() {
+    check_errors(
+        "more_foreign_words",
+        &[
+            ("a smooth triangle", "smooth_triangle { }\n"),
+            ("a blob", "blob { }\n"),
+            ("a lathe", "lathe { }\n"),
+            ("an isosurface", "isosurface { }\n"),
+            ("clipped_by", "sphere { radius 1 clipped_by { box { } } }\n"),
+            ("hollow", "sphere { radius 1 hollow }\n"),
+            ("roughness", "material m { roughness 0.05 }\n"),
+            ("metallic", "material m { specular 0.5 metallic }\n"),
+            ("emission", "material m { emission <1, 1, 1> }\n"),
+            (
+                "an area light",
+                "light point { position <0, 5, 0> area_light }\n",
+            ),
+            ("a spotlight", "light spotlight { position <0, 5, 0> }\n"),
+            (
+                "point_at",
+                "light spot { position <0, 5, 0> point_at <0, 0, 0> }\n",
+            ),
+            (
+                "falloff",
+                "light spot { position <0, 5, 0> direction <0, -1, 0> falloff 30 }\n",
+            ),
+            (
+                "fade_distance",
+                "light point { position <0, 5, 0> fade_distance 10 }\n",
+            ),
+            ("radiosity", "settings { radiosity { } }\n"),
+            ("photons", "settings { photons { } }\n"),
+        ],
+    );
+}
