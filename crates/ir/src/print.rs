@@ -134,6 +134,14 @@ fn material_fields(m: &Material) -> String {
     if m.priority != 0 {
         fields.push_str(&format!(" priority {}", m.priority));
     }
+    // Colours added after the fixed line existed show only where a scene uses them.
+    let default = Material::default();
+    for row in crate::properties::MATERIAL_COLORS {
+        let value = (row.get)(m);
+        if row.shown == crate::properties::Shown::WhenSet && value != (row.get)(&default) {
+            fields.push_str(&format!(" {} {}", row.name, color(&value)));
+        }
+    }
     fields
 }
 

@@ -9,7 +9,7 @@ use glam::{DMat4, DVec3};
 
 use crate::diagnostic::Diagnostic;
 use crate::limits::{
-    MAX_COORDINATE, MAX_DEPTH, MAX_IMAGE_SIDE, MAX_INTENSITY, MAX_IOR, MAX_PIXELS, MAX_REFLECTANCE,
+    MAX_COORDINATE, MAX_DEPTH, MAX_IMAGE_SIDE, MAX_INTENSITY, MAX_IOR, MAX_PIXELS,
     MAX_SAMPLES_PER_PIXEL, MIN_IOR, MIN_SIZE,
 };
 use crate::scene::{Color, LightKind, Material, Object, ObjectKind, Projection, Scene, Shape};
@@ -202,20 +202,14 @@ impl Ranges<'_> {
     }
 
     fn material(&mut self, m: &Material, span: Span) {
-        let intensity = [
-            ("material's `ambient`", &m.ambient),
-            ("material's `diffuse`", &m.diffuse),
-            ("material's `specular`", &m.specular),
-            ("material's `absorption`", &m.absorption),
-        ];
-        for (what, c) in intensity {
-            self.color(what, c, MAX_INTENSITY, "largest intensity", span);
-        }
-        for (what, c) in [
-            ("material's `reflective`", &m.reflective),
-            ("material's `transmissive`", &m.transmissive),
-        ] {
-            self.color(what, c, MAX_REFLECTANCE, "largest reflectance", span);
+        // Intensities first, then reflectances: the order these messages always came in.
+        for limit in [crate::properties::INTENSITY, crate::properties::REFLECTANCE] {
+            for row in crate::properties::MATERIAL_COLORS {
+                if row.limit == limit {
+                    let what = format!("material's `{}`", row.name);
+                    self.color(&what, &(row.get)(m), limit.max, limit.name, span);
+                }
+            }
         }
         self.at_most(
             "material's `shininess`",

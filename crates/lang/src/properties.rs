@@ -426,6 +426,42 @@ mod tests {
         }
     }
 
+    /// The IR's material colours (where validation and the printer find them) are exactly
+    /// this table's material colours, with the defaults the docs give.
+    #[test]
+    fn material_colours_agree_with_the_ir_table() {
+        use whitted_ir::properties::{material_color, MATERIAL_COLORS};
+        let colours: Vec<&Row> = ROWS
+            .iter()
+            .filter(|row| {
+                row.block == Block::Material
+                    && matches!(row.kind, Kind::Color | Kind::ColorOrPattern)
+            })
+            .collect();
+        for row in &colours {
+            let name = row.prop.name();
+            let ir = material_color(name)
+                .unwrap_or_else(|| panic!("`{name}` has no row in whitted_ir::properties"));
+            let grey: f64 = row
+                .default
+                .parse()
+                .unwrap_or_else(|_| panic!("`{name}`'s default {:?}", row.default));
+            let default = (ir.get)(&whitted_ir::Material::default());
+            assert_eq!(
+                default,
+                whitted_ir::Color::gray(grey),
+                "`{name}`: the docs say {grey}, the IR starts at {default:?}"
+            );
+        }
+        for ir in MATERIAL_COLORS {
+            assert!(
+                colours.iter().any(|row| row.prop.name() == ir.name),
+                "the IR's `{}` has no material row here",
+                ir.name
+            );
+        }
+    }
+
     #[test]
     fn a_property_takes_the_same_number_of_values_wherever_it_goes() {
         for prop in Prop::ALL {
