@@ -523,6 +523,40 @@ mod tests {
         }
     }
 
+    /// Every material colour of the IR's table (emission included, with no line of its own
+    /// here) is refused past its row's limit, by name, and negative; at the limit it passes.
+    #[test]
+    fn every_material_colour_is_checked_by_its_row() {
+        for row in crate::properties::MATERIAL_COLORS {
+            let with = |v: f64| {
+                let mut scene = base();
+                (row.set)(
+                    &mut scene.materials[Handle::from_index(0)],
+                    Color::new(0.0, v, 0.0),
+                );
+                messages(scene)
+            };
+            assert_eq!(with(row.limit.max), Vec::<String>::new(), "`{}`", row.name);
+            let over = with(row.limit.max * 1.5);
+            let what = format!("material's `{}`", row.name);
+            assert!(
+                over.iter()
+                    .any(|m| m.contains(&what) && m.contains(row.limit.name)),
+                "`{}` over its limit: {over:?}",
+                row.name
+            );
+            let negative = with(-1.0);
+            assert!(
+                negative.iter().any(|m| m.contains(&format!(
+                    "the material's {} coefficient must be finite and >= 0",
+                    row.name
+                ))),
+                "`{}` negative: {negative:?}",
+                row.name
+            );
+        }
+    }
+
     #[test]
     fn world_space_size_counts_after_the_transform() {
         // Radius 1e-6 under a scale of 1e-4 on one axis: 1e-10 across in world space, where
