@@ -100,6 +100,13 @@ pub const MATERIAL_COLORS: &[MaterialColor] = &[
         limit: INTENSITY,
         shown: Shown::InLine,
     },
+    MaterialColor {
+        name: "emission",
+        get: |m| m.emission,
+        set: |m, c| m.emission = c,
+        limit: INTENSITY,
+        shown: Shown::WhenSet,
+    },
 ];
 
 /// The row of the material colour called `name`.

@@ -4,9 +4,12 @@
 //! Resolution (unknown properties with suggestions, arity, words), evaluation (converting a
 //! value and checking its range: `eval/convert.rs`), the CLI's `--set NAME=VALUE` and the docs
 //! test all read these rows. **To add a property**, add its row here (a new name gets its
-//! variant from the same line), then give it meaning: the field it sets in the evaluator
-//! (`eval/objects.rs`, one match arm) and what the tracer does with that field. Nothing else
-//! needs to know about it.
+//! variant from the same line), then give it meaning: the IR field it sets and what the
+//! tracer does with that field. A material colour also gets its row in the IR's half of the
+//! table (`whitted_ir::properties`: its field, limit and how `whitted ir` shows it), from
+//! which evaluation, validation and the printer set, check and show it; any other property
+//! gets its match arm in `eval/properties.rs` (and its check in validation when it needs
+//! one). `emission` was added that way: two rows, one IR field, one term in the tracer.
 //!
 //! Rows are in the order the docs list each block's properties, so that "a sphere takes
 //! `center`, `radius`, ..." reads in that order.
@@ -250,6 +253,9 @@ properties! {
     }
     Absorption "absorption" {
         Material => Color, "0", "Beer-Lambert absorption per unit of distance inside";
+    }
+    Emission "emission" {
+        Material => Color, "0", "light the surface gives off by itself, whatever the lights and shadows";
     }
     Priority "priority" {
         Material => Whole { min: 0.0, max: limits::MAX_PRIORITY as f64 }, "0", "nested media: which solid fills an overlap";
