@@ -241,7 +241,8 @@ impl Reshader<'_> {
         }
 
         // Local illumination.
-        let mut local = c(&m.ambient) * c(&self.scene.settings.ambient) * c(&m.diffuse);
+        let mut local =
+            c(&m.ambient) * c(&self.scene.settings.ambient) * c(&m.diffuse) + c(&m.emission);
         let lights = node.local.as_ref().map_or(&[][..], |l| &l.lights[..]);
         if lights.len() != self.scene.lights.len() {
             self.problem(path, format!("{} light entries", lights.len()));

@@ -8,6 +8,7 @@ mod diagnostic;
 mod json;
 pub mod limits;
 mod print;
+pub mod properties;
 mod ranges;
 mod scene;
 mod source;

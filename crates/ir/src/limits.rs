@@ -206,7 +206,7 @@ pub const ALL: &[Limit] = &[
     number(
         "largest intensity",
         MAX_INTENSITY,
-        "light colour, ambient, background, and a material's ambient, diffuse, specular, shininess, absorption",
+        "light colour, ambient, background, and a material's ambient, diffuse, specular, shininess, absorption, emission",
     ),
     number(
         "largest reflectance",

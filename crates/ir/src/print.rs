@@ -134,6 +134,14 @@ fn material_fields(m: &Material) -> String {
     if m.priority != 0 {
         fields.push_str(&format!(" priority {}", m.priority));
     }
+    // Colours added after the fixed line existed show only where a scene uses them.
+    let default = Material::default();
+    for row in crate::properties::MATERIAL_COLORS {
+        let value = (row.get)(m);
+        if row.shown == crate::properties::Shown::WhenSet && value != (row.get)(&default) {
+            fields.push_str(&format!(" {} {}", row.name, color(&value)));
+        }
+    }
     fields
 }
 
@@ -260,5 +268,20 @@ mod tests {
             "{text:?}"
         );
         assert!(text.contains("\"red\\u{1b}[31m\\u{7}ça\""), "{text}");
+    }
+
+    /// A colour shown only when set (`emission`) leaves the default material's line as it
+    /// always was, and appears after it once a scene sets it.
+    #[test]
+    fn colours_shown_when_set_appear_only_when_set() {
+        let plain = material_fields(&Material::default());
+        assert!(!plain.contains("emission"), "{plain}");
+        assert!(plain.ends_with("absorption rgb(0, 0, 0)"), "{plain}");
+        let glowing = Material {
+            emission: crate::Color::new(1.0, 0.5, 0.25),
+            ..Material::default()
+        };
+        let text = material_fields(&glowing);
+        assert_eq!(text, format!("{plain} emission rgb(1, 0.5, 0.25)"));
     }
 }

@@ -9,7 +9,7 @@ use glam::{DMat4, DVec3};
 
 use crate::diagnostic::Diagnostic;
 use crate::limits::{
-    MAX_COORDINATE, MAX_DEPTH, MAX_IMAGE_SIDE, MAX_INTENSITY, MAX_IOR, MAX_PIXELS, MAX_REFLECTANCE,
+    MAX_COORDINATE, MAX_DEPTH, MAX_IMAGE_SIDE, MAX_INTENSITY, MAX_IOR, MAX_PIXELS,
     MAX_SAMPLES_PER_PIXEL, MIN_IOR, MIN_SIZE,
 };
 use crate::scene::{Color, LightKind, Material, Object, ObjectKind, Projection, Scene, Shape};
@@ -202,20 +202,14 @@ impl Ranges<'_> {
     }
 
     fn material(&mut self, m: &Material, span: Span) {
-        let intensity = [
-            ("material's `ambient`", &m.ambient),
-            ("material's `diffuse`", &m.diffuse),
-            ("material's `specular`", &m.specular),
-            ("material's `absorption`", &m.absorption),
-        ];
-        for (what, c) in intensity {
-            self.color(what, c, MAX_INTENSITY, "largest intensity", span);
-        }
-        for (what, c) in [
-            ("material's `reflective`", &m.reflective),
-            ("material's `transmissive`", &m.transmissive),
-        ] {
-            self.color(what, c, MAX_REFLECTANCE, "largest reflectance", span);
+        // Intensities first, then reflectances: the order these messages always came in.
+        for limit in [crate::properties::INTENSITY, crate::properties::REFLECTANCE] {
+            for row in crate::properties::MATERIAL_COLORS {
+                if row.limit == limit {
+                    let what = format!("material's `{}`", row.name);
+                    self.color(&what, &(row.get)(m), limit.max, limit.name, span);
+                }
+            }
         }
         self.at_most(
             "material's `shininess`",
@@ -536,6 +530,40 @@ mod tests {
             assert!(
                 messages.iter().any(|m| m.contains("smallest size limit")),
                 "radius {value:e}: {messages:?}"
+            );
+        }
+    }
+
+    /// Every material colour of the IR's table (emission included, with no line of its own
+    /// here) is refused past its row's limit, by name, and negative; at the limit it passes.
+    #[test]
+    fn every_material_colour_is_checked_by_its_row() {
+        for row in crate::properties::MATERIAL_COLORS {
+            let with = |v: f64| {
+                let mut scene = base();
+                (row.set)(
+                    &mut scene.materials[Handle::from_index(0)],
+                    Color::new(0.0, v, 0.0),
+                );
+                messages(scene)
+            };
+            assert_eq!(with(row.limit.max), Vec::<String>::new(), "`{}`", row.name);
+            let over = with(row.limit.max * 1.5);
+            let what = format!("material's `{}`", row.name);
+            assert!(
+                over.iter()
+                    .any(|m| m.contains(&what) && m.contains(row.limit.name)),
+                "`{}` over its limit: {over:?}",
+                row.name
+            );
+            let negative = with(-1.0);
+            assert!(
+                negative.iter().any(|m| m.contains(&format!(
+                    "the material's {} coefficient must be finite and >= 0",
+                    row.name
+                ))),
+                "`{}` negative: {negative:?}",
+                row.name
             );
         }
     }

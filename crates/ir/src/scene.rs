@@ -242,6 +242,9 @@ pub struct Material {
     pub priority: u32,
     /// Beer-Lambert absorption per unit distance inside a transmissive solid.
     pub absorption: Color,
+    /// Light the surface gives off by itself: added to its local colour whatever the lights
+    /// and shadows (a self-lit surface; it lights nothing else).
+    pub emission: Color,
     /// When set, the surface takes pattern.a or pattern.b at each point instead of this.
     pub pattern: Option<Pattern>,
 }
@@ -261,6 +264,7 @@ impl Default for Material {
             fresnel: Fresnel::Off,
             priority: 0,
             absorption: Color::BLACK,
+            emission: Color::BLACK,
             pattern: None,
         }
     }

@@ -231,16 +231,9 @@ impl Checker {
     }
 
     fn material(&mut self, scene: &Scene, handle: Handle<Material>, m: &Material, span: Span) {
-        let colors = [
-            ("ambient", &m.ambient),
-            ("diffuse", &m.diffuse),
-            ("specular", &m.specular),
-            ("reflective", &m.reflective),
-            ("transmissive", &m.transmissive),
-            ("absorption", &m.absorption),
-        ];
-        for (field, color) in colors {
-            if !color_ok(color) {
+        for row in crate::properties::MATERIAL_COLORS {
+            let field = row.name;
+            if !color_ok(&(row.get)(m)) {
                 self.error(
                     format!("the material's {field} coefficient must be finite and >= 0"),
                     span,

@@ -4,9 +4,12 @@
 //! Resolution (unknown properties with suggestions, arity, words), evaluation (converting a
 //! value and checking its range: `eval/convert.rs`), the CLI's `--set NAME=VALUE` and the docs
 //! test all read these rows. **To add a property**, add its row here (a new name gets its
-//! variant from the same line), then give it meaning: the field it sets in the evaluator
-//! (`eval/objects.rs`, one match arm) and what the tracer does with that field. Nothing else
-//! needs to know about it.
+//! variant from the same line), then give it meaning: the IR field it sets and what the
+//! tracer does with that field. A material colour also gets its row in the IR's half of the
+//! table (`whitted_ir::properties`: its field, limit and how `whitted ir` shows it), from
+//! which evaluation, validation and the printer set, check and show it; any other property
+//! gets its match arm in `eval/properties.rs` (and its check in validation when it needs
+//! one). `emission` was added that way: two rows, one IR field, one term in the tracer.
 //!
 //! Rows are in the order the docs list each block's properties, so that "a sphere takes
 //! `center`, `radius`, ..." reads in that order.
@@ -251,6 +254,9 @@ properties! {
     Absorption "absorption" {
         Material => Color, "0", "Beer-Lambert absorption per unit of distance inside";
     }
+    Emission "emission" {
+        Material => Color, "0", "light the surface gives off by itself, whatever the lights and shadows";
+    }
     Priority "priority" {
         Material => Whole { min: 0.0, max: limits::MAX_PRIORITY as f64 }, "0", "nested media: which solid fills an overlap";
     }
@@ -485,6 +491,42 @@ mod tests {
                 docs.contains(&format!("`{}", prop.name())),
                 "docs/language.md never mentions `{}`",
                 prop.name()
+            );
+        }
+    }
+
+    /// The IR's material colours (where validation and the printer find them) are exactly
+    /// this table's material colours, with the defaults the docs give.
+    #[test]
+    fn material_colours_agree_with_the_ir_table() {
+        use whitted_ir::properties::{material_color, MATERIAL_COLORS};
+        let colours: Vec<&Row> = ROWS
+            .iter()
+            .filter(|row| {
+                row.block == Block::Material
+                    && matches!(row.kind, Kind::Color | Kind::ColorOrPattern)
+            })
+            .collect();
+        for row in &colours {
+            let name = row.prop.name();
+            let ir = material_color(name)
+                .unwrap_or_else(|| panic!("`{name}` has no row in whitted_ir::properties"));
+            let grey: f64 = row
+                .default
+                .parse()
+                .unwrap_or_else(|_| panic!("`{name}`'s default {:?}", row.default));
+            let default = (ir.get)(&whitted_ir::Material::default());
+            assert_eq!(
+                default,
+                whitted_ir::Color::gray(grey),
+                "`{name}`: the docs say {grey}, the IR starts at {default:?}"
+            );
+        }
+        for ir in MATERIAL_COLORS {
+            assert!(
+                colours.iter().any(|row| row.prop.name() == ir.name),
+                "the IR's `{}` has no material row here",
+                ir.name
             );
         }
     }

@@ -21,6 +21,8 @@ pub struct PreparedMaterial {
     /// The nested-media rank: the material's priority, with 0 (plain) above every other.
     pub rank: u32,
     pub absorption: Vec3A,
+    /// Light the surface gives off by itself, added to its local colour.
+    pub emission: Vec3A,
     pub pattern: Option<PreparedPattern>,
 }
 
@@ -66,6 +68,7 @@ impl PreparedMaterial {
                 m.priority
             },
             absorption: color(&m.absorption),
+            emission: color(&m.emission),
             pattern: m.pattern.as_ref().map(|p| PreparedPattern {
                 kind: p.kind,
                 a: p.a,

@@ -11,6 +11,7 @@
 //! ├─ ray_missed                                  (then ray_finished with Miss)
 //! └─ surface_hit
 //!    ambient
+//!    emission
 //!    light_sampled           × every light, in scene order (with its shadow ray, if any)
 //!    reflected ray:   ray_started … ray_finished (nested), or secondary_skipped
 //!    transmitted ray: ray_started … ray_finished (nested), or secondary_skipped
@@ -22,7 +23,7 @@
 //!
 //! The colour a ray returns is computed in exactly this order (f32, per channel), so a
 //! recorder can re-add the parts bit for bit:
-//! `c = ambient; c += diffuse + specular` for each light in order; `c += coefficient ×
+//! `c = ambient + emission; c += diffuse + specular` for each light in order; `c += coefficient ×
 //! returned colour` for the reflected, then the transmitted ray; finally `c × absorption`
 //! (the [`SurfaceHit::absorption`] factor). A miss returns the background times the
 //! medium's transmittance over an infinite distance. Colours are linear RGB; "weight" is always the path weight: the
@@ -280,6 +281,9 @@ pub trait Recorder {
     /// The ambient term `ka·Ia·kd` at the hit.
     #[inline(always)]
     fn ambient(&mut self, _ambient: Vec3A) {}
+    /// The material's own emission at the hit (black for most surfaces).
+    #[inline(always)]
+    fn emission(&mut self, _emission: Vec3A) {}
     #[inline(always)]
     fn light_sampled(&mut self, _sample: &LightSample) {}
     #[inline(always)]

@@ -602,7 +602,7 @@ impl<'a> Tracer<'a> {
         meeting
     }
 
-    /// `ka·Ia·kd` plus, for every light on the visible side, `fatt·spot·Ii·(kd·(N·L) +
+    /// `ka·Ia·kd`, plus the surface's own emission, plus, for every light on the visible side, `fatt·spot·Ii·(kd·(N·L) +
     /// ks·(R·V)^n)` (or `ks·(N·H)^n` with `highlight blinn`) times what the shadow ray lets
     /// through. `outside` is the hit point
     /// already moved off the surface along `n`, which faces the viewer. The order of the
@@ -618,7 +618,9 @@ impl<'a> Tracer<'a> {
         let scene = self.scene;
         let ambient = m.ambient * scene.ambient * m.diffuse;
         rec.ambient(ambient);
-        let mut color = ambient;
+        // A self-lit surface: its emission counts whatever the lights and shadows.
+        rec.emission(m.emission);
+        let mut color = ambient + m.emission;
         // With no diffuse and no specular colour a light adds nothing whatever its shadow
         // ray finds, so the ray is not cast (14% of a mirror scene's shadow rays).
         let unshaded = m.diffuse == Vec3A::ZERO && m.specular == Vec3A::ZERO;

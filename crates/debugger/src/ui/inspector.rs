@@ -263,6 +263,10 @@ impl Lines {
     fn local(&mut self, local: &LocalIllumination) {
         self.section("local illumination");
         self.color("ambient", local.ambient, "ka·Ia·kd");
+        // Most surfaces give off no light: show the line only for those that do.
+        if local.emission != [0.0; 3] {
+            self.color("emission", local.emission, "the surface's own light");
+        }
         for light in &local.lights {
             let mut facts = vec![
                 match light.visibility {
@@ -372,5 +376,43 @@ fn reason(termination: Termination) -> &'static str {
         Termination::WeightCutoff => "weight cut-off: it would weigh less than min_weight",
         Termination::TotalInternalReflection => "total internal reflection",
         Termination::Absorbed => "absorbed: the surface neither reflects nor transmits",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn local_text(emission: [f32; 3]) -> String {
+        let mut lines = Lines::new(ColorDepth::TrueColor);
+        lines.local(&LocalIllumination {
+            ambient: [0.1; 3],
+            emission,
+            lights: Vec::new(),
+            total: [0.1 + emission[0], 0.1 + emission[1], 0.1 + emission[2]],
+        });
+        lines
+            .out
+            .iter()
+            .map(|line| {
+                line.spans
+                    .iter()
+                    .map(|span| span.content.as_ref())
+                    .collect::<String>()
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+
+    /// A self-lit surface shows its emission among the local terms; other surfaces show no
+    /// such line (so every existing screen stays as it was).
+    #[test]
+    fn the_emission_line_shows_only_for_surfaces_that_give_off_light() {
+        let glowing = local_text([0.5, 0.25, 0.0]);
+        assert!(glowing.contains("emission"), "{glowing}");
+        assert!(glowing.contains("0.500 0.250 0.000"), "{glowing}");
+        let plain = local_text([0.0; 3]);
+        assert!(!plain.contains("emission"), "{plain}");
+        assert!(plain.contains("ambient"), "{plain}");
     }
 }

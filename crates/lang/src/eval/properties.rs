@@ -575,11 +575,6 @@ impl<'a> Evaluator<'a> {
                     m.diffuse = color;
                 }
             }
-            Prop::Ambient => m.ambient = color,
-            Prop::Specular => m.specular = color,
-            Prop::Reflective => m.reflective = color,
-            Prop::Transmissive => m.transmissive = color,
-            Prop::Absorption => m.absorption = color,
             Prop::Shininess => m.shininess = number,
             Prop::Ior => m.ior = number,
             Prop::Fresnel => {
@@ -590,7 +585,12 @@ impl<'a> Evaluator<'a> {
                 }
             }
             Prop::Priority => m.priority = number as u32,
-            _ => {}
+            // Every other colour is stored by its row in the IR's table.
+            _ => {
+                if let Some(row) = whitted_ir::properties::material_color(prop.name()) {
+                    (row.set)(m, color);
+                }
+            }
         }
         Ok(())
     }

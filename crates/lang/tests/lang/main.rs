@@ -9,6 +9,7 @@ mod errors;
 mod exporter_scale;
 mod fuzz;
 mod limits;
+mod material_colors;
 mod overrides;
 mod scenes;
 mod second_step;

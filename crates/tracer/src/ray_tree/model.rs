@@ -201,9 +201,12 @@ pub struct LightRef {
 pub struct LocalIllumination {
     /// `ka·Ia·kd`.
     pub ambient: [f32; 3],
+    /// The material's emission; left out of the JSON when black, as most surfaces are.
+    #[serde(skip_serializing_if = "is_black")]
+    pub emission: [f32; 3],
     /// One entry per light, in scene order.
     pub lights: Vec<LightContribution>,
-    /// `ambient + Σ (diffuse + specular)`: the local colour before absorption.
+    /// `ambient + emission + Σ (diffuse + specular)`: the local colour before absorption.
     pub total: [f32; 3],
 }
 
@@ -304,4 +307,8 @@ pub enum SampleChoice {
     All,
     /// Only this one (the others are still traced, unrecorded, for the pixel's colour).
     One(u32),
+}
+
+fn is_black(c: &[f32; 3]) -> bool {
+    *c == [0.0; 3]
 }

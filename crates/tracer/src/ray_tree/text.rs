@@ -134,6 +134,9 @@ impl Printer {
         }
         if let Some(local) = &node.local {
             lines.push(format!("ambient    {}", self.color(local.ambient)));
+            if local.emission != [0.0; 3] {
+                lines.push(format!("emission   {}", self.color(local.emission)));
+            }
             for light in &local.lights {
                 lines.push(self.light_line(light));
             }

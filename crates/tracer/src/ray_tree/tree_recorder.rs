@@ -162,9 +162,25 @@ impl Recorder for TreeRecorder<'_> {
         *sum = ambient;
         node.local = Some(LocalIllumination {
             ambient: ambient.to_array(),
+            emission: [0.0; 3],
             lights: Vec::new(),
             total: ambient.to_array(),
         });
+    }
+
+    fn emission(&mut self, emission: Vec3A) {
+        if self.dropped_open > 0 {
+            return;
+        }
+        let (Some(node), Some(sum)) = (self.open.last_mut(), self.local_sums.last_mut()) else {
+            return;
+        };
+        // The tracer's own order: `ambient + emission`, before any light.
+        *sum += emission;
+        if let Some(local) = node.local.as_mut() {
+            local.emission = emission.to_array();
+            local.total = sum.to_array();
+        }
     }
 
     fn light_sampled(&mut self, sample: &LightSample) {
@@ -259,6 +275,7 @@ impl Recorder for TreeRecorder<'_> {
         }
         let local = node.local.get_or_insert_with(|| LocalIllumination {
             ambient: [0.0; 3],
+            emission: [0.0; 3],
             lights: Vec::new(),
             total: [0.0; 3],
         });

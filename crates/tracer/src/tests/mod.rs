@@ -4,6 +4,7 @@
 mod acne;
 mod bvh_oracle;
 mod csg_scenes;
+mod emission;
 mod energy;
 mod media_scenes;
 mod optics_scenes;
