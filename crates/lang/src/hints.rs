@@ -188,10 +188,6 @@ const FOREIGN: &[(&str, &str)] = &[
         "brilliance",
         "whitted's diffuse shading is Lambert's, with no `brilliance`: leave it out",
     ),
-    (
-        "emission",
-        "whitted has no emitting surfaces: a material's `ambient` keeps its colour in shadow, and a `light` is what lights the scene",
-    ),
     // Lights.
     (
         "area_light",

@@ -462,7 +462,6 @@ fn more_foreign_words() {
             ("hollow", "sphere { radius 1 hollow }\n"),
             ("roughness", "material m { roughness 0.05 }\n"),
             ("metallic", "material m { specular 0.5 metallic }\n"),
-            ("emission", "material m { emission <1, 1, 1> }\n"),
             (
                 "an area light",
                 "light point { position <0, 5, 0> area_light }\n",
