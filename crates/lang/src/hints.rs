@@ -16,7 +16,7 @@ const FOREIGN: &[(&str, &str)] = &[
     ),
     (
         "rgb",
-        "`rgb` is a function: write `rgb(0.9, 0.9, 0.9)`, with no space before the bracket, or just `<0.9, 0.9, 0.9>`",
+        "`rgb` is a function: write `rgb(0.9, 0.9, 0.9)`, with no space before the bracket, or `<0.9, 0.9, 0.9>`, or `0.9` alone for a grey",
     ),
     (
         "rgbf",
@@ -217,15 +217,17 @@ pub(crate) fn syntax(text: &str, pos: usize) -> Vec<String> {
     hints
 }
 
-/// The property name before a comma that ends `before` (`center <0, 0, 0>, radius` gives
-/// `radius`): a comma put between two properties, as in a list.
-pub(crate) fn comma_before_property(before: &str) -> Option<&str> {
+/// The property name before a comma that ends `before`, with the comma's byte offset
+/// (`center <0, 0, 0>, radius` gives `radius` and 17): a comma put between two properties,
+/// as in a list.
+pub(crate) fn comma_before_property(before: &str) -> Option<(&str, usize)> {
     let trimmed = before.trim_end();
     let word_start = last_word_start(trimmed);
     let word = &trimmed[word_start..];
     let is_property = Prop::ALL.iter().any(|p| p.name() == word);
-    let comma_before = trimmed[..word_start].trim_end().ends_with(',');
-    (is_property && comma_before).then_some(word)
+    let head = trimmed[..word_start].trim_end();
+    let comma = head.strip_suffix(',').map(str::len);
+    comma.filter(|_| is_property).map(|at| (word, at))
 }
 
 /// The object kind when `before` ends with `kind {` and a bare value follows.
@@ -271,11 +273,11 @@ mod tests {
     fn a_comma_between_properties_is_found_only_before_a_property_name() {
         assert_eq!(
             comma_before_property("sphere { center <0,0,0>, radius"),
-            Some("radius")
+            Some(("radius", 23))
         );
         assert_eq!(
-            comma_before_property("sphere { center <0,0,0>, radius "),
-            Some("radius")
+            comma_before_property("sphere { center <0,0,0> ,\n radius "),
+            Some(("radius", 24))
         );
         assert_eq!(comma_before_property("vertices a, b"), None);
         assert_eq!(comma_before_property("sphere { radius"), None);

@@ -488,7 +488,10 @@ impl<'a> Resolver<'a> {
                     Context::Object(parent) => parent.is_container(),
                     _ => false,
                 };
-                if !allowed {
+                // A foreign block (`pigment { ... }`) gets its advice as an unknown kind;
+                // saying that an object cannot go here as well would mislead.
+                let foreign = crate::hints::foreign(self.name(kind.sym)).is_some();
+                if !allowed && !foreign {
                     let hint = match cx {
                         Context::Object(_) => "only `union`, `intersection`, `difference` and `group` hold other objects",
                         _ => "objects go at the top level, in functions, or inside `union`, `intersection`, `difference` and `group`",
