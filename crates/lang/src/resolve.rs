@@ -558,13 +558,16 @@ impl<'a> Resolver<'a> {
         let name = self.name(kind.sym);
         let mut diagnostic = Diagnostic::error(format!("unknown {what} kind `{name}`"), kind.span)
             .with_label(format!("not a kind of {what}"));
-        diagnostic = match closest(name, names.iter().copied()) {
-            Some(best) => diagnostic.with_hint(format!("did you mean `{best}`?")),
-            None => diagnostic.with_hint(format!("the kinds are {}", list_or(names))),
+        // A foreign word's advice says what to write instead; the list of kinds would only
+        // bury it.
+        diagnostic = match (
+            crate::hints::foreign(name),
+            closest(name, names.iter().copied()),
+        ) {
+            (Some(advice), _) => diagnostic.with_hint(advice),
+            (None, Some(best)) => diagnostic.with_hint(format!("did you mean `{best}`?")),
+            (None, None) => diagnostic.with_hint(format!("the kinds are {}", list_or(names))),
         };
-        if let Some(advice) = crate::hints::foreign(name) {
-            diagnostic = diagnostic.with_hint(advice);
-        }
         self.error(diagnostic);
     }
 
