@@ -297,6 +297,13 @@ pub fn translate(
         diagnostic =
             diagnostic.with_secondary(Span::new(file, comma, comma + 1), "remove this comma");
     }
+    // The word the advice is about, unless the error already points at it.
+    if let Some((start, end)) =
+        crate::hints::first_foreign_word(text, pos).filter(|&(start, _)| start != pos)
+    {
+        diagnostic =
+            diagnostic.with_secondary(Span::new(file, start, end), "see the help about this");
+    }
     for hint in hints(&expected, text, pos, &found) {
         diagnostic = diagnostic.with_hint(hint);
     }
