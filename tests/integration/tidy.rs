@@ -69,15 +69,33 @@ fn purpose(text: &str) -> Option<String> {
             sentence.push(' ');
         }
         sentence.push_str(rest);
-        if let Some(end) = sentence.find(". ") {
+        if let Some(end) = sentence_end(&sentence) {
             sentence.truncate(end + 1);
             break;
         }
-        if sentence.ends_with('.') {
+        if sentence.ends_with('.') && !sentence.ends_with("...") {
             break;
         }
     }
     Some(sentence)
+}
+
+/// Where the first sentence of `text` ends: the first `.` followed by a space that is not
+/// part of an ellipsis (`for ... step` is not the end of a sentence).
+fn sentence_end(text: &str) -> Option<usize> {
+    let bytes = text.as_bytes();
+    (0..bytes.len().saturating_sub(1))
+        .find(|&i| bytes[i] == b'.' && bytes[i + 1] == b' ' && (i == 0 || bytes[i - 1] != b'.'))
+}
+
+#[test]
+fn a_sentence_ends_at_a_full_stop_but_not_at_an_ellipsis() {
+    assert_eq!(purpose("//! One. Two.\n"), Some("One.".to_string()));
+    assert_eq!(
+        purpose("//! `for ...\n//! step` loops. More.\n"),
+        Some("`for ... step` loops.".to_string())
+    );
+    assert_eq!(purpose("fn main() {}\n"), None);
 }
 
 #[test]
@@ -168,6 +186,14 @@ fn every_path_architecture_md_names_exists() {
     .map(|c| root.join(c))
     .chain([root.join("xtask"), root.clone()])
     .collect();
+    let exists = |token: &str| {
+        root.join(token).exists()
+            || crates
+                .iter()
+                .any(|c| c.join(token).exists() || c.join("src").join(token).exists())
+            || (!token.contains('/') && files.iter().any(|f| f.ends_with(&format!("/{token}"))))
+            || (token.contains('/') && files.iter().any(|f| f.contains(&format!("/{token}"))))
+    };
     let mut missing = Vec::new();
     for token in text.split('`').skip(1).step_by(2) {
         let token = token.trim_end_matches(['/', ',', '.']);
@@ -178,14 +204,31 @@ fn every_path_architecture_md_names_exists() {
         if !looks_like_path || token.contains(" ") || token.starts_with("//") {
             continue;
         }
-        let found = root.join(token).exists()
-            || crates
-                .iter()
-                .any(|c| c.join(token).exists() || c.join("src").join(token).exists())
-            || (!token.contains('/') && files.iter().any(|f| f.ends_with(&format!("/{token}"))))
-            || (token.contains('/') && files.iter().any(|f| f.contains(&format!("/{token}"))));
-        if !found {
+        if !exists(token) {
             missing.push(token.to_string());
+        }
+    }
+    // Paths written as plain words too ("checked by tests/integration/tidy.rs"): any word
+    // that starts with one of the repository's top-level folders.
+    const TOP: [&str; 8] = [
+        "crates/",
+        "src/",
+        "tests/",
+        "xtask/",
+        "docs/",
+        "scenes/",
+        "grammar/",
+        "examples/",
+    ];
+    for word in text.split(|c: char| c.is_whitespace() || c == '`') {
+        let word = word.trim_end_matches("'s");
+        let word = word.trim_matches(|c: char| "()[],.;:'\"".contains(c));
+        if TOP.iter().any(|top| word.starts_with(top))
+            && !word.contains(['*', '<', '{'])
+            && !exists(word.trim_end_matches('/'))
+            && !missing.iter().any(|m| m == word)
+        {
+            missing.push(word.to_string());
         }
     }
     assert!(

@@ -18,7 +18,7 @@ const FOREIGN: &[(&str, &str)] = &[
     ),
     (
         "rgb",
-        "`rgb` is a function: write `rgb(0.9, 0.9, 0.9)`, with no space before the bracket, or just `<0.9, 0.9, 0.9>`",
+        "`rgb` is a function: write `rgb(0.9, 0.9, 0.9)`, with no space before the bracket, or `<0.9, 0.9, 0.9>`, or `0.9` alone for a grey",
     ),
     (
         "rgbf",
@@ -283,10 +283,33 @@ pub(crate) fn syntax(text: &str, pos: usize) -> Vec<String> {
             named_example(kind)
         ));
     }
+    for (_, word, advice) in foreign_words_on_line(text, pos) {
+        if advice.starts_with(&format!("`{word}`")) {
+            hints.push(advice.to_string());
+        } else {
+            hints.push(format!("`{word}`: {advice}"));
+        }
+    }
+    hints
+}
+
+/// Where the first foreign word on the line of a syntax error at byte `pos` is (a byte range
+/// of `text`), so the error can point at the word its advice is about.
+pub(crate) fn first_foreign_word(text: &str, pos: usize) -> Option<(usize, usize)> {
+    let (start, word, _) = *foreign_words_on_line(text, pos).first()?;
+    Some((start, start + word.len()))
+}
+
+/// The foreign words on the line holding byte `pos`, each once, with its byte offset in
+/// `text` and its advice; directives (`#declare`) and whitted's own property names are left
+/// out.
+fn foreign_words_on_line(text: &str, pos: usize) -> Vec<(usize, &str, &'static str)> {
+    let before = text.get(..pos).unwrap_or("");
+    let next = text.get(pos..).unwrap_or("");
     let line_start = before.rfind('\n').map_or(0, |i| i + 1);
     let line_end = next.find('\n').map_or(text.len(), |i| pos + i);
     let line = text.get(line_start..line_end).unwrap_or("");
-    let mut seen = Vec::new();
+    let mut found: Vec<(usize, &str, &'static str)> = Vec::new();
     let mut rest = line;
     while let Some(start) = rest.find(|c: char| c.is_ascii_alphabetic() || c == '_') {
         let directive = rest[..start].ends_with('#');
@@ -295,32 +318,33 @@ pub(crate) fn syntax(text: &str, pos: usize) -> Vec<String> {
             .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
             .unwrap_or(tail.len());
         let word = &tail[..end];
+        let offset = line_start + (line.len() - tail.len());
         rest = &tail[end..];
-        // Directives got their advice above; whitted's own property names are not foreign.
-        if directive || seen.contains(&word) || Prop::ALL.iter().any(|p| p.name() == word) {
+        // Directives get their own advice; whitted's own property names are not foreign.
+        if directive
+            || found.iter().any(|(_, seen, _)| *seen == word)
+            || Prop::ALL.iter().any(|p| p.name() == word)
+        {
             continue;
         }
         if let Some(advice) = foreign(word) {
-            seen.push(word);
-            if advice.starts_with(&format!("`{word}`")) {
-                hints.push(advice.to_string());
-            } else {
-                hints.push(format!("`{word}`: {advice}"));
-            }
+            found.push((offset, word, advice));
         }
     }
-    hints
+    found
 }
 
-/// The property name before a comma that ends `before` (`center <0, 0, 0>, radius` gives
-/// `radius`): a comma put between two properties, as in a list.
-pub(crate) fn comma_before_property(before: &str) -> Option<&str> {
+/// The property name before a comma that ends `before`, with the comma's byte offset
+/// (`center <0, 0, 0>, radius` gives `radius` and 17): a comma put between two properties,
+/// as in a list.
+pub(crate) fn comma_before_property(before: &str) -> Option<(&str, usize)> {
     let trimmed = before.trim_end();
     let word_start = last_word_start(trimmed);
     let word = &trimmed[word_start..];
     let is_property = Prop::ALL.iter().any(|p| p.name() == word);
-    let comma_before = trimmed[..word_start].trim_end().ends_with(',');
-    (is_property && comma_before).then_some(word)
+    let head = trimmed[..word_start].trim_end();
+    let comma = head.strip_suffix(',').map(str::len);
+    comma.filter(|_| is_property).map(|at| (word, at))
 }
 
 /// The object kind when `before` ends with `kind {` and a bare value follows.
@@ -366,11 +390,11 @@ mod tests {
     fn a_comma_between_properties_is_found_only_before_a_property_name() {
         assert_eq!(
             comma_before_property("sphere { center <0,0,0>, radius"),
-            Some("radius")
+            Some(("radius", 23))
         );
         assert_eq!(
-            comma_before_property("sphere { center <0,0,0>, radius "),
-            Some("radius")
+            comma_before_property("sphere { center <0,0,0> ,\n radius "),
+            Some(("radius", 24))
         );
         assert_eq!(comma_before_property("vertices a, b"), None);
         assert_eq!(comma_before_property("sphere { radius"), None);
@@ -379,6 +403,19 @@ mod tests {
         assert_eq!(comma_before_property(" /**/ if\n[\u{feff}matrial"), None);
         assert_eq!(comma_before_property("a, \u{feff}radius"), None);
         assert_eq!(comma_before_property("a,\u{e9}radius"), None);
+    }
+
+    #[test]
+    fn the_first_foreign_word_on_the_line_is_found_by_its_bytes() {
+        let text = "let a = 1;\nsphere { radius 1 no_shadow }\n";
+        let (start, end) = first_foreign_word(text, text.find('}').unwrap()).unwrap();
+        assert_eq!(&text[start..end], "no_shadow");
+        // Property names and words on other lines are not foreign words of this line.
+        assert_eq!(first_foreign_word("mesh\ncolor 1 }", 13), None);
+        let text = "material { diffuse rgb 1 }";
+        let (start, end) = first_foreign_word(text, 23).unwrap();
+        assert_eq!(&text[start..end], "rgb");
+        assert_eq!(first_foreign_word("#declare R", 0), None);
     }
 
     #[test]

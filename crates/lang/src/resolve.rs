@@ -490,7 +490,10 @@ impl<'a> Resolver<'a> {
                     Context::Object(parent) => parent.is_container(),
                     _ => false,
                 };
-                if !allowed {
+                // A foreign block (`pigment { ... }`) gets its advice as an unknown kind;
+                // saying that an object cannot go here as well would mislead.
+                let foreign = crate::hints::foreign(self.name(kind.sym)).is_some();
+                if !allowed && !foreign {
                     let hint = match cx {
                         Context::Object(_) => "only `union`, `intersection`, `difference` and `group` hold other objects",
                         _ => "objects go at the top level, in functions, or inside `union`, `intersection`, `difference` and `group`",
@@ -555,13 +558,16 @@ impl<'a> Resolver<'a> {
         let name = self.name(kind.sym);
         let mut diagnostic = Diagnostic::error(format!("unknown {what} kind `{name}`"), kind.span)
             .with_label(format!("not a kind of {what}"));
-        diagnostic = match closest(name, names.iter().copied()) {
-            Some(best) => diagnostic.with_hint(format!("did you mean `{best}`?")),
-            None => diagnostic.with_hint(format!("the kinds are {}", list_or(names))),
+        // A foreign word's advice says what to write instead; the list of kinds would only
+        // bury it.
+        diagnostic = match (
+            crate::hints::foreign(name),
+            closest(name, names.iter().copied()),
+        ) {
+            (Some(advice), _) => diagnostic.with_hint(advice),
+            (None, Some(best)) => diagnostic.with_hint(format!("did you mean `{best}`?")),
+            (None, None) => diagnostic.with_hint(format!("the kinds are {}", list_or(names))),
         };
-        if let Some(advice) = crate::hints::foreign(name) {
-            diagnostic = diagnostic.with_hint(advice);
-        }
         self.error(diagnostic);
     }
 

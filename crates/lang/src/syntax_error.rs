@@ -290,6 +290,20 @@ pub fn translate(
             );
         }
     }
+    if let (Some((_, comma)), true) = (
+        crate::hints::comma_before_property(text.get(..pos).unwrap_or("")),
+        expected.punctuation.contains(&",") && !expected.in_vector && expected.statement,
+    ) {
+        diagnostic =
+            diagnostic.with_secondary(Span::new(file, comma, comma + 1), "remove this comma");
+    }
+    // The word the advice is about, unless the error already points at it.
+    if let Some((start, end)) =
+        crate::hints::first_foreign_word(text, pos).filter(|&(start, _)| start != pos)
+    {
+        diagnostic =
+            diagnostic.with_secondary(Span::new(file, start, end), "see the help about this");
+    }
     for hint in hints(&expected, text, pos, &found) {
         diagnostic = diagnostic.with_hint(hint);
     }
@@ -309,7 +323,7 @@ fn hints(expected: &Expected, text: &str, pos: usize, found: &str) -> Vec<String
     if expected.punctuation.contains(&",") {
         if expected.in_vector {
             hints.push("vectors are written `<x, y, z>`, with commas".to_string());
-        } else if let (Some(property), true) = (comma_before_property, expected.statement) {
+        } else if let (Some((property, _)), true) = (comma_before_property, expected.statement) {
             hints.push(format!(
                 "a comma separates the values of one property, not properties: remove the `,` before `{property}`"
             ));

@@ -443,6 +443,22 @@ fn foreign_words_and_habits() {
             ),
             ("a positional sphere", "sphere { <0, 0, 0>, 1 }\n"),
             ("a positional box", "box { <0, 0, 0>, <1, 1, 1> }\n"),
+            (
+                "a comma between properties on two lines",
+                "sphere {\n    center <0, 0, 0>,\n    radius 1\n}\n",
+            ),
+            ("an x axis", "plane { normal x }\n"),
+            ("a z axis", "disk { normal z }\n"),
+            ("#local", "fn f() {\n    #local R = 1;\n}\n"),
+            (
+                "a transmit channel",
+                "material m { diffuse rgbt <1, 1, 1, 0.5> }\n",
+            ),
+            ("filter", "material m { filter 0.5 }\n"),
+            ("transmit", "material m { transmit 0.5 }\n"),
+            ("a finish block", "sphere { finish { phong 1 } }\n"),
+            ("a texture block", "sphere { texture { } }\n"),
+            ("a mesh2", "mesh2 { }\n"),
         ],
     );
 }
