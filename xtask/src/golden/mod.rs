@@ -84,14 +84,18 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     };
     // Built as `cargo test --workspace` builds it (same profile and the same unified
     // features, dev-dependencies included), so that after the tests of `cargo xtask ci` this
-    // is a no-op instead of a second build of five crates with other features.
+    // is a no-op instead of a second build of five crates with other features. The target is
+    // the integration tests, because building them builds `target/debug/whitted` itself:
+    // `--bin whitted` built only the binary's unit-test harness, so after a source change the
+    // executable run below was stale, and two references were blessed from old code (blinn
+    // as Phong; marble before its veins changed) until a later build refreshed it.
     run_cargo(&[
         "test",
         "--workspace",
         "--locked",
         "--no-run",
-        "--bin",
-        "whitted",
+        "--test",
+        "integration",
     ])?;
     let exe = root.join("target/debug/whitted");
     let out_dir = root.join("target/golden");
