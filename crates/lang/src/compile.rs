@@ -408,6 +408,28 @@ impl Loading<'_> {
     }
 }
 
+impl Loading<'_> {
+    /// Parses the expression after `NAME=` (at `offset`) in the pseudo-file `file` of a `-D`
+    /// or `--set`, keeping any problem found while building it.
+    fn parse_value(
+        &mut self,
+        file: FileId,
+        text: &str,
+        offset: usize,
+    ) -> Result<crate::ast::Expr, Diagnostic> {
+        let mut cx = ParseContext::new(
+            file,
+            &mut self.interner,
+            &mut self.program.functions,
+            self.max_tree_depth,
+        );
+        let result = parser::parse_define_value(text, offset, &mut cx, self.max_nesting);
+        let build_errors = std::mem::take(&mut cx.errors);
+        self.diagnostics.extend(build_errors);
+        result
+    }
+}
+
 fn has_error(diagnostics: &[Diagnostic]) -> bool {
     diagnostics.iter().any(Diagnostic::is_error)
 }
@@ -574,17 +596,8 @@ fn parse_defines(loading: &mut Loading<'_>, defines: &[(String, String)]) -> Opt
             continue;
         }
         seen.insert(name, (name_span, value));
-        let mut cx = ParseContext::new(
-            file,
-            &mut loading.interner,
-            &mut loading.program.functions,
-            loading.max_tree_depth,
-        );
-        let result =
-            parser::parse_define_value(&text, name.len() + 1, &mut cx, loading.max_nesting);
-        let build_errors = std::mem::take(&mut cx.errors);
+        let result = loading.parse_value(file, &text, name.len() + 1);
         let sym = loading.interner.intern(name);
-        loading.diagnostics.extend(build_errors);
         match result {
             Ok(value) => parsed.push(Define {
                 name: sym,
@@ -679,26 +692,14 @@ fn parse_setting_overrides(
                     continue;
                 }
             },
-            _ => {
-                let mut cx = ParseContext::new(
-                    file,
-                    &mut loading.interner,
-                    &mut loading.program.functions,
-                    loading.max_tree_depth,
-                );
-                let result =
-                    parser::parse_define_value(&text, name.len() + 1, &mut cx, loading.max_nesting);
-                let build_errors = std::mem::take(&mut cx.errors);
-                loading.diagnostics.extend(build_errors);
-                match result {
-                    Ok(expr) => OverrideValue::Expr(expr),
-                    Err(diagnostic) => {
-                        loading.diagnostics.push(diagnostic);
-                        ok = false;
-                        continue;
-                    }
+            _ => match loading.parse_value(file, &text, name.len() + 1) {
+                Ok(expr) => OverrideValue::Expr(expr),
+                Err(diagnostic) => {
+                    loading.diagnostics.push(diagnostic);
+                    ok = false;
+                    continue;
                 }
-            }
+            },
         };
         parsed.push(SettingOverride {
             prop: row.prop,

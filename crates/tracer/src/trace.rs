@@ -602,10 +602,10 @@ impl<'a> Tracer<'a> {
         meeting
     }
 
-    /// `ka·Ia·kd`, plus the surface's own emission, plus, for every light on the visible side, `fatt·spot·Ii·(kd·(N·L) +
-    /// ks·(R·V)^n)` (or `ks·(N·H)^n` with `highlight blinn`) times what the shadow ray lets
-    /// through. `outside` is the hit point
-    /// already moved off the surface along `n`, which faces the viewer. The order of the
+    /// `ka·Ia·kd`, plus the surface's own emission, plus, for every light on the visible
+    /// side, `fatt·spot·Ii·(kd·(N·L) + ks·(R·V)^n)` (or `ks·(N·H)^n` with `highlight blinn`)
+    /// times what the shadow ray lets through. `outside` is the hit point already moved off
+    /// the surface along `n`, which faces the viewer. The order of the
     /// additions is part of the recorder contract (see `recorder.rs`): keep it.
     fn local_illumination<R: Recorder>(
         &mut self,

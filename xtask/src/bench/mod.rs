@@ -248,7 +248,11 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     println!("\ncompile only (`whitted check`, one core; wall includes process start)");
     println!("{:<34} {:>8} {:>12}", "scene", "wall", "peak memory");
     for case in COMPILES {
-        let (wall, peak_kib) = time_check(&exe, &root.join(case.scene), case.defines)?;
+        let mut args = vec!["check"];
+        for define in case.defines {
+            args.extend(["-D", define]);
+        }
+        let (wall, peak_kib) = measure(&exe, &args, &root.join(case.scene))?;
         let memory = peak_kib.map_or("n/a".to_string(), |k| {
             format!("{:.0} MiB", k as f64 / 1024.0)
         });
@@ -257,8 +261,13 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     programs::run(&exe, &out_dir, RUNS)
 }
 
-/// Wall time and, where /usr/bin/time exists, peak resident memory of `whitted check`.
-fn time_check(exe: &Path, scene: &Path, defines: &[&str]) -> anyhow::Result<(f64, Option<u64>)> {
+/// Wall seconds and, where /usr/bin/time exists, peak resident KiB of one `whitted ARGS SCENE`
+/// run (the compile table here and the table of scenes written by programs).
+pub(super) fn measure(
+    exe: &Path,
+    args: &[&str],
+    scene: &Path,
+) -> anyhow::Result<(f64, Option<u64>)> {
     let gnu_time = Path::new("/usr/bin/time");
     let mut command = if gnu_time.exists() {
         let mut c = Command::new(gnu_time);
@@ -267,16 +276,14 @@ fn time_check(exe: &Path, scene: &Path, defines: &[&str]) -> anyhow::Result<(f64
     } else {
         Command::new(exe)
     };
-    command.arg("check").arg(scene);
-    for define in defines {
-        command.args(["-D", define]);
-    }
+    command.args(args).arg(scene);
     let started = Instant::now();
     let result = command.output()?;
     let wall = started.elapsed().as_secs_f64();
     if !result.status.success() {
         bail!(
-            "check {} failed:\n{}",
+            "whitted {} {} failed:\n{}",
+            args.join(" "),
             scene.display(),
             String::from_utf8_lossy(&result.stderr)
         );

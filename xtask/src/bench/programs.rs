@@ -7,10 +7,10 @@
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::time::Instant;
 
-use anyhow::{bail, Context};
+use anyhow::Context;
+
+use super::measure;
 
 const HEADER: &str = "camera perspective { eye <0, 5, -60> look_at <0, 0, 0> fov 60 }\n\
                       light point { position <10, 40, -30> color <1, 1, 1> }\n\
@@ -79,35 +79,6 @@ fn write_scene(dir: &Path, name: &str, label: String, text: String) -> anyhow::R
         path,
         bytes: text.len() as u64,
     })
-}
-
-/// Wall seconds and peak resident KiB (when /usr/bin/time exists) of one `whitted` run.
-fn measure(exe: &Path, args: &[&str], scene: &Path) -> anyhow::Result<(f64, Option<u64>)> {
-    let gnu_time = Path::new("/usr/bin/time");
-    let mut command = if gnu_time.exists() {
-        let mut c = Command::new(gnu_time);
-        c.args(["-f", "%M"]).arg(exe);
-        c
-    } else {
-        Command::new(exe)
-    };
-    command.args(args).arg(scene);
-    let started = Instant::now();
-    let result = command.output()?;
-    let wall = started.elapsed().as_secs_f64();
-    if !result.status.success() {
-        bail!(
-            "whitted {} {} failed:\n{}",
-            args.join(" "),
-            scene.display(),
-            String::from_utf8_lossy(&result.stderr)
-        );
-    }
-    let peak = String::from_utf8_lossy(&result.stderr)
-        .lines()
-        .last()
-        .and_then(|line| line.trim().parse::<u64>().ok());
-    Ok((wall, peak))
 }
 
 /// Best of `runs` (the run least disturbed by other work) by wall time.

@@ -356,6 +356,29 @@ impl<'t> Reader<'t, '_, '_> {
         }
     }
 
+    /// `block?`: a block if one follows, else nothing consumed.
+    fn optional_block(&mut self) -> Option<(Block, Depth)> {
+        let checkpoint = self.checkpoint();
+        let found = self.block();
+        if found.is_none() {
+            self.restore(checkpoint);
+        }
+        found
+    }
+
+    /// `(kw_KEYWORD ~ expr)?`: the expression after the keyword if both follow, else nothing
+    /// consumed.
+    fn optional_keyword_expr(&mut self, keyword: &str) -> Option<(Expr, Depth)> {
+        let checkpoint = self.checkpoint();
+        self.keyword(keyword)?;
+        self.skip();
+        let found = self.expr(false);
+        if found.is_none() {
+            self.restore(checkpoint);
+        }
+        found
+    }
+
     fn block(&mut self) -> Option<(Block, Depth)> {
         self.nested(|r| {
             let start = r.pos;
@@ -582,18 +605,12 @@ impl<'t> Reader<'t, '_, '_> {
         let (end, end_depth) = self.expr(false)?;
         self.skip();
         let mut depth = start_depth.max(end_depth);
-        let checkpoint = self.checkpoint();
-        let mut step = None;
-        if self.keyword("step").is_some() {
-            self.skip();
-            match self.expr(false) {
-                Some((value, step_depth)) => {
-                    step = Some(value);
-                    depth = depth.max(step_depth);
-                }
-                None => self.restore(checkpoint),
-            }
-        }
+        let step = self
+            .optional_keyword_expr("step")
+            .map(|(value, step_depth)| {
+                depth = depth.max(step_depth);
+                value
+            });
         self.skip();
         let (body, body_depth) = self.block()?;
         let kind = ItemKind::For {
@@ -786,17 +803,10 @@ impl<'t> Reader<'t, '_, '_> {
     fn call_stmt(&mut self) -> Option<(ItemKind, Depth)> {
         let (call, mut depth) = self.call()?;
         self.skip();
-        let checkpoint = self.checkpoint();
-        let modifiers = match self.block() {
-            Some((block, block_depth)) => {
-                depth = depth.max(block_depth);
-                Some(block)
-            }
-            None => {
-                self.restore(checkpoint);
-                None
-            }
-        };
+        let modifiers = self.optional_block().map(|(block, block_depth)| {
+            depth = depth.max(block_depth);
+            block
+        });
         Some((
             ItemKind::Call {
                 call: Box::new(call),
@@ -878,30 +888,17 @@ impl<'t> Reader<'t, '_, '_> {
             }
         }
         self.skip();
-        let checkpoint = self.checkpoint();
-        let mut about = None;
-        if self.keyword("about").is_some() {
-            self.skip();
-            match self.expr(false) {
-                Some((value, about_depth)) => {
-                    about = Some(value);
-                    depth = depth.max(about_depth);
-                }
-                None => self.restore(checkpoint),
-            }
-        }
+        let about = self
+            .optional_keyword_expr("about")
+            .map(|(value, about_depth)| {
+                depth = depth.max(about_depth);
+                value
+            });
         self.skip();
-        let checkpoint = self.checkpoint();
-        let block = match self.block() {
-            Some((block, block_depth)) => {
-                depth = depth.max(block_depth);
-                Some(block)
-            }
-            None => {
-                self.restore(checkpoint);
-                None
-            }
-        };
+        let block = self.optional_block().map(|(block, block_depth)| {
+            depth = depth.max(block_depth);
+            block
+        });
         let kind = ItemKind::Property(property(name, values, about, block));
         Some((kind, depth))
     }
