@@ -5,6 +5,7 @@
 // A program, not a library: it prints its results and sets its exit status.
 #![allow(clippy::print_stdout, clippy::print_stderr, clippy::exit)]
 
+mod allocator;
 mod cli;
 mod debug_cmd;
 mod image_output;
@@ -40,6 +41,7 @@ impl From<std::io::Error> for Failure {
 }
 
 fn main() -> ExitCode {
+    allocator::configure();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Check(args) => scene_input::check(&args),

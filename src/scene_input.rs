@@ -54,7 +54,13 @@ pub fn read_source(path: &Path) -> std::io::Result<Vec<u8>> {
     if !kind.is_file() {
         return Err(not_regular(file_kind(kind)));
     }
+    // Room for the whole file up front (one byte more, so that reaching its end needs no
+    // growth): growing by doubling would copy and touch a large generated scene twice over.
+    let expected = usize::try_from(file.metadata()?.len()).unwrap_or(usize::MAX);
     let mut bytes = Vec::new();
+    bytes
+        .try_reserve_exact(expected.min(limit) + 1)
+        .map_err(|_| Error::new(ErrorKind::OutOfMemory, "not enough memory to read it"))?;
     file.take(limit as u64 + 1).read_to_end(&mut bytes)?;
     if bytes.len() > limit {
         return Err(Error::new(

@@ -65,19 +65,22 @@ pub struct LineCol {
 pub struct SourceFile {
     /// The path as the user or the importing file named it (shown in diagnostics).
     pub path: String,
-    pub text: Arc<str>,
+    /// An `Arc<String>` rather than an `Arc<str>`: a file's text moves in without being
+    /// copied (a generated scene can be hundreds of megabytes).
+    pub text: Arc<String>,
     line_starts: Arc<[u32]>,
 }
 
 impl SourceFile {
-    pub fn new(path: impl Into<String>, text: impl Into<Arc<str>>) -> Self {
-        let text: Arc<str> = text.into();
-        let mut line_starts = vec![0u32];
-        for (i, byte) in text.bytes().enumerate() {
-            if byte == b'\n' {
-                line_starts.push(u32::try_from(i + 1).unwrap_or(u32::MAX));
-            }
-        }
+    pub fn new(path: impl Into<String>, text: impl Into<String>) -> Self {
+        let text = Arc::new(text.into());
+        // memchr finds the newlines many bytes at a time: a generated scene is millions of lines.
+        let line_starts: Vec<u32> = std::iter::once(0)
+            .chain(
+                memchr::memchr_iter(b'\n', text.as_bytes())
+                    .map(|i| u32::try_from(i + 1).unwrap_or(u32::MAX)),
+            )
+            .collect();
         SourceFile {
             path: path.into(),
             text,

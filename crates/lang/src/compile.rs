@@ -525,6 +525,14 @@ fn compile_root(
     // Evaluation runs even after resolution errors (unresolved names evaluate quietly to
     // nothing), so that one run reports every error it can find.
 
+    // The root file's items are handed to the evaluator to own, so each is dropped as soon
+    // as it has run: a scene written by a program is mostly its root file, and its syntax
+    // tree is then given back while the scene grows rather than held beside all of it.
+    let root_items = program
+        .files
+        .first_mut()
+        .map(|root| std::mem::take(&mut root.items))
+        .unwrap_or_default();
     let evaluator = crate::eval::Evaluator::new(
         &program,
         &interner,
@@ -537,7 +545,7 @@ fn compile_root(
         sources.clone(),
         max_evaluation_depth,
     );
-    let (scene, eval_diagnostics, failed) = evaluator.run();
+    let (scene, eval_diagnostics, failed) = evaluator.run(root_items);
     diagnostics.extend(eval_diagnostics);
     if failed || has_error(&diagnostics) {
         return finish(sources, None, diagnostics, work);

@@ -33,7 +33,12 @@ impl Interner {
 
     /// Forgets every name interned after `mark` (a parse that was abandoned), so the
     /// symbols of a second attempt are numbered as if the first had never run.
+    #[inline]
     pub fn forget_after(&mut self, mark: usize) {
+        // Backtracking usually interned nothing: keep that case to one comparison.
+        if mark >= self.names.len() {
+            return;
+        }
         for name in self.names.drain(mark.min(self.names.len())..) {
             self.ids.remove(&name);
         }

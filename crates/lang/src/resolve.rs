@@ -107,6 +107,9 @@ pub struct Resolver<'a> {
     in_progress: Vec<bool>,
     /// See [`Resolution::name_probes`]; a cell because lookups only read.
     name_probes: Cell<u64>,
+    /// Each property name's row in each kind of block, once looked up: a script's million
+    /// statements ask the table about the same few names over and over.
+    property_rows: HashMap<(Sym, Context), Option<Prop>, foldhash::fast::FixedState>,
 }
 
 impl<'a> Resolver<'a> {
@@ -126,6 +129,7 @@ impl<'a> Resolver<'a> {
             resolution: Resolution::default(),
             in_progress: vec![false; file_count],
             name_probes: Cell::new(0),
+            property_rows: HashMap::default(),
         }
     }
 
@@ -175,15 +179,18 @@ impl<'a> Resolver<'a> {
         let saved_file = std::mem::replace(&mut self.file, index);
         let saved_later = std::mem::take(&mut self.later);
 
-        self.scopes.push(Scope::new(false));
         let mut items = std::mem::take(&mut program.files[index].items);
         // A script's file can define 100,000 names: sized once, not rehashed as it grows.
         self.later.reserve(items.len());
+        let mut top_level_names = 0;
         for item in &items {
             if let Some((sym, span)) = top_level_name(&item.kind, &program.functions) {
                 self.later.entry(sym).or_insert(span);
+                top_level_names += 1;
             }
         }
+        self.scopes.push(Scope::with_capacity(top_level_names));
+        self.definitions.reserve(top_level_names);
         let top = Context::Statements {
             top_level: true,
             in_function: false,
@@ -492,8 +499,7 @@ impl<'a> Resolver<'a> {
                 };
                 // A foreign block (`pigment { ... }`) gets its advice as an unknown kind;
                 // saying that an object cannot go here as well would mislead.
-                let foreign = crate::hints::foreign(self.name(kind.sym)).is_some();
-                if !allowed && !foreign {
+                if !allowed && crate::hints::foreign(self.name(kind.sym)).is_none() {
                     let hint = match cx {
                         Context::Object(_) => "only `union`, `intersection`, `difference` and `group` hold other objects",
                         _ => "objects go at the top level, in functions, or inside `union`, `intersection`, `difference` and `group`",

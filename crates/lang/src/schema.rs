@@ -120,7 +120,7 @@ impl CameraTag {
 }
 
 /// The kind of block an item sits in, which decides what the item may be.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Context {
     /// A file's top level, a function body, or a `for`/`if` block inside either.
     Statements {

@@ -44,6 +44,25 @@ fn literal_spheres(n: usize) -> String {
     text
 }
 
+/// The same spheres (the same coordinates) in POV-Ray's language, for its parse time.
+fn literal_spheres_pov(n: usize) -> String {
+    let mut text = String::with_capacity(n * 72);
+    text.push_str(
+        "camera { location <0, 5, -60> look_at <0, 0, 0> angle 60 }\n\
+         light_source { <10, 40, -30> color rgb <1, 1, 1> }\n\
+         #declare Red = texture { pigment { rgb <0.8, 0.2, 0.2> } }\n",
+    );
+    let mut at = Coordinates(17);
+    for _ in 0..n {
+        let (x, y, z) = (at.next(), at.next(), at.next());
+        let _ = writeln!(
+            text,
+            "sphere {{ <{x:.3}, {y:.3}, {z:.3}>, 0.05 texture {{ Red }} }}"
+        );
+    }
+    text
+}
+
 fn loop_spheres(n: usize) -> String {
     format!(
         "{HEADER}for i in 0..{n} {{\n  sphere {{ center <rand(1, i) * 40 - 20, rand(2, i) * 40 - 20, rand(3, i) * 40 - 20> radius 0.05 material red }}\n}}\n"
@@ -192,6 +211,28 @@ pub fn run(exe: &Path, out_dir: &Path, runs: usize) -> anyhow::Result<()> {
             "200k lets take {:.2}x the time of 100k (linear would be 2x)",
             two_hundred / hundred.max(1e-9)
         );
+    }
+    povray_parse_times(&dir, runs)
+}
+
+/// POV-Ray's own parse time of the literal spheres (its log's "Parse Time", best of
+/// `runs`), the figure issue 17's targets are set against. Skipped where POV-Ray is not
+/// installed.
+fn povray_parse_times(dir: &Path, runs: usize) -> anyhow::Result<()> {
+    if !Path::new(super::POVRAY).exists() {
+        println!("POV-Ray is not installed here: no parse times to compare with");
+        return Ok(());
+    }
+    for (count, label) in [(100_000, "100k"), (1_000_000, "1M")] {
+        let path = dir.join(format!("literal-{label}.pov"));
+        std::fs::write(&path, literal_spheres_pov(count))
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        let mut best = f64::INFINITY;
+        for _ in 0..runs {
+            let figures = super::run_povray(&path, dir, 64, 48, 1)?;
+            best = best.min(figures.parse_seconds);
+        }
+        println!("POV-Ray parses the same {label} literal spheres in {best:.3}s (its own parse time, best of {runs})");
     }
     Ok(())
 }

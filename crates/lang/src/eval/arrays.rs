@@ -39,7 +39,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// `[a, b, c]`.
-    pub(super) fn array_literal(&mut self, items: &'a [Expr], span: Span) -> Eval<Value> {
+    pub(super) fn array_literal(&mut self, items: &[Expr], span: Span) -> Eval<Value> {
         if items.len() > MAX_ARRAY_LENGTH {
             return self.fail(
                 Diagnostic::error(
@@ -66,12 +66,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// `base[index]`: bounds-checked, with a whole-number index.
-    pub(super) fn index_value(
-        &mut self,
-        base: &'a Expr,
-        index: &'a Expr,
-        span: Span,
-    ) -> Eval<Value> {
+    pub(super) fn index_value(&mut self, base: &Expr, index: &Expr, span: Span) -> Eval<Value> {
         let container = self.eval(base)?;
         let id = match container {
             Value::Array(id) => id,
@@ -135,7 +130,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// `len(array)` or `len(string)`.
-    pub(super) fn len_call(&mut self, call: &'a Call, args: &[Value]) -> Eval<Value> {
+    pub(super) fn len_call(&mut self, call: &Call, args: &[Value]) -> Eval<Value> {
         match args.first() {
             Some(Value::Array(id)) => Ok(Value::Number(
                 self.store.arrays.get(*id as usize).map_or(0, Vec::len) as f64,

@@ -14,14 +14,14 @@ use crate::value::Value;
 const MAX_WHOLE: f64 = 9_007_199_254_740_992.0;
 
 impl<'a> Evaluator<'a> {
-    pub(super) fn eval(&mut self, expr: &'a Expr) -> Eval<Value> {
+    pub(super) fn eval(&mut self, expr: &Expr) -> Eval<Value> {
         self.enter(expr.span)?;
         let value = self.eval_inner(expr);
         self.leave();
         value
     }
 
-    fn eval_inner(&mut self, expr: &'a Expr) -> Eval<Value> {
+    fn eval_inner(&mut self, expr: &Expr) -> Eval<Value> {
         let value = match &expr.kind {
             ExprKind::Number(x) => Value::Number(*x),
             ExprKind::Bool(b) => Value::Bool(*b),
@@ -101,7 +101,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// Evaluates a number; `what` names it in the error ("a loop's start").
-    pub(super) fn number(&mut self, expr: &'a Expr, what: &str) -> Eval<f64> {
+    pub(super) fn number(&mut self, expr: &Expr, what: &str) -> Eval<f64> {
         match self.eval(expr)? {
             Value::Number(x) => Ok(x),
             other => self.fail(
@@ -114,7 +114,7 @@ impl<'a> Evaluator<'a> {
         }
     }
 
-    pub(super) fn boolean(&mut self, expr: &'a Expr, what: &str) -> Eval<bool> {
+    pub(super) fn boolean(&mut self, expr: &Expr, what: &str) -> Eval<bool> {
         match self.eval(expr)? {
             Value::Bool(b) => Ok(b),
             other => self.fail(
@@ -132,7 +132,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// A number that must be whole (loop bounds).
-    pub(super) fn whole_number(&mut self, expr: &'a Expr, what: &str) -> Eval<i64> {
+    pub(super) fn whole_number(&mut self, expr: &Expr, what: &str) -> Eval<i64> {
         let x = self.number(expr, what)?;
         if x.fract() != 0.0 || x.abs() > MAX_WHOLE {
             return self.fail(
@@ -144,7 +144,7 @@ impl<'a> Evaluator<'a> {
         Ok(x as i64)
     }
 
-    fn binary(&mut self, op: BinaryOp, op_span: Span, lhs: &'a Expr, rhs: &'a Expr) -> Eval<Value> {
+    fn binary(&mut self, op: BinaryOp, op_span: Span, lhs: &Expr, rhs: &Expr) -> Eval<Value> {
         // `&&` and `||` look at their right side only when they need to.
         if matches!(op, BinaryOp::And | BinaryOp::Or) {
             let what = format!("the left side of `{}`", op.symbol());
@@ -218,7 +218,7 @@ impl<'a> Evaluator<'a> {
         self.finite(result, op_span)
     }
 
-    fn division_by_zero<T>(&mut self, op: BinaryOp, rhs: &'a Expr) -> Eval<T> {
+    fn division_by_zero<T>(&mut self, op: BinaryOp, rhs: &Expr) -> Eval<T> {
         let what = if op == BinaryOp::Rem {
             "remainder of a division by zero"
         } else {
@@ -254,7 +254,7 @@ impl<'a> Evaluator<'a> {
         )
     }
 
-    pub(super) fn call_builtin(&mut self, function: Function, call: &'a Call) -> Eval<Value> {
+    pub(super) fn call_builtin(&mut self, function: Function, call: &Call) -> Eval<Value> {
         let (low, high) = function.arity();
         if call.args.len() < low || call.args.len() > high {
             // Reported by the resolver; evaluation only goes on to find other errors.
@@ -302,7 +302,7 @@ impl<'a> Evaluator<'a> {
 
     /// `checker(a, b, size)`, `stripes(a, b, width)` and the noise patterns `marble`, `wood`
     /// and `turbulence`: each side a colour or a material.
-    fn pattern(&mut self, function: Function, call: &'a Call, args: &[Value]) -> Eval<Value> {
+    fn pattern(&mut self, function: Function, call: &Call, args: &[Value]) -> Eval<Value> {
         let mut parts = [PatternPart::Color(DVec3::ZERO); 2];
         for (index, part) in parts.iter_mut().enumerate() {
             *part = match args.get(index) {

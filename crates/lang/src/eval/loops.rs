@@ -14,11 +14,11 @@ impl<'a> Evaluator<'a> {
     pub(super) fn stepped_loop(
         &mut self,
         slot: Slot,
-        start: &'a Expr,
-        end: &'a Expr,
+        start: &Expr,
+        end: &Expr,
         inclusive: bool,
-        step: &'a Expr,
-        body: &'a Block,
+        step: &Expr,
+        body: &Block,
     ) -> Eval<Flow> {
         let first = i128::from(self.whole_number(start, "a loop's start")?);
         let last = i128::from(self.whole_number(end, "a loop's end")?);
@@ -80,7 +80,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// `while condition { ... }`: one evaluation step per iteration.
-    pub(super) fn while_loop(&mut self, condition: &'a Expr, body: &'a Block) -> Eval<Flow> {
+    pub(super) fn while_loop(&mut self, condition: &Expr, body: &Block) -> Eval<Flow> {
         let mut iterations: u64 = 0;
         while self.boolean(condition, "a `while` condition")? {
             let limit = self.limits.max_evaluation_steps;
@@ -106,7 +106,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// `name = value;`.
-    pub(super) fn assign(&mut self, target: &'a Name, value: &'a Expr) -> Eval<()> {
+    pub(super) fn assign(&mut self, target: &Name, value: &Expr) -> Eval<()> {
         let slot = match target.res {
             Res::Local(i) => Slot::Local(i),
             Res::Global(i) => Slot::Global(i),

@@ -43,7 +43,7 @@ impl<'a> Evaluator<'a> {
     /// Evaluates `material [: parent] { ... }` into a new table entry.
     pub(super) fn material(
         &mut self,
-        body: &'a MaterialBody,
+        body: &MaterialBody,
         name: Option<String>,
     ) -> Eval<MaterialId> {
         let (material, pattern) = match &body.parent {
@@ -204,7 +204,7 @@ impl<'a> Evaluator<'a> {
     pub(super) fn transformed_pattern(
         &mut self,
         pattern: PatternId,
-        block: &'a Block,
+        block: &Block,
     ) -> Eval<PatternId> {
         let errors_before = self.error_events;
         self.targets.push(Target::PatternTransform(DMat4::IDENTITY));

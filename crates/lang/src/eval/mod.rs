@@ -178,7 +178,10 @@ impl<'a> Evaluator<'a> {
 
     /// Runs the root file (and its imports), then gives every object without a material the
     /// default one. Returns the scene; errors are in `diagnostics`.
-    pub(crate) fn run(mut self) -> (Scene, Vec<Diagnostic>, bool) {
+    ///
+    /// `root_items` are the root file's items, taken out of the program: each is dropped once
+    /// it has run.
+    pub(crate) fn run(mut self, root_items: Vec<Item>) -> (Scene, Vec<Diagnostic>, bool) {
         // A scene written by a program is mostly top-level objects: room for them at once,
         // rather than arenas that grow by copying a million objects several times.
         let literal_objects = self
@@ -186,13 +189,16 @@ impl<'a> Evaluator<'a> {
             .files
             .iter()
             .flat_map(|file| &file.items)
+            .chain(&root_items)
             .filter(|item| matches!(item.kind, ItemKind::Object { .. }))
             .count()
             .min(self.limits.max_objects);
         if literal_objects > self.scene.objects.len() {
             self.scene.objects = whitted_ir::Arena::with_capacity(literal_objects);
         }
-        let outcome = self.run_file(0).and_then(|()| self.apply_overrides());
+        let outcome = self
+            .run_root(root_items)
+            .and_then(|()| self.apply_overrides());
         let failed = outcome.is_err() || self.unique_errors > 0;
         if let Some(Sink::Collect(roots)) = self.sinks.pop() {
             self.scene.roots = roots;
@@ -294,7 +300,28 @@ impl<'a> Evaluator<'a> {
         result.map(|_| ())
     }
 
-    fn items(&mut self, items: &'a [Item]) -> Eval<Flow> {
+    /// Runs the root file like [`Self::run_file`], dropping each item once it has run.
+    fn run_root(&mut self, items: Vec<Item>) -> Eval<()> {
+        if self.files_run.is_empty() || self.files_run[0] {
+            return Ok(());
+        }
+        self.files_run[0] = true;
+        let frame_size = self.program.files[0].frame_size as usize;
+        self.base = self.stack.len();
+        self.stack.resize(self.base + frame_size, Value::Poisoned);
+        for item in items {
+            match self.item(&item) {
+                Ok(Flow::Normal) | Err(Abort::Reported) => {}
+                // The resolver allows `return` only inside a function.
+                Ok(Flow::Return(_)) => break,
+                Err(Abort::Fatal) => return Err(Abort::Fatal),
+            }
+        }
+        self.stack.truncate(self.base);
+        Ok(())
+    }
+
+    fn items(&mut self, items: &[Item]) -> Eval<Flow> {
         for item in items {
             match self.item(item) {
                 Ok(Flow::Normal) | Err(Abort::Reported) => {}
@@ -321,14 +348,14 @@ impl<'a> Evaluator<'a> {
         }
     }
 
-    fn item(&mut self, item: &'a Item) -> Eval<Flow> {
+    fn item(&mut self, item: &Item) -> Eval<Flow> {
         self.enter(item.span)?;
         let result = self.item_inner(item);
         self.leave();
         result
     }
 
-    fn item_inner(&mut self, item: &'a Item) -> Eval<Flow> {
+    fn item_inner(&mut self, item: &Item) -> Eval<Flow> {
         match &item.kind {
             ItemKind::Import { file, .. } => {
                 if let Some(index) = *file {
@@ -430,7 +457,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// A `const`, with its `-D` override if there is one.
-    fn constant(&mut self, binding: &'a Binding) -> Eval<Value> {
+    fn constant(&mut self, binding: &Binding) -> Eval<Value> {
         let value = self.eval(&binding.value)?;
         let Slot::Global(slot) = binding.slot else {
             return Ok(value);
@@ -468,10 +495,10 @@ impl<'a> Evaluator<'a> {
     fn for_loop(
         &mut self,
         slot: Slot,
-        start: &'a Expr,
-        end: &'a Expr,
+        start: &Expr,
+        end: &Expr,
         inclusive: bool,
-        body: &'a Block,
+        body: &Block,
     ) -> Eval<Flow> {
         let first = self.whole_number(start, "a loop's start")?;
         let last = self.whole_number(end, "a loop's end")?;
@@ -513,7 +540,7 @@ impl<'a> Evaluator<'a> {
 
     /// A call used as a statement: its objects go where the statement is, after the
     /// modifier block's transforms and material are applied to them.
-    fn call_statement(&mut self, call: &'a Call, modifiers: Option<&'a Block>) -> Eval<()> {
+    fn call_statement(&mut self, call: &Call, modifiers: Option<&Block>) -> Eval<()> {
         let CallTarget::User(id) = call.target else {
             // A built-in as a statement has nothing to make; evaluate it for its errors.
             self.call_value(call)?;
@@ -547,7 +574,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// A call in an expression: its value. Objects made inside are an error.
-    fn call_value(&mut self, call: &'a Call) -> Eval<Value> {
+    fn call_value(&mut self, call: &Call) -> Eval<Value> {
         match call.target {
             CallTarget::Builtin(function) => self.call_builtin(function, call),
             CallTarget::User(id) => {
@@ -576,7 +603,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// Runs a user function: arguments become the first slots of a fresh frame.
-    fn call_user(&mut self, id: FnId, call: &'a Call) -> Eval<Option<Value>> {
+    fn call_user(&mut self, id: FnId, call: &Call) -> Eval<Option<Value>> {
         let program = self.program;
         let Some(function) = program.functions.get(id) else {
             return Err(Abort::Reported);

@@ -22,8 +22,8 @@ impl<'a> Evaluator<'a> {
         &mut self,
         tag: ObjectTag,
         kind: Ident,
-        name: Option<&'a StrLit>,
-        body: &'a Block,
+        name: Option<&StrLit>,
+        body: &Block,
     ) -> Eval<()> {
         let header = match name {
             Some(name) => kind.span.to(name.span),
@@ -237,7 +237,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// The block after a call statement: transforms and a material for what the call made.
-    pub(super) fn modifiers(&mut self, block: &'a Block) -> Eval<Placement> {
+    pub(super) fn modifiers(&mut self, block: &Block) -> Eval<Placement> {
         let errors_before = self.error_events;
         self.targets
             .push(Target::Modifiers(Placement::new(), PropSet::new()));
@@ -253,7 +253,7 @@ impl<'a> Evaluator<'a> {
         Ok(placement)
     }
 
-    pub(super) fn settings(&mut self, body: &'a Block) -> Eval<()> {
+    pub(super) fn settings(&mut self, body: &Block) -> Eval<()> {
         self.targets.push(Target::Settings);
         let result = self.items(&body.items);
         self.targets.pop();
@@ -264,7 +264,7 @@ impl<'a> Evaluator<'a> {
         &mut self,
         tag: crate::schema::CameraTag,
         header: Span,
-        body: &'a Block,
+        body: &Block,
     ) -> Eval<()> {
         if let Some(first) = self.camera_span {
             return self.fail(
@@ -295,8 +295,8 @@ impl<'a> Evaluator<'a> {
         &mut self,
         tag: LightTag,
         header: Span,
-        name: Option<&'a StrLit>,
-        body: &'a Block,
+        name: Option<&StrLit>,
+        body: &Block,
     ) -> Eval<()> {
         if self.scene.lights.len() >= self.limits.max_lights {
             let limit = self.limits.max_lights;

@@ -23,7 +23,7 @@ pub(super) enum Values {
 impl<'a> Evaluator<'a> {
     // ---- properties ------------------------------------------------------------------------
 
-    pub(super) fn property(&mut self, property: &'a Property) -> Eval<()> {
+    pub(super) fn property(&mut self, property: &Property) -> Eval<()> {
         let Some(prop) = property.prop else {
             // Already reported by the resolver, or in a block of unknown kind.
             return Ok(());
@@ -109,7 +109,7 @@ impl<'a> Evaluator<'a> {
         self.fail(diagnostic)
     }
 
-    pub(super) fn values(&mut self, property: &'a Property, prop: Prop) -> Eval<Values> {
+    pub(super) fn values(&mut self, property: &Property, prop: Prop) -> Eval<Values> {
         if prop.words().is_some() {
             return Ok(Values::None);
         }
@@ -199,7 +199,7 @@ impl<'a> Evaluator<'a> {
 
     pub(super) fn transform(
         &mut self,
-        property: &'a Property,
+        property: &Property,
         prop: Prop,
         values: &Values,
     ) -> Eval<DMat4> {
@@ -381,7 +381,7 @@ impl<'a> Evaluator<'a> {
 
     pub(super) fn settings_property(
         &mut self,
-        property: &'a Property,
+        property: &Property,
         prop: Prop,
         values: &Values,
     ) -> Eval<()> {
@@ -525,7 +525,7 @@ impl<'a> Evaluator<'a> {
 
     pub(super) fn material_property(
         &mut self,
-        property: &'a Property,
+        property: &Property,
         prop: Prop,
         values: &Values,
     ) -> Eval<()> {

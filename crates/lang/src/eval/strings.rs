@@ -11,7 +11,7 @@ use crate::value::Value;
 
 impl<'a> Evaluator<'a> {
     /// A string in an expression: formatted and stored.
-    pub(super) fn string_value(&mut self, lit: &'a StrLit) -> Eval<Value> {
+    pub(super) fn string_value(&mut self, lit: &StrLit) -> Eval<Value> {
         let text = self.format_string(lit)?;
         self.charge(text.len() + std::mem::size_of::<String>(), lit.span)?;
         let id = self.store.strings.len() as u32;
@@ -20,14 +20,14 @@ impl<'a> Evaluator<'a> {
     }
 
     /// The name of an object or light, formatted.
-    pub(super) fn object_name(&mut self, name: Option<&'a StrLit>) -> Eval<Option<String>> {
+    pub(super) fn object_name(&mut self, name: Option<&StrLit>) -> Eval<Option<String>> {
         let Some(lit) = name else { return Ok(None) };
         let text = self.format_string(lit)?;
         self.charge(text.len() + std::mem::size_of::<String>(), lit.span)?;
         Ok(Some(text))
     }
 
-    fn format_string(&mut self, lit: &'a StrLit) -> Eval<String> {
+    fn format_string(&mut self, lit: &StrLit) -> Eval<String> {
         if lit.parts.is_empty() {
             return self.bounded(lit.value.clone(), lit);
         }
@@ -75,7 +75,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// Refuses strings over the string length limit.
-    fn bounded(&mut self, text: String, lit: &'a StrLit) -> Eval<String> {
+    fn bounded(&mut self, text: String, lit: &StrLit) -> Eval<String> {
         if text.len() <= MAX_STRING_BYTES {
             return Ok(text);
         }

@@ -1047,6 +1047,14 @@ impl<'t> Reader<'t, '_, '_> {
             ("/", BinaryOp::Div),
             ("%", BinaryOp::Rem),
         ];
+        // Most operands are followed by `,`, `>` or `}`: one look at the next byte rules out
+        // every operator but `>` before trying them one by one.
+        if !matches!(
+            self.byte(self.pos),
+            Some(b'|' | b'&' | b'=' | b'!' | b'<' | b'>' | b'+' | b'-' | b'*' | b'/' | b'%')
+        ) {
+            return None;
+        }
         let comparisons: &[(&str, BinaryOp)] = if arith { &[] } else { &COMPARISONS };
         for &(literal, op) in comparisons.iter().chain(ARITHMETIC.iter()) {
             if let Some(span) = self.eat_span(literal) {

@@ -6,7 +6,10 @@ use super::*;
 impl Resolver<'_> {
     pub(super) fn property(&mut self, property: &mut Property, cx: Context, program: &mut Program) {
         let name = self.name(property.name.sym);
-        let prop = cx.property_named(name);
+        let prop = *self
+            .property_rows
+            .entry((property.name.sym, cx))
+            .or_insert_with(|| cx.property_named(name));
         match (prop, cx) {
             (_, Context::Unknown) => {}
             (Some(prop), _) => property.prop = Some(prop),

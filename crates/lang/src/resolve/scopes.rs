@@ -31,6 +31,15 @@ impl Scope {
         }
     }
 
+    /// A file's scope, with room for the names its top level defines.
+    pub(super) fn with_capacity(names: usize) -> Scope {
+        Scope {
+            names: Vec::with_capacity(names),
+            index: HashMap::with_capacity_and_hasher(names, FixedState::default()),
+            barrier: false,
+        }
+    }
+
     pub(super) fn add(&mut self, sym: Sym, def: DefId) {
         self.names.push((sym, def));
         self.index
