@@ -275,6 +275,8 @@ impl Lines {
                     Visibility::Blocked => "in shadow".to_string(),
                     Visibility::NotFacing => "faces away (no shadow ray)".to_string(),
                     Visibility::Unshaded => "nothing to light (no shadow ray)".to_string(),
+                    Visibility::NoShadows => "lit (shadows none: no shadow ray)".to_string(),
+                    Visibility::BackFace => "unlit back face (shade_back off)".to_string(),
                 },
                 format!("N·L {}", number(light.n_dot_l)),
             ];
