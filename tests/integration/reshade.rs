@@ -287,7 +287,8 @@ impl Reshader<'_> {
             // surface); without a shadow ray, from the hit point itself.
             let from = shadow.map_or(p, |s| v(s.origin));
             let settings = &self.scene.settings;
-            let (l, distance, fatt, spot) = incidence(&light.kind, from, settings.attenuation_clamp);
+            let (l, distance, fatt, spot) =
+                incidence(&light.kind, from, settings.attenuation_clamp);
             let n_dot_l = n.dot(l);
             let strength = fatt * spot * c(&light.color).max_element();
             if !settings.shade_back && !hit.front_face {

@@ -32,7 +32,11 @@ pub fn print(scene: &Scene) -> String {
             crate::scene::Highlight::Blinn => ", highlight Blinn",
         },
         // Likewise shown only when they leave the default.
-        if s.shade_back { "" } else { ", back faces unlit" },
+        if s.shade_back {
+            ""
+        } else {
+            ", back faces unlit"
+        },
         if s.attenuation_clamp {
             ""
         } else {

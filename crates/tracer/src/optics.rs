@@ -269,8 +269,16 @@ mod tests {
     #[test]
     fn attenuation_follows_the_textbook_formula() {
         assert_eq!(attenuation(1.0, 0.0, 0.0, 100.0, true), 1.0);
-        assert!(close(attenuation(1.0, 0.5, 0.25, 2.0, true), 1.0 / 3.0, 1e-7));
-        assert!(close(attenuation(0.0, 0.0, 1.0, 4.0, true), 1.0 / 16.0, 1e-7));
+        assert!(close(
+            attenuation(1.0, 0.5, 0.25, 2.0, true),
+            1.0 / 3.0,
+            1e-7
+        ));
+        assert!(close(
+            attenuation(0.0, 0.0, 1.0, 4.0, true),
+            1.0 / 16.0,
+            1e-7
+        ));
         // Clamped to 1 close to the light.
         assert_eq!(attenuation(0.0, 0.0, 1.0, 0.5, true), 1.0);
     }
@@ -278,7 +286,11 @@ mod tests {
     #[test]
     fn unclamped_attenuation_exceeds_one_close_to_the_light() {
         // 1 / (0.25 + 0.5·0.5 + 1·0.25) = 1 / 0.75.
-        assert!(close(attenuation(0.25, 0.5, 1.0, 0.5, false), 4.0 / 3.0, 1e-6));
+        assert!(close(
+            attenuation(0.25, 0.5, 1.0, 0.5, false),
+            4.0 / 3.0,
+            1e-6
+        ));
         // Far away the two agree.
         assert_eq!(
             attenuation(1.0, 0.5, 0.25, 2.0, false),
@@ -286,7 +298,10 @@ mod tests {
         );
         // At a light with no constant term: the largest attenuation, not infinity.
         let at_light = attenuation(0.0, 0.0, 1.0, 0.0, false);
-        assert_eq!(at_light, whitted_ir::limits::MAX_UNCLAMPED_ATTENUATION as f32);
+        assert_eq!(
+            at_light,
+            whitted_ir::limits::MAX_UNCLAMPED_ATTENUATION as f32
+        );
     }
 
     #[test]

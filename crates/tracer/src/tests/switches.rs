@@ -118,13 +118,19 @@ fn floor_from_below(shade_back: bool) -> Node {
 #[test]
 fn shade_back_lights_a_back_face_with_the_turned_normal_or_not_at_all() {
     let lit = floor_from_below(true);
-    let hit = lit.hit.unwrap_or_else(|| panic!("the ray misses the floor"));
+    let hit = lit
+        .hit
+        .unwrap_or_else(|| panic!("the ray misses the floor"));
     assert!(!hit.front_face, "the camera is below the floor");
     // By hand: the turned normal is -y, the light comes from -(0, 1, 0.5) normalised.
     let n_dot_l = DVec3::new(0.0, -1.0, 0.0).dot(-DVec3::new(0.0, 1.0, 0.5).normalize());
     let ambient = Vec3A::new(0.05, 0.06, 0.07);
     let diffuse = Vec3A::new(0.5, 0.6, 0.7) * 0.8 * n_dot_l as f32;
-    assert!(lit.color.abs_diff_eq(ambient + diffuse, 1e-6), "{}", lit.color);
+    assert!(
+        lit.color.abs_diff_eq(ambient + diffuse, 1e-6),
+        "{}",
+        lit.color
+    );
 
     let unlit = floor_from_below(false);
     assert!(unlit.color.abs_diff_eq(ambient, 1e-7), "{}", unlit.color);
@@ -227,7 +233,10 @@ fn unclamped_attenuation_follows_the_formula_above_one() {
     let d = f64::from(light.distance);
     let fatt = 1.0 / (terms[0] + terms[1] * d + terms[2] * d * d);
     assert!((fatt - 2.0).abs() < 1e-3, "{d}");
-    assert!((f64::from(light.attenuation) - fatt).abs() < 1e-5, "{light:?}");
+    assert!(
+        (f64::from(light.attenuation) - fatt).abs() < 1e-5,
+        "{light:?}"
+    );
     // The whole pixel: Ii·kd·(N·L)·fatt, with N·L = 1 straight below the light.
     let expected = (0.5 * 0.4 * fatt) as f32;
     assert!(
