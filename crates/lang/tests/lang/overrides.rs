@@ -142,3 +142,40 @@ fn bad_settings_on_the_command_line_point_into_their_text() {
         insta::assert_snapshot!("setting_overrides", out);
     });
 }
+
+/// Another front end's scene (the MIT 6.837 format) gets `--set` through the same rows: its
+/// own settings stay unless overridden, and mistakes point into the `--set` text.
+#[test]
+fn settings_of_another_front_end_are_overridden_by_the_same_rows() {
+    let base = whitted_ir::Settings {
+        shadows: ShadowMode::None,
+        shade_back: false,
+        width: 200,
+        ..whitted_ir::Settings::default()
+    };
+    let options = CompileOptions {
+        settings: vec![("shade_back".into(), "on".into())],
+        ..CompileOptions::default()
+    };
+    let compilation = whitted_lang::override_settings(&base, &options);
+    assert!(
+        compilation.diagnostics.is_empty(),
+        "{}",
+        output(&compilation)
+    );
+    let Some(scene) = compilation.scene else {
+        panic!("{}", output(&compilation));
+    };
+    let s = &scene.settings;
+    assert!(s.shade_back);
+    assert_eq!((s.shadows, s.width), (ShadowMode::None, 200));
+
+    let options = CompileOptions {
+        settings: vec![("shadows".into(), "soft".into())],
+        ..CompileOptions::default()
+    };
+    let bad = whitted_lang::override_settings(&base, &options);
+    assert!(bad.scene.is_none());
+    let text = output(&bad);
+    assert!(text.contains("<--set shadows=soft>:1:9"), "{text}");
+}
