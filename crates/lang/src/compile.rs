@@ -92,7 +92,8 @@ pub fn compile_bytes(
 /// `--set NAME=VALUE` for a scene that another front end made (the MIT 6.837 format):
 /// `options.settings` applied to `base` by the same rows and checks as for a scene in the
 /// language. The result's `scene` is an empty scene whose settings are the overridden ones;
-/// its `sources` hold the `--set` pseudo-files its diagnostics point into.
+/// its `sources` are an empty `<--set>` file and the `--set` pseudo-files its diagnostics
+/// point into.
 pub fn override_settings(base: &whitted_ir::Settings, options: &CompileOptions) -> Compilation {
     struct NoFiles;
     impl SourceLoader for NoFiles {
