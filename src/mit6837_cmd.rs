@@ -153,10 +153,12 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
                 depth = Some((near, far, image_path(value(what)?, "-depth")?));
             }
             "-normals" => normals = Some(image_path(value("an image file")?, "-normals")?),
-            later if LATER_ASSIGNMENTS.contains(&later) => return Err(format!(
+            later if LATER_ASSIGNMENTS.contains(&later) => {
+                return Err(format!(
                 "{later} is a flag of the course's later assignments, which whitted does not have \
                      (see whitted mit6837 -help)"
-            )),
+            ))
+            }
             other => {
                 return Err(format!(
                     "unknown flag `{other}` (see whitted mit6837 -help for the flags)"
