@@ -366,7 +366,10 @@ fn a_signal_from_outside_gives_the_terminal_back() {
 #[test]
 fn a_course_scene_shows_its_txt_lines() {
     // Run from the scene's folder, so that the pane titles show the whole (short) path.
-    let command = format!("'{}' debug spheres-orthographic.txt --pixel 133,317", whitted());
+    let command = format!(
+        "'{}' debug spheres-orthographic.txt --pixel 133,317",
+        whitted()
+    );
     let folder = repository().join("scenes/mit6837");
     let tmux = Tmux::start("course", &folder, &command, 120, 40);
     let screen = tmux.wait_for("the ray tree of the pixel", |s| {
