@@ -1,6 +1,5 @@
 //! Reading the format's pieces from the token stream: keywords, braces, numbers, vectors and
 //! counts, each failure a located [`Diagnostic`] that says what was expected in words.
-//! in words.
 
 use whitted_ir::{DVec3, Diagnostic, FileId, Span};
 
