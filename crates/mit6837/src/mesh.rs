@@ -15,6 +15,9 @@ use crate::convert::{decode, Converter};
 use crate::reader::Read;
 use crate::tokens::Token;
 
+/// Faces left out for having their corners in a line: how many, and where the first is.
+pub(crate) type Degenerate = Option<(usize, Span)>;
+
 /// A mesh as the `.obj` file gives it.
 pub(crate) struct ObjMesh {
     pub positions: Vec<DVec3>,
@@ -174,9 +177,9 @@ pub(crate) fn lower_to_triangles(
     span: Span,
     world_from_object: DMat4,
     material: Handle<Material>,
-) -> Read<(Handle<Object>, Option<(usize, Span)>)> {
+) -> Read<(Handle<Object>, Degenerate)> {
     let mut children = Vec::with_capacity(mesh.faces.len());
-    let mut degenerate: Option<(usize, Span)> = None;
+    let mut degenerate: Degenerate = None;
     for &([i, j, k], face_span) in &mesh.faces {
         let (a, b, c) = (mesh.positions[i], mesh.positions[j], mesh.positions[k]);
         // The validator's own threshold for a degenerate triangle.
