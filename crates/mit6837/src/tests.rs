@@ -6,7 +6,8 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use whitted_ir::{
-    DMat4, DVec3, Highlight, LightKind, ObjectKind, Projection, Scene, ShadowMode, Shape,
+    DMat4, DVec3, Diagnostic, Highlight, LightKind, ObjectKind, Projection, Scene, ShadowMode,
+    Shape,
 };
 
 use crate::{convert, is_mit6837, Conversion, CourseOptions, MeshLoader};
@@ -457,4 +458,107 @@ fn the_camera_basis_is_the_course_s() {
         // The ambient term is ambientLight·kd (the ball's own colour, ka = 1).
         assert_eq!(at(16, 10), [1.0, 0.0, 0.0]);
     }
+}
+
+/// Thousands of mutated scenes (a word replaced by one that often breaks things: a brace, a
+/// keyword out of place, a count far too big, a number at the edge of f64): each is a scene
+/// or a located error, never a panic. The mutations are a fixed pseudo-random sequence.
+#[test]
+fn mutated_scenes_never_panic() {
+    const WORDS: &[&str] = &[
+        "{",
+        "}",
+        "Group",
+        "Transform",
+        "Sphere",
+        "Matrix",
+        "MaterialIndex",
+        "numObjects",
+        "0",
+        "-1",
+        "1e308",
+        "-1e308",
+        "1e-320",
+        "nan",
+        "inf",
+        "4294967296",
+        "99999999999999999999",
+        "TriangleMesh",
+        "obj_file",
+        "Rotate",
+        "angle",
+        "0.5",
+        "PointLight",
+        "attenuation",
+    ];
+    const NUMBERS: &[&str] = &[
+        "0", "-1", "1", "2", "0.001", "1e308", "-1e308", "1e-320", "1e9", "-1e9", "179", "181",
+    ];
+    let mut files = Files::default();
+    files.0.insert(
+        PathBuf::from("course/tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 3 2 -1\n".to_string(),
+    );
+    let base = SCENE.replace(
+        "Sphere { center 3 0 0 radius 0.5 }",
+        "Transform { Rotate { axis 0 1 0 angle 30 } TriangleMesh { obj_file tri.obj } }",
+    );
+    let words: Vec<&str> = base.split_whitespace().collect();
+    let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut next = |n: usize| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % n as u64) as usize
+    };
+    let mut converted = 0;
+    for _ in 0..3000 {
+        let mut mutated = words.clone();
+        for _ in 0..1 + next(3) {
+            let at = next(mutated.len());
+            match next(4) {
+                // A number for a number: the structure holds, the values go to the edges.
+                3 if mutated[at].parse::<f64>().is_ok() => {
+                    mutated[at] = NUMBERS[next(NUMBERS.len())]
+                }
+                0 | 3 => mutated[at] = WORDS[next(WORDS.len())],
+                1 => {
+                    mutated.remove(at);
+                }
+                _ => mutated.insert(at, WORDS[next(WORDS.len())]),
+            }
+        }
+        let text = mutated.join(" ");
+        let options = CourseOptions {
+            width: 4,
+            height: 4,
+            shadows: true,
+            bounces: 3,
+            ..CourseOptions::default()
+        };
+        let conversion = read_with(&text, &mut files, &options);
+        match conversion.scene {
+            // What validation accepts, the tracer renders (finite colours, no panic).
+            Some(scene) => {
+                let prepared = whitted_tracer::PreparedScene::new(&scene);
+                let render_options = whitted_tracer::RenderOptions::from_settings(&scene.settings);
+                let rendered =
+                    whitted_tracer::render(&prepared, &render_options, &whitted_tracer::NoObserver);
+                let Some((image, _)) = rendered else {
+                    panic!("cancelled");
+                };
+                assert!(
+                    image.pixels.iter().flatten().all(|c| c.is_finite()),
+                    "{text}"
+                );
+                converted += 1;
+            }
+            None => assert!(
+                conversion.diagnostics.iter().any(Diagnostic::is_error),
+                "no error for {text}"
+            ),
+        }
+    }
+    // Otherwise the renders above would check nothing.
+    assert!(converted > 50, "only {converted} mutated scenes converted");
 }
