@@ -58,6 +58,7 @@ pub fn convert(
         folder,
         warnings: Vec::new(),
         depth: 0,
+        meshes: Vec::new(),
         background: None,
         ambient: None,
         seen: Vec::new(),
@@ -184,6 +185,8 @@ pub(crate) struct Converter<'a, 'l> {
     pub warnings: Vec<Diagnostic>,
     /// Nested groups and transforms, bounded by the nesting limit.
     pub depth: usize,
+    /// Mesh files read so far (by path), each parsed once however often it is used.
+    pub meshes: Vec<(PathBuf, crate::mesh::ObjMesh)>,
     background: Option<Color>,
     ambient: Option<Color>,
     /// The top-level blocks read so far, each at most once.

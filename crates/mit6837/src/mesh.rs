@@ -35,29 +35,47 @@ impl<'a> Converter<'a, '_> {
         material: Handle<Material>,
     ) -> Read<Handle<Object>> {
         let path = self.folder.join(name.text);
-        let bytes = match self.loader.load(&path) {
-            Ok(bytes) => bytes,
-            Err(error) => {
-                return Err(Box::new(
-                    Diagnostic::error(
-                        format!("cannot read the mesh {}: {error}", path.display()),
-                        self.reader.span(name),
-                    )
-                    .with_label("this file")
-                    .with_hint("the path is relative to the scene file's folder"),
-                ))
+        let display = path.to_string_lossy().into_owned();
+        // A mesh used twice is read, parsed and shown in the source map once.
+        let known = self.meshes.iter().position(|(p, _)| *p == path);
+        let index = match known {
+            Some(index) => index,
+            None => {
+                let bytes = match self.loader.load(&path) {
+                    Ok(bytes) => bytes,
+                    Err(error) => {
+                        return Err(Box::new(
+                            Diagnostic::error(
+                                format!("cannot read the mesh {}: {error}", path.display()),
+                                self.reader.span(name),
+                            )
+                            .with_label("this file")
+                            .with_hint("the path is relative to the scene file's folder"),
+                        ))
+                    }
+                };
+                let text = decode(&display, bytes, &mut self.scene.sources)?;
+                let file = self
+                    .scene
+                    .sources
+                    .add(SourceFile::new(display.clone(), text.as_str()));
+                let mesh = parse_obj(&text, file, self.scene.objects.len())?;
+                self.meshes.push((path, mesh));
+                self.meshes.len() - 1
             }
         };
-        let display = path.to_string_lossy().into_owned();
-        let text = decode(&display, bytes, &mut self.scene.sources)?;
-        let file = self
-            .scene
-            .sources
-            .add(SourceFile::new(display.clone(), text.as_str()));
-        let mesh = parse_obj(&text, file, self.scene.objects.len())?;
-        let (handle, degenerate) =
-            lower_to_triangles(self, &mesh, span, world_from_object, material)?;
-        if let Some((count, first)) = degenerate {
+        let mesh = std::mem::replace(
+            &mut self.meshes[index].1,
+            ObjMesh {
+                positions: Vec::new(),
+                faces: Vec::new(),
+            },
+        );
+        let lowered = lower_to_triangles(self, &mesh, span, world_from_object, material);
+        self.meshes[index].1 = mesh;
+        let (handle, degenerate) = lowered?;
+        // Said once per file, not once per use.
+        if let (Some((count, first)), None) = (degenerate, known) {
             self.warnings.push(
                 Diagnostic::warning(
                     format!(

@@ -316,6 +316,31 @@ fn a_mesh_becomes_triangles_pointing_at_their_face_lines() {
 }
 
 #[test]
+fn a_mesh_used_twice_is_one_source_file_and_one_warning() {
+    let mut files = Files::default();
+    files.0.insert(
+        PathBuf::from("course/tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n".to_string(),
+    );
+    let text = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\n\
+        Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n\
+        Group { numObjects 2 MaterialIndex 0\n\
+          TriangleMesh { obj_file tri.obj }\n\
+          Transform { Translate 0 0 1 TriangleMesh { obj_file tri.obj } } }\n";
+    let conversion = read_with(text, &mut files, &CourseOptions::default());
+    assert_eq!(
+        messages(&conversion),
+        "course/tri.obj:6:1: 1 degenerate face of course/tri.obj (corners in a line) left out\n"
+    );
+    assert_eq!(conversion.sources.files().len(), 2);
+    let Some(scene) = conversion.scene else {
+        panic!("not converted");
+    };
+    // Two groups of one triangle each, and the root group.
+    assert_eq!(scene.objects.len(), 5);
+}
+
+#[test]
 fn broken_files_get_located_errors() {
     let camera = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\n";
     let materials = "Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n";
