@@ -80,6 +80,9 @@ pub fn convert(
             diagnostics: warnings,
         };
     }
+    // The course's reader: a scene without lights is ray cast in flat colour, its ambient
+    // light white (unless the scene gives one).
+    let ambient = ambient.or((scene.lights.is_empty()).then_some(Color::WHITE));
     scene.settings = settings(options, background, ambient);
     let sources = scene.sources.clone();
     match whitted_ir::validate(scene) {

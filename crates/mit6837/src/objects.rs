@@ -193,26 +193,36 @@ impl<'a> Converter<'a, '_> {
         )
     }
 
-    /// `Transform { <transforms> <object> }`: the transforms compose left to right (the
-    /// last one applies to the object first), as the course's reader multiplied them.
+    /// `Transform { <transforms> <object> }`, composed as the course's reader composed them:
+    /// each transform multiplies on the right (the last one written applies to the object
+    /// first), except `Matrix`, which multiplies on the left (it applies after the transforms
+    /// written before it in the same block). The block's transform applies under the
+    /// parent's.
     fn transform(&mut self, keyword: Token<'a>, world_from_parent: DMat4) -> Read<Handle<Object>> {
         self.enter(keyword)?;
         self.reader.expect("{")?;
-        let mut matrix = world_from_parent;
+        let mut local = DMat4::IDENTITY;
         let object = loop {
             let token = self.reader.next("a transform or an object")?;
             let step = match token.text {
-                "Scale" => DMat4::from_scale(self.reader.vector("a scale factor")?),
-                "UniformScale" => {
-                    DMat4::from_scale(DVec3::splat(self.reader.number("a scale factor")?))
+                "Scale" => DMat4::from_scale(self.argument(|r| r.reader.vector("a scale factor"))?),
+                "UniformScale" => DMat4::from_scale(DVec3::splat(
+                    self.argument(|r| r.reader.number("a scale factor"))?,
+                )),
+                "Translate" => {
+                    DMat4::from_translation(self.argument(|r| r.reader.vector("a translation"))?)
                 }
-                "Translate" => DMat4::from_translation(self.reader.vector("a translation")?),
-                "XRotate" => DMat4::from_rotation_x(self.degrees()?),
-                "YRotate" => DMat4::from_rotation_y(self.degrees()?),
-                "ZRotate" => DMat4::from_rotation_z(self.degrees()?),
+                "XRotate" => DMat4::from_rotation_x(self.argument(Self::degrees)?),
+                "YRotate" => DMat4::from_rotation_y(self.argument(Self::degrees)?),
+                "ZRotate" => DMat4::from_rotation_z(self.argument(Self::degrees)?),
                 "Rotate" => self.rotate(token)?,
-                "Matrix" => self.matrix(token)?,
-                _ if OBJECTS.contains(&token.text) => break self.object(token, matrix)?,
+                "Matrix" => {
+                    local = self.matrix(token)? * local;
+                    continue;
+                }
+                _ if OBJECTS.contains(&token.text) => {
+                    break self.object(token, world_from_parent * local)?
+                }
                 other => {
                     return Err(Box::new(
                         Diagnostic::error(
@@ -227,11 +237,24 @@ impl<'a> Converter<'a, '_> {
                     ))
                 }
             };
-            matrix *= step;
+            local *= step;
         };
         self.reader.expect("}")?;
         self.depth -= 1;
         Ok(object)
+    }
+
+    /// A transform's argument, bare (`Scale 1 2 3`) or in braces (`Scale { 1 2 3 }`, as some
+    /// years of the course wrote it).
+    fn argument<T>(&mut self, read: impl FnOnce(&mut Self) -> Read<T>) -> Read<T> {
+        if self.reader.tokens.peek().is_some_and(|t| t.text == "{") {
+            self.reader.expect("{")?;
+            let value = read(self)?;
+            self.reader.expect("}")?;
+            Ok(value)
+        } else {
+            read(self)
+        }
     }
 
     /// An angle in degrees, as radians.
@@ -239,22 +262,56 @@ impl<'a> Converter<'a, '_> {
         Ok(self.reader.number("an angle in degrees")?.to_radians())
     }
 
-    /// `Rotate { axis v angle f }`.
+    /// `Rotate { x y z degrees }` as the course's reader read it, or with names,
+    /// `Rotate { axis x y z angle degrees }`.
     fn rotate(&mut self, keyword: Token<'a>) -> Read<DMat4> {
-        let known = ["axis", "angle"];
-        let (mut axis, mut angle) = (None, None);
-        let span = self.fields(keyword, &known, |this, field| {
-            match field.text {
-                "axis" => axis = Some(this.direction("the rotation axis")?),
-                "angle" => angle = Some(this.degrees()?),
-                _ => return Ok(false),
+        let open = self.reader.expect("{")?;
+        let named = self
+            .reader
+            .tokens
+            .peek()
+            .is_some_and(|t| t.text == "axis" || t.text == "angle");
+        let (axis, angle) = if named {
+            let (mut axis, mut angle) = (None, None);
+            loop {
+                let token = self.reader.next("`axis`, `angle` or `}`")?;
+                let slot_is_set = match token.text {
+                    "}" => break,
+                    "axis" => axis.is_some(),
+                    "angle" => angle.is_some(),
+                    other => {
+                        return self.reader.error_at(
+                            token,
+                            format!("`Rotate` has no field `{other}`: it takes `axis` and `angle`"),
+                        )
+                    }
+                };
+                if slot_is_set {
+                    return self.reader.error_at(
+                        token,
+                        format!("`{}` is given twice in this `Rotate`", token.text),
+                    );
+                }
+                if token.text == "axis" {
+                    axis = Some(self.direction("the rotation axis")?);
+                } else {
+                    angle = Some(self.degrees()?);
+                }
             }
-            Ok(true)
-        })?;
-        match (axis, angle) {
-            (Some(axis), Some(angle)) => Ok(DMat4::from_axis_angle(axis.normalize(), angle)),
-            _ => self.missing(span, keyword.text, &known),
-        }
+            match (axis, angle) {
+                (Some(axis), Some(angle)) => (axis, angle),
+                _ => {
+                    let span = Span::new(self.reader.file, keyword.start, open.end);
+                    return self.missing(span, keyword.text, &["axis", "angle"]);
+                }
+            }
+        } else {
+            let axis = self.direction("the rotation axis")?;
+            let angle = self.degrees()?;
+            self.reader.expect("}")?;
+            (axis, angle)
+        };
+        Ok(DMat4::from_axis_angle(axis.normalize(), angle))
     }
 
     /// `Matrix { 16 numbers }`, row by row as written (the translation in the fourth

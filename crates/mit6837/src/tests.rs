@@ -231,7 +231,8 @@ fn a_scene_without_background_gets_the_course_grey() {
          Group { numObjects 0 }\n",
     );
     assert_eq!(scene.settings.background.g, 0.5);
-    assert_eq!(scene.settings.ambient.g, 0.0);
+    // No lights either: flat colour (see below).
+    assert_eq!(scene.settings.ambient.g, 1.0);
     assert_eq!(
         scene.camera.projection,
         Projection::Perspective {
@@ -241,28 +242,46 @@ fn a_scene_without_background_gets_the_course_grey() {
 }
 
 #[test]
+fn a_scene_without_lights_is_flat_colour() {
+    let text = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\n";
+    assert_eq!(scene_of(text).settings.ambient, whitted_ir::Color::WHITE);
+    // Unless it gives its own ambient light.
+    let own = format!("{text}Background {{ ambientLight 0.3 0.3 0.3 }}");
+    assert_eq!(scene_of(&own).settings.ambient.r, 0.3);
+    // With lights, the course's default: none.
+    let lit = format!(
+        "{text}Lights {{ numLights 1 DirectionalLight {{ direction 0 0 -1 color 1 1 1 }} }}"
+    );
+    assert_eq!(scene_of(&lit).settings.ambient.r, 0.0);
+}
+
+#[test]
 fn transforms_compose_as_the_course_multiplied_them() {
     let text = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\n\
         Materials { numMaterials 1 Material { diffuseColor 1 1 1 } }\n\
         Group { numObjects 1 MaterialIndex 0\n\
-          Transform { ZRotate 90 Translate 1 0 0 Scale 1 2 3\n\
-            Rotate { axis 0 0 2 angle 90 }\n\
+          Transform { Translate 0 1 0\n\
+          Transform { ZRotate 90 Translate 1 0 0 Scale { 1 2 3 }\n\
+            Rotate { axis 0 0 2 angle 90 } Rotate { 1 0 0 30 }\n\
             Matrix { 1 0 0 5  0 1 0 6  0 0 1 7  0 0 0 1 }\n\
-            Sphere { center 0 0 0 radius 1 } } }\n";
+            Sphere { center 0 0 0 radius 1 } } } }\n";
     let scene = scene_of(text);
-    let (_, sphere) = scene
-        .objects
-        .iter()
-        .next()
-        .unwrap_or_else(|| panic!("no objects"));
+    let Some((_, sphere)) = scene.objects.iter().next() else {
+        panic!("no objects");
+    };
     let m = sphere.world_from_object;
-    // The matrix is read row by row: it moves the origin to (5, 6, 7) first.
+    // Each transform multiplies on the right, `Matrix` on the left (as the course's reader
+    // did); the matrix is read row by row (it moves by (5, 6, 7)); braces around an
+    // argument and the unnamed `Rotate { x y z degrees }` are read too. The outer block's
+    // transform applies last.
     let rotate = DMat4::from_rotation_z(90f64.to_radians());
-    let expected = rotate
+    let expected = DMat4::from_translation(DVec3::Y)
+        * DMat4::from_translation(DVec3::new(5.0, 6.0, 7.0))
+        * rotate
         * DMat4::from_translation(DVec3::X)
         * DMat4::from_scale(DVec3::new(1.0, 2.0, 3.0))
         * rotate
-        * DMat4::from_translation(DVec3::new(5.0, 6.0, 7.0));
+        * DMat4::from_rotation_x(30f64.to_radians());
     assert!(m.abs_diff_eq(expected, 1e-12), "{m}\n{expected}");
 }
 
