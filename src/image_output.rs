@@ -235,6 +235,11 @@ mod tests {
         assert_eq!(&file[18..24], &[255, 0, 0, 255, 0, 0]);
         assert_eq!(&file[24..30], &[0, 0, 255, 0, 0, 255]);
         assert_eq!(file.len(), 18 + 12);
+        // A standard decoder reads it the right way up.
+        let decoded = image::open(&path).unwrap().into_rgb8();
+        assert_eq!(decoded.dimensions(), (2, 2));
+        assert_eq!(decoded.get_pixel(0, 0).0, [255, 0, 0]);
+        assert_eq!(decoded.get_pixel(1, 1).0, [0, 0, 255]);
     }
 
     #[cfg(unix)]
