@@ -18,7 +18,7 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 pub enum Command {
-    /// Render a scene to an image (.png, .exr, .hdr or .ppm).
+    /// Render a scene to an image (.png, .exr, .hdr, .ppm or .tga).
     Render(RenderArgs),
     /// Compile and validate a scene; print its diagnostics.
     Check(SceneArgs),
@@ -28,12 +28,25 @@ pub enum Command {
     Trace(TraceArgs),
     /// Explore a scene in the terminal: pick a pixel, walk its ray tree, see the source.
     Debug(DebugArgs),
+    /// Run the MIT 6.837 course's command line, flags as it wrote them (see -help).
+    ///
+    /// whitted mit6837 -input scene.txt -size 200 200 -output out.tga [-shadows] ...
+    #[command(disable_help_flag = true)]
+    Mit6837(Mit6837Args),
+}
+
+/// Everything after `whitted mit6837`, read by the course's own flag rules
+/// (`src/mit6837_cmd.rs`), not by clap's.
+#[derive(Args)]
+pub struct Mit6837Args {
+    #[arg(num_args = 0.., allow_hyphen_values = true, trailing_var_arg = true, value_name = "FLAGS")]
+    pub args: Vec<std::ffi::OsString>,
 }
 
 /// The scene file and the `-D` overrides every scene-reading command takes.
 #[derive(Args, Clone, Debug)]
 pub struct SceneArgs {
-    /// The .scene file.
+    /// The .scene file, or a MIT 6.837 scene file (.txt; recognised by its first word).
     pub scene: PathBuf,
     /// Override a top-level `const`: -D N=316 (VALUE is an expression).
     #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
@@ -65,7 +78,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Output image; the extension picks the format: .png (8-bit sRGB), .exr and .hdr
-    /// (linear float), .ppm (8-bit sRGB). Default: the scene's name with .png, here.
+    /// (linear float), .ppm and .tga (8-bit sRGB). Default: the scene's name with .png, here.
     #[arg(short = 'o', long = "output", value_name = "OUT", value_parser = parse_output)]
     pub output: Option<PathBuf>,
     #[command(flatten)]
@@ -178,6 +191,8 @@ pub enum ImageFormat {
     Exr,
     Hdr,
     Ppm,
+    /// Uncompressed 24-bit Targa, the MIT 6.837 course's format.
+    Tga,
 }
 
 impl ImageFormat {
@@ -188,6 +203,7 @@ impl ImageFormat {
             "exr" => Some(ImageFormat::Exr),
             "hdr" => Some(ImageFormat::Hdr),
             "ppm" => Some(ImageFormat::Ppm),
+            "tga" => Some(ImageFormat::Tga),
             _ => None,
         }
     }
@@ -198,7 +214,7 @@ fn parse_output(text: &str) -> Result<PathBuf, String> {
     match ImageFormat::from_path(&path) {
         Some(_) => Ok(path),
         None => Err(format!(
-            "cannot tell the image format of `{text}`: use a .png, .exr, .hdr or .ppm extension"
+            "cannot tell the image format of `{text}`: use a .png, .exr, .hdr, .ppm or .tga extension"
         )),
     }
 }

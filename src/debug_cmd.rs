@@ -6,25 +6,10 @@ use std::path::{Path, PathBuf};
 
 use whitted_debugger::{Compiled, DebugError, Recompile, Session};
 use whitted_ir::SourceMap;
-use whitted_lang::{compile_file, CompileOptions, SourceLoader};
 
 use crate::cli::{DebugArgs, SceneArgs};
 use crate::scene_input::load_scene;
 use crate::Failure;
-
-/// Reads scene files (the root and its imports) from the file system for the compiler.
-struct DiskLoader;
-
-impl SourceLoader for DiskLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
-        crate::scene_input::read_source(path)
-    }
-
-    /// Through symbolic links, so that a linked folder that loops is an import cycle.
-    fn identify(&mut self, path: &Path) -> std::path::PathBuf {
-        std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
-    }
-}
 
 pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
     // The first compile prints its diagnostics like every other command; a scene with
@@ -61,13 +46,10 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
     })
 }
 
-/// Compiles the scene again, silently: the debugger shows the diagnostics itself.
+/// Compiles the scene again (with the front end its content calls for, and the same `-D`
+/// and `--set` as the first compile), silently: the debugger shows the diagnostics itself.
 fn compile(args: &SceneArgs) -> Compiled {
-    let options = CompileOptions {
-        defines: args.define.clone(),
-        ..CompileOptions::default()
-    };
-    let compilation = compile_file(&args.scene, &mut DiskLoader, &options);
+    let compilation = crate::front_end::compile(args, &whitted_mit6837::CourseOptions::default());
     let watch = watch_list(&args.scene, &compilation.sources);
     Compiled {
         scene: compilation.scene,

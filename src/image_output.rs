@@ -1,4 +1,4 @@
-//! Encoding a linear-light image to PNG, EXR, HDR or PPM, written atomically.
+//! Encoding a linear-light image to PNG, EXR, HDR, PPM or TGA, written atomically.
 
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -21,6 +21,19 @@ pub enum Pixels<'a> {
     Linear(&'a [[f32; 3]]),
     /// 8-bit sRGB, three bytes per pixel (the heat maps), taken as they are by PNG and PPM.
     Srgb8(Vec<u8>),
+    /// 8-bit linear values, three bytes per pixel (the MIT 6.837 course's images: colour
+    /// times 255, no transfer curve), taken as they are by the 8-bit formats.
+    Linear8(Vec<u8>),
+}
+
+/// Linear colours to 8-bit linear bytes as the 6.837 course wrote them: each channel clamped
+/// to [0, 1], times 255, rounded to nearest.
+pub fn to_linear8(pixels: &[[f32; 3]]) -> Vec<u8> {
+    pixels
+        .iter()
+        .flatten()
+        .map(|&c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)
+        .collect()
 }
 
 /// Writes `pixels` to `path` in `format`.
@@ -69,7 +82,7 @@ fn encode(
     // every copy costs gigabytes.
     let srgb8 = |pixels: Pixels<'_>| match pixels {
         Pixels::Linear(linear) => to_srgb8(linear),
-        Pixels::Srgb8(bytes) => bytes,
+        Pixels::Srgb8(bytes) | Pixels::Linear8(bytes) => bytes,
     };
     let floats = |pixels: Pixels<'_>| -> Vec<f32> {
         match pixels {
@@ -78,6 +91,7 @@ fn encode(
                 .iter()
                 .map(|&b| srgb_to_linear(f32::from(b) / 255.0))
                 .collect(),
+            Pixels::Linear8(bytes) => bytes.iter().map(|&b| f32::from(b) / 255.0).collect(),
         }
     };
     match format {
@@ -106,8 +120,37 @@ fn encode(
                 .write_all(&srgb8(pixels))
                 .map_err(|e| e.to_string())?;
         }
+        ImageFormat::Tga => write_tga(&mut writer, width, height, &srgb8(pixels))?,
     }
     writer.flush().map_err(|e| e.to_string())
+}
+
+/// An uncompressed 24-bit Targa image (type 2), rows bottom first and blue-green-red as the
+/// format's origin in the lower left corner (descriptor 0) has them: what the 6.837 course's
+/// images were, and what every reader of the format takes.
+fn write_tga(writer: &mut impl Write, width: u32, height: u32, rgb: &[u8]) -> Result<(), String> {
+    let (Ok(w), Ok(h)) = (u16::try_from(width), u16::try_from(height)) else {
+        return Err(format!(
+            "a TGA image is at most 65535 pixels wide and high, not {width}x{height}"
+        ));
+    };
+    let row = width as usize * 3;
+    if rgb.len() != row * height as usize {
+        return Err("the image has the wrong number of pixels".into());
+    }
+    let mut header = [0u8; 18];
+    header[2] = 2;
+    header[12..14].copy_from_slice(&w.to_le_bytes());
+    header[14..16].copy_from_slice(&h.to_le_bytes());
+    header[16] = 24;
+    writer.write_all(&header).map_err(|e| e.to_string())?;
+    let mut bgr = Vec::with_capacity(row);
+    for line in rgb.chunks_exact(row.max(1)).rev() {
+        bgr.clear();
+        bgr.extend(line.chunks_exact(3).flat_map(|p| [p[2], p[1], p[0]]));
+        writer.write_all(&bgr).map_err(|e| e.to_string())?;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -166,6 +209,37 @@ mod tests {
             })
             .count();
         assert_eq!(leftovers, 0, "the temporary file must be removed");
+    }
+
+    #[test]
+    fn linear_bytes_are_the_colour_times_255_clamped() {
+        assert_eq!(
+            to_linear8(&[[0.0, 0.5, 1.0], [-1.0, 2.0, 0.25]]),
+            vec![0, 128, 255, 0, 255, 64]
+        );
+    }
+
+    #[test]
+    fn a_tga_is_bottom_up_bgr_after_its_header_and_image_reads_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.tga");
+        // Top row red, bottom row blue, two pixels each.
+        let bytes = vec![255, 0, 0, 255, 0, 0, 0, 0, 255, 0, 0, 255];
+        write_image(&path, ImageFormat::Tga, 2, 2, Pixels::Linear8(bytes)).unwrap();
+        let file = std::fs::read(&path).unwrap();
+        assert_eq!(
+            &file[..18],
+            &[0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 2, 0, 24, 0]
+        );
+        // The first row in the file is the bottom (blue) one, in BGR order.
+        assert_eq!(&file[18..24], &[255, 0, 0, 255, 0, 0]);
+        assert_eq!(&file[24..30], &[0, 0, 255, 0, 0, 255]);
+        assert_eq!(file.len(), 18 + 12);
+        // A standard decoder reads it the right way up.
+        let decoded = image::open(&path).unwrap().into_rgb8();
+        assert_eq!(decoded.dimensions(), (2, 2));
+        assert_eq!(decoded.get_pixel(0, 0).0, [255, 0, 0]);
+        assert_eq!(decoded.get_pixel(1, 1).0, [0, 0, 255]);
     }
 
     #[cfg(unix)]

@@ -8,8 +8,10 @@
 mod allocator;
 mod cli;
 mod debug_cmd;
+mod front_end;
 mod image_output;
 mod interrupt;
+mod mit6837_cmd;
 mod render_cmd;
 mod scene_input;
 mod stats_image;
@@ -49,6 +51,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render_cmd::render(&args),
         Command::Trace(args) => trace_cmd::trace(&args),
         Command::Debug(args) => debug_cmd::debug(&args),
+        Command::Mit6837(args) => mit6837_cmd::mit6837(&args.args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -71,7 +71,7 @@ impl MemoryEstimate {
     /// float formats a copy of 12 bytes of floats and the encoder's own buffer of as much.
     fn encoding(format: ImageFormat) -> u64 {
         match format {
-            ImageFormat::Png | ImageFormat::Ppm => 3,
+            ImageFormat::Png | ImageFormat::Ppm | ImageFormat::Tga => 3,
             ImageFormat::Exr | ImageFormat::Hdr => 24,
         }
     }
@@ -144,7 +144,7 @@ fn refuse_outputs_over_sources(
 
 /// Whether two paths name the same file: the same device and inode when both exist (this
 /// sees through links and `..`), otherwise the same canonical folder and file name.
-fn same_file(a: &Path, b: &Path) -> bool {
+pub fn same_file(a: &Path, b: &Path) -> bool {
     #[cfg(unix)]
     {
         use std::os::unix::fs::MetadataExt;

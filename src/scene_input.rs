@@ -5,24 +5,11 @@ use std::io::{IsTerminal, Write};
 use std::path::Path;
 
 use whitted_ir::{Severity, ValidScene};
-use whitted_lang::{compile_file, render_diagnostics, CompileOptions, SourceLoader};
+use whitted_lang::render_diagnostics;
+use whitted_mit6837::CourseOptions;
 
 use crate::cli::{IrArgs, SceneArgs};
 use crate::Failure;
-
-/// Reads scene files from the file system for the compiler.
-struct FileLoader;
-
-impl SourceLoader for FileLoader {
-    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
-        read_source(path)
-    }
-
-    /// Through symbolic links, so that a linked folder that loops is an import cycle.
-    fn identify(&mut self, path: &Path) -> std::path::PathBuf {
-        std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf())
-    }
-}
 
 /// Reads one scene file's bytes (the language decodes them and locates bad UTF-8), refusing
 /// what is not a regular file (a device such as `/dev/zero` never ends, a FIFO blocks) and
@@ -104,9 +91,19 @@ pub struct Loaded {
     pub warnings: usize,
 }
 
-/// Compiles `args.scene`, prints diagnostics (all of them, or only errors when `quiet`),
-/// and returns the scene or `Failure::SceneErrors`.
+/// Compiles `args.scene` (with either front end, a 6.837 scene with the course's defaults),
+/// prints diagnostics (all of them, or only errors when `quiet`), and returns the scene or
+/// `Failure::SceneErrors`.
 pub fn load_scene(args: &SceneArgs, quiet: bool) -> Result<Loaded, Failure> {
+    load_scene_with(args, quiet, &CourseOptions::default())
+}
+
+/// [`load_scene`] with the course's switches for a 6.837 scene.
+pub fn load_scene_with(
+    args: &SceneArgs,
+    quiet: bool,
+    course: &CourseOptions,
+) -> Result<Loaded, Failure> {
     // Report a missing or unreadable root file as one line, before the compiler sees it.
     if let Err(error) = std::fs::metadata(&args.scene) {
         return Err(Failure::Message(format!(
@@ -114,12 +111,7 @@ pub fn load_scene(args: &SceneArgs, quiet: bool) -> Result<Loaded, Failure> {
             args.scene.display()
         )));
     }
-    let options = CompileOptions {
-        defines: args.define.clone(),
-        settings: args.set.clone(),
-        ..CompileOptions::default()
-    };
-    let compilation = compile_file(&args.scene, &mut FileLoader, &options);
+    let compilation = crate::front_end::compile(args, course);
     let shown: Vec<_> = compilation
         .diagnostics
         .iter()

@@ -235,11 +235,21 @@ fn set_replaces_a_setting_for_every_command_and_reports_mistakes_in_its_text() {
         "highlight=blinn",
         "--set",
         "max_depth=9",
+        "--set",
+        "shadows=none",
+        "--set",
+        "shade_back=off",
+        "--set",
+        "attenuation_clamp=off",
     ]);
     assert!(output.status.success(), "{}", stderr(&output));
     let text = stdout(&output);
     assert!(
         text.contains("highlight Blinn") && text.contains("max depth 9"),
+        "{text}"
+    );
+    assert!(
+        text.contains("shadows None, highlight Blinn, back faces unlit, attenuation unclamped"),
         "{text}"
     );
 

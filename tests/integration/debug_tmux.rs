@@ -360,3 +360,35 @@ fn a_signal_from_outside_gives_the_terminal_back() {
         );
     }
 }
+
+/// A MIT 6.837 scene in the debugger: the picked pixel's tree and the source pane point at
+/// the `.txt` file's lines (the object hit and, with `m`, its material).
+#[test]
+fn a_course_scene_shows_its_txt_lines() {
+    // Run from the scene's folder, so that the pane titles show the whole (short) path.
+    let command = format!(
+        "'{}' debug spheres-orthographic.txt --pixel 133,317",
+        whitted()
+    );
+    let folder = repository().join("scenes/mit6837");
+    let tmux = Tmux::start("course", &folder, &command, 120, 40);
+    let screen = tmux.wait_for("the ray tree of the pixel", |s| {
+        s.contains("Ray tree of (133, 317)") && s.contains("Source · ")
+    });
+    assert!(
+        line_with(&screen, "camera      d0").contains("sphere #0"),
+        "{screen}"
+    );
+    assert!(
+        line_with(&screen, "Source · ").contains("spheres-orthographic.txt:31:5"),
+        "{screen}"
+    );
+    assert!(
+        line_with(&screen, "31 │").contains("Sphere {"),
+        "the definition's line is shown:\n{screen}"
+    );
+    tmux.keys(&["q"]);
+    tmux.wait_for("the shell after quitting", |s| {
+        s.contains("debugger exited with 0")
+    });
+}

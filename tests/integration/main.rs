@@ -10,6 +10,7 @@ mod debug_tmux;
 mod extremes;
 mod guards;
 mod json_schema;
+mod mit6837;
 mod ray_trees;
 mod reshade;
 mod tidy;

@@ -20,28 +20,56 @@ impl SourceLoader for FileLoader {
     }
 }
 
+impl whitted_mit6837::MeshLoader for FileLoader {
+    fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
+        std::fs::read(path)
+    }
+}
+
 /// A compiled and prepared scene; paths are relative to the workspace, as users type them.
 pub struct Loaded {
     pub scene: ValidScene,
     pub prepared: PreparedScene,
 }
 
+/// Compiles a scene with the front end its content calls for. A 6.837 scene gets the
+/// course's defaults (no shadow rays, back faces unlit, attenuation unclamped) with five
+/// bounces, so that its reflections and refractions are traced too.
 pub fn load(path: &str) -> Loaded {
-    let compilation = compile_file(Path::new(path), &mut FileLoader, &CompileOptions::default());
-    let Some(scene) = compilation.scene else {
-        panic!("{path} does not compile: {:?}", compilation.diagnostics);
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let (scene, diagnostics) = if whitted_mit6837::is_mit6837(&bytes) {
+        let options = whitted_mit6837::CourseOptions {
+            bounces: 5,
+            weight: 0.01,
+            ..whitted_mit6837::CourseOptions::default()
+        };
+        let conversion =
+            whitted_mit6837::convert(Path::new(path), bytes, &mut FileLoader, &options);
+        (conversion.scene, conversion.diagnostics)
+    } else {
+        let compilation =
+            compile_file(Path::new(path), &mut FileLoader, &CompileOptions::default());
+        (compilation.scene, compilation.diagnostics)
+    };
+    let Some(scene) = scene else {
+        panic!("{path} does not compile: {diagnostics:?}");
     };
     let prepared = PreparedScene::new(&scene);
     Loaded { scene, prepared }
 }
 
-/// The feature scenes (scenes/*.scene, not the benchmarks), sorted.
+/// The feature scenes (scenes/*.scene, not the benchmarks, and the 6.837 scenes in
+/// scenes/mit6837/), sorted.
 pub fn feature_scenes() -> Vec<PathBuf> {
-    let mut scenes: Vec<PathBuf> = std::fs::read_dir("scenes")
-        .expect("the scenes directory")
-        .filter_map(|entry| entry.ok().map(|e| e.path()))
-        .filter(|path| path.extension().is_some_and(|e| e == "scene"))
-        .collect();
+    let listed = |dir: &str, extension: &str| -> Vec<PathBuf> {
+        std::fs::read_dir(dir)
+            .unwrap_or_else(|e| panic!("{dir}: {e}"))
+            .filter_map(|entry| entry.ok().map(|e| e.path()))
+            .filter(|path| path.extension().is_some_and(|e| e == extension))
+            .collect()
+    };
+    let mut scenes = listed("scenes", "scene");
+    scenes.extend(listed("scenes/mit6837", "txt"));
     scenes.sort();
     scenes
 }

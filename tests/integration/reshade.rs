@@ -122,9 +122,15 @@ fn fresnel_exact(cos_i: f64, n1: f64, n2: f64) -> f64 {
     0.5 * (rs * rs + rp * rp)
 }
 
-/// Distance attenuation `min(1, 1/(c + l·d + q·d²))`.
-fn fatt(a: &whitted_ir::Attenuation, d: f64) -> f64 {
-    (1.0 / (a.constant + a.linear * d + a.quadratic * d * d)).min(1.0)
+/// Distance attenuation `min(1, 1/(c + l·d + q·d²))`, or without the `min` when `clamp` is
+/// off (then bounded by the largest attenuation limit, as docs/language.md says).
+fn fatt(a: &whitted_ir::Attenuation, d: f64, clamp: bool) -> f64 {
+    let largest = if clamp {
+        1.0
+    } else {
+        whitted_ir::limits::MAX_UNCLAMPED_ATTENUATION
+    };
+    (1.0 / (a.constant + a.linear * d + a.quadratic * d * d)).min(largest)
 }
 
 /// The smoothstep of the spot cone between the outer and the inner angle.
@@ -142,14 +148,14 @@ fn spot_factor(cos_angle: f64, inner_degrees: f64, outer_degrees: f64) -> f64 {
 }
 
 /// Where the light is seen from `p`: unit direction, distance, fatt and the spot factor.
-fn incidence(kind: &LightKind, p: DVec3) -> (DVec3, f64, f64, f64) {
+fn incidence(kind: &LightKind, p: DVec3, clamp: bool) -> (DVec3, f64, f64, f64) {
     match kind {
         LightKind::Point {
             position,
             attenuation,
         } => {
             let d = (*position - p).length();
-            ((*position - p) / d, d, fatt(attenuation, d), 1.0)
+            ((*position - p) / d, d, fatt(attenuation, d, clamp), 1.0)
         }
         LightKind::Directional { direction } => (-direction.normalize(), f64::INFINITY, 1.0, 1.0),
         LightKind::Spot {
@@ -163,7 +169,7 @@ fn incidence(kind: &LightKind, p: DVec3) -> (DVec3, f64, f64, f64) {
             let l = (*position - p) / d;
             let cos_angle = (-l).dot(direction.normalize());
             let spot = spot_factor(cos_angle, *inner_angle_degrees, *outer_angle_degrees);
-            (l, d, fatt(attenuation, d), spot)
+            (l, d, fatt(attenuation, d, clamp), spot)
         }
     }
 }
@@ -221,6 +227,31 @@ impl Reshader<'_> {
         color
     }
 
+    /// One light's diffuse and specular terms: `strength` is fatt·spot, `passed` what the
+    /// shadow ray let through, `(n, l, d)` the shading normal, the unit direction to the
+    /// light and the incoming ray's direction.
+    fn light_terms(
+        &self,
+        light: &whitted_ir::Light,
+        strength: f64,
+        passed: DVec3,
+        (n, l, d): (DVec3, DVec3, DVec3),
+        m: &Material,
+    ) -> DVec3 {
+        let n_dot_l = n.dot(l);
+        let light_in = c(&light.color) * strength * passed;
+        let diffuse = light_in * c(&m.diffuse) * n_dot_l.max(0.0);
+        let cosine = match self.scene.settings.highlight {
+            Highlight::Phong => {
+                let r = -l + 2.0 * n_dot_l * n; // L mirrored about N
+                r.dot(-d)
+            }
+            // H halfway between the light and the viewer.
+            Highlight::Blinn => n.dot((l - d).normalize_or_zero()),
+        };
+        diffuse + light_in * c(&m.specular) * cosine.max(0.0).powf(m.shininess)
+    }
+
     fn shade_inner(&mut self, node: &RayNode, weight: DVec3, media: &Media, path: &str) -> DVec3 {
         let a = media.absorption();
         let d = v(node.direction).normalize();
@@ -255,9 +286,27 @@ impl Reshader<'_> {
             // The light is seen from where the shadow ray starts (the point moved off the
             // surface); without a shadow ray, from the hit point itself.
             let from = shadow.map_or(p, |s| v(s.origin));
-            let (l, distance, fatt, spot) = incidence(&light.kind, from);
+            let settings = &self.scene.settings;
+            let (l, distance, fatt, spot) =
+                incidence(&light.kind, from, settings.attenuation_clamp);
             let n_dot_l = n.dot(l);
             let strength = fatt * spot * c(&light.color).max_element();
+            if !settings.shade_back && !hit.front_face {
+                // A back face with `shade_back off`: no light, no shadow ray.
+                if shadow.is_some() {
+                    self.problem(path, "a shadow ray from an unlit back face".into());
+                }
+                continue;
+            }
+            if settings.shadows == ShadowMode::None {
+                if shadow.is_some() {
+                    self.problem(path, "a shadow ray with shadows none".into());
+                }
+                if n_dot_l > 0.0 && strength > 0.0 {
+                    local += self.light_terms(light, fatt * spot, DVec3::ONE, (n, l, d), &m);
+                }
+                continue;
+            }
             let Some(shadow) = shadow else {
                 // No shadow ray: right when the light cannot count here (or, as a shortcut
                 // some tracers take, when the material has no diffuse or specular term).
@@ -322,18 +371,7 @@ impl Reshader<'_> {
                     DVec3::ZERO
                 }
             };
-            let light_in = c(&light.color) * fatt * spot * passed;
-            let diffuse = light_in * kd * n_dot_l.max(0.0);
-            let cosine = match self.scene.settings.highlight {
-                Highlight::Phong => {
-                    let r = -l + 2.0 * n_dot_l * n; // L mirrored about N
-                    r.dot(-d)
-                }
-                // H halfway between the light and the viewer.
-                Highlight::Blinn => n.dot((l - d).normalize_or_zero()),
-            };
-            let specular = light_in * ks * cosine.max(0.0).powf(m.shininess);
-            local += diffuse + specular;
+            local += self.light_terms(light, fatt * spot, passed, (n, l, d), &m);
         }
 
         // Secondary rays: what the material asks for, split by Fresnel.

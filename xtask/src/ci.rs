@@ -8,32 +8,60 @@ use anyhow::{bail, Context};
 use crate::{cargo, run_cargo, workspace_root};
 
 /// Which crates each workspace crate must never depend on (DESIGN.md, "Dependency directions").
-/// `ir <- lang`, `ir <- tracer <- debugger`; the tracer never sees syntax, the debugger never parses.
+/// `ir <- lang`, `ir <- mit6837`, `ir <- tracer <- debugger`; the tracer never sees syntax,
+/// the debugger never parses, and the two front ends know nothing of each other or of what
+/// comes after the IR.
 const FORBIDDEN: &[(&str, &[&str])] = &[
     (
         "whitted-ir",
-        &["whitted-lang", "whitted-tracer", "whitted-debugger", "pest"],
+        &[
+            "whitted-lang",
+            "whitted-mit6837",
+            "whitted-tracer",
+            "whitted-debugger",
+            "pest",
+        ],
+    ),
+    (
+        "whitted-mit6837",
+        &[
+            "whitted-lang",
+            "whitted-tracer",
+            "whitted-debugger",
+            "pest",
+            "ratatui",
+        ],
     ),
     (
         "whitted-lang",
-        &["whitted-tracer", "whitted-debugger", "ratatui"],
+        &[
+            "whitted-mit6837",
+            "whitted-tracer",
+            "whitted-debugger",
+            "ratatui",
+        ],
     ),
     (
         "whitted-tracer",
         &[
             "whitted-lang",
+            "whitted-mit6837",
             "whitted-debugger",
             "pest",
             "pest_derive",
             "ratatui",
         ],
     ),
-    ("whitted-debugger", &["whitted-lang", "pest", "pest_derive"]),
+    (
+        "whitted-debugger",
+        &["whitted-lang", "whitted-mit6837", "pest", "pest_derive"],
+    ),
 ];
 
 /// Edges that must exist, so that a renamed crate cannot make the checks above vacuous.
 const REQUIRED: &[(&str, &str)] = &[
     ("whitted-lang", "whitted-ir"),
+    ("whitted-mit6837", "whitted-ir"),
     ("whitted-tracer", "whitted-ir"),
     ("whitted-debugger", "whitted-tracer"),
 ];

@@ -92,6 +92,12 @@ pub const MIN_IOR: f64 = 1e-3;
 /// The largest index of refraction.
 pub const MAX_IOR: f64 = 1e3;
 
+/// The largest distance attenuation of a point or spot light when `attenuation_clamp` is
+/// off: `1 / (c + l·d + q·d²)` grows without bound as a surface nears a light with no
+/// constant term, and this keeps it (times the largest intensity and coefficient, over
+/// every light) finite in f32.
+pub const MAX_UNCLAMPED_ATTENUATION: f64 = 1e6;
+
 /// A limit's value: a count of things, or a bound on a number in the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Value {
@@ -215,6 +221,11 @@ pub const ALL: &[Limit] = &[
     ),
     number("smallest ior", MIN_IOR, "index of refraction"),
     number("largest ior", MAX_IOR, "index of refraction"),
+    number(
+        "largest attenuation",
+        MAX_UNCLAMPED_ATTENUATION,
+        "a point or spot light's distance attenuation with `attenuation_clamp off`",
+    ),
 ];
 
 /// The limit called `name` (for messages): `the evaluation steps limit (100,000,000)`.

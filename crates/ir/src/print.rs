@@ -21,7 +21,7 @@ pub fn print(scene: &Scene) -> String {
     );
     let _ = writeln!(
         out,
-        "  background {}, ambient {}, epsilon {}, shadows {:?}{}",
+        "  background {}, ambient {}, epsilon {}, shadows {:?}{}{}{}",
         color(&s.background),
         color(&s.ambient),
         s.epsilon.map_or("auto".to_string(), |e| e.to_string()),
@@ -30,6 +30,17 @@ pub fn print(scene: &Scene) -> String {
         match s.highlight {
             crate::scene::Highlight::Phong => "",
             crate::scene::Highlight::Blinn => ", highlight Blinn",
+        },
+        // Likewise shown only when they leave the default.
+        if s.shade_back {
+            ""
+        } else {
+            ", back faces unlit"
+        },
+        if s.attenuation_clamp {
+            ""
+        } else {
+            ", attenuation unclamped"
         }
     );
     let c = &scene.camera;

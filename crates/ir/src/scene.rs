@@ -47,6 +47,9 @@ pub enum ShadowMode {
     Opaque,
     /// A transmissive blocker lets light through, multiplied by its transmissive colour.
     Filtered,
+    /// No shadow rays at all: every light reaches every surface that faces it (MIT 6.837's
+    /// default without `-shadows`).
+    None,
 }
 
 /// The specular highlight's model.
@@ -78,6 +81,13 @@ pub struct Settings {
     pub epsilon: Option<f64>,
     pub shadows: ShadowMode,
     pub highlight: Highlight,
+    /// Whether a surface seen from its back is lit by the lights (with its normal turned to
+    /// face the viewer). When false, lights add nothing there; its ambient and emission
+    /// terms and its reflected and transmitted rays stay (MIT 6.837 without `-shade_back`).
+    pub shade_back: bool,
+    /// Whether point and spot lights' distance attenuation is clamped at 1, so that a light
+    /// never gets brighter than its colour close up (MIT 6.837 does not clamp).
+    pub attenuation_clamp: bool,
 }
 
 impl Default for Settings {
@@ -93,6 +103,8 @@ impl Default for Settings {
             epsilon: None,
             shadows: ShadowMode::Opaque,
             highlight: Highlight::Phong,
+            shade_back: true,
+            attenuation_clamp: true,
         }
     }
 }
@@ -125,7 +137,8 @@ impl Default for Camera {
     }
 }
 
-/// Distance attenuation `fatt = min(1, 1 / (constant + linear·d + quadratic·d²))`.
+/// Distance attenuation `fatt = min(1, 1 / (constant + linear·d + quadratic·d²))` (without the
+/// `min` when [`Settings::attenuation_clamp`] is off).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Attenuation {
     pub constant: f64,

@@ -207,10 +207,16 @@ properties! {
         Settings => Number { min: limits::MIN_SIZE, open: false, max: 1.0 }, "automatic", "how far off a surface secondary rays start";
     }
     Shadows "shadows" {
-        Settings => Word(&["opaque", "filtered"]), "opaque", "whether transparent objects let light through to what they shadow";
+        Settings => Word(&["opaque", "filtered", "none"]), "opaque", "whether transparent objects let light through to what they shadow (`none`: no shadow rays at all)";
     }
     Highlight "highlight" {
         Settings => Word(&["phong", "blinn"]), "phong", "the specular model: Phong ks·(R·V)^n or Blinn-Phong ks·(N·H)^n";
+    }
+    ShadeBack "shade_back" {
+        Settings => Word(&["on", "off"]), "on", "whether lights shade a surface seen from its back (`off`: only its ambient, emission, reflection and refraction)";
+    }
+    AttenuationClamp "attenuation_clamp" {
+        Settings => Word(&["on", "off"]), "on", "whether point and spot lights' distance attenuation is clamped at 1";
     }
     Position "position" {
         Light(POSITIONED) => Vector, "", "where the light is";

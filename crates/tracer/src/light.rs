@@ -19,6 +19,7 @@ pub enum PreparedLightKind {
     Point {
         position: Vec3A,
         attenuation: [f32; 3],
+        clamp: bool,
     },
     Directional {
         /// Unit vector towards the light (against its direction of travel).
@@ -31,6 +32,7 @@ pub enum PreparedLightKind {
         cos_inner: f32,
         cos_outer: f32,
         attenuation: [f32; 3],
+        clamp: bool,
     },
 }
 
@@ -52,7 +54,8 @@ fn terms(a: &Attenuation) -> [f32; 3] {
 }
 
 impl PreparedLight {
-    pub fn new(handle: Handle<Light>, light: &Light) -> PreparedLight {
+    /// `clamp` is the scene's `attenuation_clamp` setting.
+    pub fn new(handle: Handle<Light>, light: &Light, clamp: bool) -> PreparedLight {
         let kind = match &light.kind {
             LightKind::Point {
                 position,
@@ -60,6 +63,7 @@ impl PreparedLight {
             } => PreparedLightKind::Point {
                 position: position.as_vec3a(),
                 attenuation: terms(attenuation),
+                clamp,
             },
             LightKind::Directional { direction } => PreparedLightKind::Directional {
                 to_light: (-direction.normalize()).as_vec3a(),
@@ -76,6 +80,7 @@ impl PreparedLight {
                 cos_inner: inner_angle_degrees.to_radians().cos() as f32,
                 cos_outer: outer_angle_degrees.to_radians().cos() as f32,
                 attenuation: terms(attenuation),
+                clamp,
             },
         };
         PreparedLight {
@@ -98,12 +103,13 @@ impl PreparedLight {
             PreparedLightKind::Point {
                 position,
                 attenuation,
+                clamp,
             } => {
                 let (to_light, distance) = towards(*position, point);
                 Incidence {
                     to_light,
                     distance,
-                    attenuation: fatt(attenuation, distance),
+                    attenuation: fatt(attenuation, distance, *clamp),
                     spot: 1.0,
                 }
             }
@@ -113,13 +119,14 @@ impl PreparedLight {
                 cos_inner,
                 cos_outer,
                 attenuation,
+                clamp,
             } => {
                 let (to_light, distance) = towards(*position, point);
                 let cos_angle = (-to_light).dot(*axis);
                 Incidence {
                     to_light,
                     distance,
-                    attenuation: fatt(attenuation, distance),
+                    attenuation: fatt(attenuation, distance, *clamp),
                     spot: optics::spot_factor(cos_angle, *cos_inner, *cos_outer),
                 }
             }
@@ -138,6 +145,6 @@ fn towards(position: Vec3A, point: Vec3A) -> (Vec3A, f32) {
     }
 }
 
-fn fatt(terms: &[f32; 3], distance: f32) -> f32 {
-    optics::attenuation(terms[0], terms[1], terms[2], distance)
+fn fatt(terms: &[f32; 3], distance: f32, clamp: bool) -> f32 {
+    optics::attenuation(terms[0], terms[1], terms[2], distance, clamp)
 }

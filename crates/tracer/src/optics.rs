@@ -72,12 +72,19 @@ pub fn critical_angle(ior_from: f32, ior_to: f32) -> Option<f32> {
     (ior_from > ior_to).then(|| (ior_to / ior_from).asin())
 }
 
-/// Distance attenuation of point and spot lights: `min(1, 1 / (c + l·d + q·d²))`.
+/// Distance attenuation of point and spot lights: `min(1, 1 / (c + l·d + q·d²))`, or with
+/// `clamp` false `1 / (c + l·d + q·d²)` itself, bounded by the largest attenuation limit
+/// (a surface at a light with no constant term would otherwise get infinite light).
 #[inline]
-pub fn attenuation(constant: f32, linear: f32, quadratic: f32, distance: f32) -> f32 {
+pub fn attenuation(constant: f32, linear: f32, quadratic: f32, distance: f32, clamp: bool) -> f32 {
     let denominator = constant + linear * distance + quadratic * distance * distance;
-    if denominator <= 1.0 {
+    let largest = if clamp {
         1.0
+    } else {
+        whitted_ir::limits::MAX_UNCLAMPED_ATTENUATION as f32
+    };
+    if denominator * largest <= 1.0 {
+        largest
     } else {
         1.0 / denominator
     }
@@ -261,11 +268,40 @@ mod tests {
 
     #[test]
     fn attenuation_follows_the_textbook_formula() {
-        assert_eq!(attenuation(1.0, 0.0, 0.0, 100.0), 1.0);
-        assert!(close(attenuation(1.0, 0.5, 0.25, 2.0), 1.0 / 3.0, 1e-7));
-        assert!(close(attenuation(0.0, 0.0, 1.0, 4.0), 1.0 / 16.0, 1e-7));
+        assert_eq!(attenuation(1.0, 0.0, 0.0, 100.0, true), 1.0);
+        assert!(close(
+            attenuation(1.0, 0.5, 0.25, 2.0, true),
+            1.0 / 3.0,
+            1e-7
+        ));
+        assert!(close(
+            attenuation(0.0, 0.0, 1.0, 4.0, true),
+            1.0 / 16.0,
+            1e-7
+        ));
         // Clamped to 1 close to the light.
-        assert_eq!(attenuation(0.0, 0.0, 1.0, 0.5), 1.0);
+        assert_eq!(attenuation(0.0, 0.0, 1.0, 0.5, true), 1.0);
+    }
+
+    #[test]
+    fn unclamped_attenuation_exceeds_one_close_to_the_light() {
+        // 1 / (0.25 + 0.5·0.5 + 1·0.25) = 1 / 0.75.
+        assert!(close(
+            attenuation(0.25, 0.5, 1.0, 0.5, false),
+            4.0 / 3.0,
+            1e-6
+        ));
+        // Far away the two agree.
+        assert_eq!(
+            attenuation(1.0, 0.5, 0.25, 2.0, false),
+            attenuation(1.0, 0.5, 0.25, 2.0, true)
+        );
+        // At a light with no constant term: the largest attenuation, not infinity.
+        let at_light = attenuation(0.0, 0.0, 1.0, 0.0, false);
+        assert_eq!(
+            at_light,
+            whitted_ir::limits::MAX_UNCLAMPED_ATTENUATION as f32
+        );
     }
 
     #[test]

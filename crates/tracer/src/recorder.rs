@@ -241,6 +241,12 @@ pub struct LightSample {
     /// The light faces the surface, but no shadow ray was cast because the material has no
     /// diffuse and no specular colour: the light could add nothing.
     pub unshaded: bool,
+    /// The light faces the surface and no shadow ray was cast because the scene has
+    /// `shadows none`: the light counts as unblocked.
+    pub shadows_off: bool,
+    /// The surface is seen from its back and the scene has `shade_back off`: the light adds
+    /// nothing, and no shadow ray was cast.
+    pub back_face: bool,
     /// `fatt·spot·Ii·shadow·kd·(N·L)`, as added to the colour.
     pub diffuse: Vec3A,
     /// `fatt·spot·Ii·shadow·ks·(R·V)^n`, as added to the colour.

@@ -112,7 +112,9 @@ impl PreparedScene {
         let lights = scene
             .lights
             .iter()
-            .map(|(handle, light)| PreparedLight::new(handle, light))
+            .map(|(handle, light)| {
+                PreparedLight::new(handle, light, scene.settings.attenuation_clamp)
+            })
             .collect();
         let roots = flatten_groups(scene);
         // Memory traffic dominates scenes of a million objects, so items are made once and

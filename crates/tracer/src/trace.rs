@@ -291,7 +291,7 @@ impl<'a> Tracer<'a> {
 
         let offset = scene.offset_at(ray, hit.t, point) * self.offset_scale;
         let outside = point + offset * n;
-        let mut color = self.local_illumination(m, outside, n, -d, rec);
+        let mut color = self.local_illumination(m, outside, n, -d, front_face, rec);
 
         // Secondary rays.
         let split = split_at(
@@ -605,14 +605,17 @@ impl<'a> Tracer<'a> {
     /// `ka·Ia·kd`, plus the surface's own emission, plus, for every light on the visible
     /// side, `fatt·spot·Ii·(kd·(N·L) + ks·(R·V)^n)` (or `ks·(N·H)^n` with `highlight blinn`)
     /// times what the shadow ray lets through. `outside` is the hit point already moved off
-    /// the surface along `n`, which faces the viewer. The order of the
-    /// additions is part of the recorder contract (see `recorder.rs`): keep it.
+    /// the surface along `n`, which faces the viewer. With `shade_back off`, a surface seen
+    /// from its back (`front_face` false) gets no light at all; with `shadows none`, no
+    /// shadow ray is cast and every light facing the surface counts as unblocked. The order
+    /// of the additions is part of the recorder contract (see `recorder.rs`): keep it.
     fn local_illumination<R: Recorder>(
         &mut self,
         m: &PreparedMaterial,
         outside: Vec3A,
         n: Vec3A,
         view: Vec3A,
+        front_face: bool,
         rec: &mut R,
     ) -> Vec3A {
         let scene = self.scene;
@@ -624,6 +627,7 @@ impl<'a> Tracer<'a> {
         // With no diffuse and no specular colour a light adds nothing whatever its shadow
         // ray finds, so the ray is not cast (14% of a mirror scene's shadow rays).
         let unshaded = m.diffuse == Vec3A::ZERO && m.specular == Vec3A::ZERO;
+        let back_face = !front_face && !scene.settings.shade_back;
         for light in &scene.lights {
             let incidence = light.incidence(outside);
             let n_dot_l = n.dot(incidence.to_light);
@@ -637,9 +641,15 @@ impl<'a> Tracer<'a> {
                 spot: incidence.spot,
                 shadow_ray: None,
                 unshaded: false,
+                shadows_off: false,
+                back_face,
                 diffuse: Vec3A::ZERO,
                 specular: Vec3A::ZERO,
             };
+            if back_face {
+                rec.light_sampled(&sample);
+                continue;
+            }
             if n_dot_l <= 0.0 || strength <= 0.0 || light.intensity == Vec3A::ZERO {
                 rec.light_sampled(&sample);
                 continue;
@@ -649,8 +659,12 @@ impl<'a> Tracer<'a> {
                 rec.light_sampled(&sample);
                 continue;
             }
-            let (passed, shadow_ray) =
-                self.cast_shadow::<R>(outside, incidence.to_light, incidence.distance);
+            let (passed, shadow_ray) = if scene.shadows == ShadowMode::None {
+                sample.shadows_off = true;
+                (Vec3A::ONE, None)
+            } else {
+                self.cast_shadow::<R>(outside, incidence.to_light, incidence.distance)
+            };
             sample.shadow_ray = shadow_ray;
             if passed != Vec3A::ZERO {
                 let light_in = light.intensity * strength * passed;
@@ -686,6 +700,8 @@ impl<'a> Tracer<'a> {
                 None => Shadow::Clear,
             },
             ShadowMode::Filtered => scene.filter_shadow(&ray, 0.0, distance, &mut self.scratch),
+            // `local_illumination` casts no shadow ray with `shadows none`.
+            ShadowMode::None => Shadow::Clear,
         };
         let passed = match shadow {
             Shadow::Clear => Vec3A::ONE,

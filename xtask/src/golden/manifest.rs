@@ -52,6 +52,7 @@ struct RawScene {
     max_mean_flip: Option<f64>,
     #[serde(default)]
     pixels: Vec<[u32; 2]>,
+    course: Option<Vec<String>>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -84,6 +85,10 @@ pub struct GoldenScene {
     pub thresholds: Thresholds,
     /// Pixels (at the golden size) whose ray trees are stored beside the image.
     pub pixels: Vec<[u32; 2]>,
+    /// For a MIT 6.837 scene, the course's flags (`["-shadows", "-bounces", "4"]`): the
+    /// reference is what `whitted mit6837 -input PATH -size W H -output OUT FLAGS` writes
+    /// (8-bit linear, as the course's images). `None`: `whitted render`.
+    pub course: Option<Vec<String>>,
 }
 
 #[derive(Debug)]
@@ -129,6 +134,14 @@ pub fn parse(text: &str, origin: &Path) -> anyhow::Result<Manifest> {
         }
         let width = s.width.or(defaults.width).unwrap_or(DEFAULT_WIDTH);
         let height = s.height.or(defaults.height).unwrap_or(DEFAULT_HEIGHT);
+        if s.course.is_some() && !s.pixels.is_empty() {
+            bail!(
+                "{}: `{}` is rendered by the course's command line, which has no ray trees: \
+                 leave out `pixels`",
+                origin.display(),
+                s.name
+            );
+        }
         for [x, y] in &s.pixels {
             if *x >= width || *y >= height {
                 bail!(
@@ -159,6 +172,7 @@ pub fn parse(text: &str, origin: &Path) -> anyhow::Result<Manifest> {
                     .unwrap_or(base.max_mean_flip),
             },
             pixels: s.pixels,
+            course: s.course,
         });
     }
     Ok(Manifest {
@@ -167,7 +181,7 @@ pub fn parse(text: &str, origin: &Path) -> anyhow::Result<Manifest> {
     })
 }
 
-/// A manifest for a user's folder without one: every `.scene` in it, with the defaults.
+/// A manifest for a user's folder without one: every scene in it, with the defaults.
 pub fn from_folder(scenes_dir: &Path) -> anyhow::Result<Manifest> {
     let mut scenes = Vec::new();
     for path in scene_files(scenes_dir)? {
@@ -183,6 +197,7 @@ pub fn from_folder(scenes_dir: &Path) -> anyhow::Result<Manifest> {
             defines: Vec::new(),
             thresholds: Thresholds::default(),
             pixels: Vec::new(),
+            course: None,
         });
     }
     Ok(Manifest {
@@ -191,18 +206,27 @@ pub fn from_folder(scenes_dir: &Path) -> anyhow::Result<Manifest> {
     })
 }
 
-/// The `.scene` files directly inside `dir`, sorted (no recursion: subfolders such as
-/// scenes/bench/ are not golden).
+/// The `.scene` files and MIT 6.837 scenes (`.txt` files whose first word is a 6.837
+/// keyword) directly inside `dir`, sorted (no recursion: subfolders such as scenes/bench/
+/// are not golden).
 pub fn scene_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for entry in std::fs::read_dir(dir).with_context(|| format!("cannot list {}", dir.display()))? {
         let path = entry?.path();
-        if path.is_file() && path.extension().is_some_and(|e| e == "scene") {
+        if path.is_file()
+            && (path.extension().is_some_and(|e| e == "scene") || is_course_scene(&path))
+        {
             files.push(path);
         }
     }
     files.sort();
     Ok(files)
+}
+
+/// A `.txt` file that is a MIT 6.837 scene.
+fn is_course_scene(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e == "txt")
+        && std::fs::read(path).is_ok_and(|bytes| whitted_mit6837::is_mit6837(&bytes))
 }
 
 #[cfg(test)]

@@ -166,7 +166,8 @@ fn load_manifest(root: &Path, options: &Options) -> anyhow::Result<(Manifest, Pa
     let text = std::fs::read_to_string(&manifest_path)
         .with_context(|| format!("cannot read {}", manifest_path.display()))?;
     let manifest = manifest::parse(&text, &manifest_path)?;
-    // Every scene in scenes/ must be golden or excluded with a reason, so none is forgotten.
+    // Every scene in scenes/ and scenes/mit6837/ must be golden or excluded with a reason, so
+    // none is forgotten.
     let listed: Vec<PathBuf> = manifest
         .scenes
         .iter()
@@ -174,7 +175,10 @@ fn load_manifest(root: &Path, options: &Options) -> anyhow::Result<(Manifest, Pa
         .chain(manifest.exclusions.iter().map(|e| e.path.clone()))
         .collect();
     let mut missing = Vec::new();
-    for file in manifest::scene_files(&root.join("scenes"))? {
+    let scene_files = manifest::scene_files(&root.join("scenes"))?
+        .into_iter()
+        .chain(manifest::scene_files(&root.join("scenes/mit6837"))?);
+    for file in scene_files {
         let relative = file.strip_prefix(root).unwrap_or(&file).to_path_buf();
         if !listed.contains(&relative) {
             missing.push(relative.display().to_string());
@@ -216,11 +220,42 @@ fn scene_command(exe: &Path, root: &Path, subcommand: &str, scene: &GoldenScene)
     command
 }
 
-/// Renders a scene at its golden size into `out`.
-fn render(exe: &Path, root: &Path, scene: &GoldenScene, out: &Path) -> anyhow::Result<RgbImage> {
-    let result = scene_command(exe, root, "render", scene)
-        .args(["--quiet", "-o"])
+/// `whitted mit6837 -input SCENE -size W H -output OUT FLAGS...`: the course's command line.
+fn course_command(
+    exe: &Path,
+    root: &Path,
+    scene: &GoldenScene,
+    flags: &[String],
+    out: &Path,
+) -> Command {
+    let mut command = Command::new(exe);
+    command
+        .current_dir(root)
+        .args(["mit6837", "-input"])
+        .arg(&scene.path)
+        .args([
+            "-size",
+            &scene.width.to_string(),
+            &scene.height.to_string(),
+            "-output",
+        ])
         .arg(out)
+        .args(flags);
+    command
+}
+
+/// Renders a scene at its golden size into `out` (with the course's command line for a
+/// 6.837 scene that names its flags).
+fn render(exe: &Path, root: &Path, scene: &GoldenScene, out: &Path) -> anyhow::Result<RgbImage> {
+    let mut command = match &scene.course {
+        Some(flags) => course_command(exe, root, scene, flags, out),
+        None => {
+            let mut command = scene_command(exe, root, "render", scene);
+            command.args(["--quiet", "-o"]).arg(out);
+            command
+        }
+    };
+    let result = command
         .output()
         .with_context(|| format!("cannot run {}", exe.display()))?;
     if !result.status.success() {

@@ -164,7 +164,7 @@ impl Lines {
                 }
             }
             if let Some(local) = &node.local {
-                self.local(local);
+                self.local(local, whole.model.highlight);
             }
             self.why_this_colour(node);
         }
@@ -260,7 +260,7 @@ impl Lines {
         }
     }
 
-    fn local(&mut self, local: &LocalIllumination) {
+    fn local(&mut self, local: &LocalIllumination, highlight: whitted_ir::Highlight) {
         self.section("local illumination");
         self.color("ambient", local.ambient, "ka·Ia·kd");
         // Most surfaces give off no light: show the line only for those that do.
@@ -275,6 +275,8 @@ impl Lines {
                     Visibility::Blocked => "in shadow".to_string(),
                     Visibility::NotFacing => "faces away (no shadow ray)".to_string(),
                     Visibility::Unshaded => "nothing to light (no shadow ray)".to_string(),
+                    Visibility::NoShadows => "lit (shadows none: no shadow ray)".to_string(),
+                    Visibility::BackFace => "unlit back face (shade_back off)".to_string(),
                 },
                 format!("N·L {}", number(light.n_dot_l)),
             ];
@@ -286,7 +288,11 @@ impl Lines {
             }
             self.text(&format!("light {}", light.light.label), facts.join(" · "));
             self.color("  diffuse", light.diffuse, "kd·(N·L)");
-            self.color("  specular", light.specular, "ks·(R·V)^n");
+            let specular = match highlight {
+                whitted_ir::Highlight::Phong => "ks·(R·V)^n",
+                whitted_ir::Highlight::Blinn => "ks·(N·H)^n",
+            };
+            self.color("  specular", light.specular, specular);
         }
         self.color("local total", local.total, "");
     }
@@ -384,13 +390,18 @@ mod tests {
     use super::*;
 
     fn local_text(emission: [f32; 3]) -> String {
-        let mut lines = Lines::new(ColorDepth::TrueColor);
-        lines.local(&LocalIllumination {
+        let local = LocalIllumination {
             ambient: [0.1; 3],
             emission,
             lights: Vec::new(),
             total: [0.1 + emission[0], 0.1 + emission[1], 0.1 + emission[2]],
-        });
+        };
+        text_of(&local, whitted_ir::Highlight::Phong)
+    }
+
+    fn text_of(local: &LocalIllumination, highlight: whitted_ir::Highlight) -> String {
+        let mut lines = Lines::new(ColorDepth::TrueColor);
+        lines.local(local, highlight);
         lines
             .out
             .iter()
@@ -414,5 +425,45 @@ mod tests {
         let plain = local_text([0.0; 3]);
         assert!(!plain.contains("emission"), "{plain}");
         assert!(plain.contains("ambient"), "{plain}");
+    }
+
+    #[test]
+    fn the_specular_line_names_the_scene_s_highlight_model() {
+        let light = whitted_tracer::ray_tree::LightContribution {
+            light: whitted_tracer::ray_tree::LightRef {
+                handle: 0,
+                name: None,
+                label: "light #0".into(),
+                kind: "directional".into(),
+                location: "<built-in>".into(),
+                span: whitted_ir::Span::detached(),
+            },
+            to_light: [0.0, 1.0, 0.0],
+            distance: None,
+            n_dot_l: 1.0,
+            attenuation: 1.0,
+            spot: 1.0,
+            diffuse: [0.5; 3],
+            specular: [0.25; 3],
+            visibility: Visibility::NoShadows,
+            shadow_child: None,
+        };
+        let local = LocalIllumination {
+            ambient: [0.0; 3],
+            emission: [0.0; 3],
+            lights: vec![light],
+            total: [0.75; 3],
+        };
+        let blinn = text_of(&local, whitted_ir::Highlight::Blinn);
+        assert!(blinn.contains("ks·(N·H)^n"), "{blinn}");
+        assert!(
+            blinn.contains("lit (shadows none: no shadow ray)"),
+            "{blinn}"
+        );
+        let phong = text_of(&local, whitted_ir::Highlight::Phong);
+        assert!(
+            phong.contains("ks·(R·V)^n") && !phong.contains("N·H"),
+            "{phong}"
+        );
     }
 }

@@ -125,6 +125,9 @@ pub(crate) struct Evaluator<'a> {
 pub(crate) struct CommandLine<'a> {
     pub defines: &'a [Define],
     pub overrides: &'a [crate::compile::SettingOverride],
+    /// The settings a scene starts from (`None`: the IR's defaults); another front end's
+    /// scene, when only its settings are overridden.
+    pub base_settings: Option<whitted_ir::Settings>,
 }
 
 impl<'a> Evaluator<'a> {
@@ -137,9 +140,14 @@ impl<'a> Evaluator<'a> {
         sources: whitted_ir::SourceMap,
         max_depth: usize,
     ) -> Self {
-        let CommandLine { defines, overrides } = command_line;
+        let CommandLine {
+            defines,
+            overrides,
+            base_settings,
+        } = command_line;
         let scene = Scene {
             sources,
+            settings: base_settings.unwrap_or_default(),
             ..Scene::default()
         };
         Evaluator {

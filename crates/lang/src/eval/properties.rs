@@ -415,10 +415,10 @@ impl<'a> Evaluator<'a> {
             Prop::Background => settings.background = value.color(),
             Prop::Ambient => settings.ambient = value.color(),
             Prop::Shadows => {
-                settings.shadows = if word == Some("filtered") {
-                    ShadowMode::Filtered
-                } else {
-                    ShadowMode::Opaque
+                settings.shadows = match word {
+                    Some("filtered") => ShadowMode::Filtered,
+                    Some("none") => ShadowMode::None,
+                    _ => ShadowMode::Opaque,
                 }
             }
             Prop::Highlight => {
@@ -428,6 +428,8 @@ impl<'a> Evaluator<'a> {
                     Highlight::Phong
                 }
             }
+            Prop::ShadeBack => settings.shade_back = word != Some("off"),
+            Prop::AttenuationClamp => settings.attenuation_clamp = word != Some("off"),
             _ => {}
         }
         let pixels = u64::from(settings.width) * u64::from(settings.height);

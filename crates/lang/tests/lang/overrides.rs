@@ -32,12 +32,33 @@ fn set_replaces_what_the_scene_set_and_leaves_the_rest() {
         panic!("{}", output(&compilation));
     };
     let s = &scene.settings;
+    // The defaults keep the classic model.
+    assert!(s.shade_back && s.attenuation_clamp);
     assert_eq!(s.max_depth, 8);
     assert_eq!(s.highlight, Highlight::Blinn);
     assert_eq!(s.shadows, ShadowMode::Filtered);
     assert!((s.background.b - 0.2).abs() < 1e-12 && s.background.r == 0.0);
     // Not overridden: the scene's own value stays.
     assert_eq!(s.width, 320);
+}
+
+#[test]
+fn the_course_switches_are_settings() {
+    let compilation = with_settings(&[
+        ("shadows", "none"),
+        ("shade_back", "off"),
+        ("attenuation_clamp", "off"),
+    ]);
+    let Some(scene) = compilation.scene else {
+        panic!("{}", output(&compilation));
+    };
+    let s = &scene.settings;
+    assert_eq!(s.shadows, ShadowMode::None);
+    assert!(!s.shade_back && !s.attenuation_clamp);
+    let back_on = with_settings(&[("shade_back", "on")]);
+    assert!(back_on.scene.is_some_and(|s| s.settings.shade_back));
+    let wrong = with_settings(&[("shade_back", "yes")]);
+    assert!(wrong.has_errors(), "shade_back yes was accepted");
 }
 
 /// Every setting the table has can be given on the command line, with a value taken from
@@ -55,6 +76,8 @@ fn every_setting_of_the_docs_can_be_set() {
         ("epsilon", "0.01"),
         ("shadows", "filtered"),
         ("highlight", "blinn"),
+        ("shade_back", "off"),
+        ("attenuation_clamp", "off"),
     ];
     let docs = std::fs::read_to_string(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/language.md"),
@@ -118,4 +141,41 @@ fn bad_settings_on_the_command_line_point_into_their_text() {
     insta::with_settings!({ prepend_module_to_snapshot => false }, {
         insta::assert_snapshot!("setting_overrides", out);
     });
+}
+
+/// Another front end's scene (the MIT 6.837 format) gets `--set` through the same rows: its
+/// own settings stay unless overridden, and mistakes point into the `--set` text.
+#[test]
+fn settings_of_another_front_end_are_overridden_by_the_same_rows() {
+    let base = whitted_ir::Settings {
+        shadows: ShadowMode::None,
+        shade_back: false,
+        width: 200,
+        ..whitted_ir::Settings::default()
+    };
+    let options = CompileOptions {
+        settings: vec![("shade_back".into(), "on".into())],
+        ..CompileOptions::default()
+    };
+    let compilation = whitted_lang::override_settings(&base, &options);
+    assert!(
+        compilation.diagnostics.is_empty(),
+        "{}",
+        output(&compilation)
+    );
+    let Some(scene) = compilation.scene else {
+        panic!("{}", output(&compilation));
+    };
+    let s = &scene.settings;
+    assert!(s.shade_back);
+    assert_eq!((s.shadows, s.width), (ShadowMode::None, 200));
+
+    let options = CompileOptions {
+        settings: vec![("shadows".into(), "soft".into())],
+        ..CompileOptions::default()
+    };
+    let bad = whitted_lang::override_settings(&base, &options);
+    assert!(bad.scene.is_none());
+    let text = output(&bad);
+    assert!(text.contains("<--set shadows=soft>:1:9"), "{text}");
 }

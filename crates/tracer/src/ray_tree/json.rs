@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use super::model::{RayNode, RayTree, SampleTree, RAY_TREE_JSON_VERSION};
+use super::model::{RayNode, RayTree, SampleTree, ShadingModel, RAY_TREE_JSON_VERSION};
 
 /// What `whitted trace --json` prints: `version`, the pixel, its colour, `root` (the first
 /// recorded sample's camera ray) and every recorded sample.
@@ -17,6 +17,7 @@ pub struct RayTreeDocument<'a> {
     pub samples_per_pixel: u32,
     pub max_depth: u32,
     pub min_weight: f32,
+    pub model: ShadingModel,
     pub node_budget: usize,
     pub unrecorded: u64,
     /// The index of the sample `root` belongs to.
@@ -37,6 +38,7 @@ impl RayTree {
             samples_per_pixel: self.samples_per_pixel,
             max_depth: self.max_depth,
             min_weight: self.min_weight,
+            model: self.model,
             node_budget: self.node_budget,
             unrecorded: self.unrecorded,
             root_sample: first.map(|s| s.index),

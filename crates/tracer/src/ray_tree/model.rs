@@ -26,6 +26,8 @@ pub struct RayTree {
     /// The limits the tree was traced with.
     pub max_depth: u32,
     pub min_weight: f32,
+    /// The scene's shading-model switches the tree was traced with.
+    pub model: ShadingModel,
     /// The most nodes the tree may hold (`ray tree nodes` in docs/language.md).
     pub node_budget: usize,
     /// Rays traced but not recorded because the tree reached `node_budget` (the sum of every
@@ -33,6 +35,31 @@ pub struct RayTree {
     pub unrecorded: u64,
     /// Every sample recorded: all of the pixel's samples, or just the one asked for.
     pub samples: Vec<SampleTree>,
+}
+
+/// The settings that change how a hit is shaded (docs/language.md, Settings), so that a tree
+/// read on its own says which model made its numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ShadingModel {
+    /// `opaque`, `filtered` or `none`.
+    pub shadows: whitted_ir::ShadowMode,
+    /// `phong` or `blinn`.
+    pub highlight: whitted_ir::Highlight,
+    /// Whether lights shade a surface seen from its back.
+    pub shade_back: bool,
+    /// Whether point and spot lights' attenuation is clamped at 1.
+    pub attenuation_clamp: bool,
+}
+
+impl ShadingModel {
+    pub fn of(settings: &whitted_ir::Settings) -> ShadingModel {
+        ShadingModel {
+            shadows: settings.shadows,
+            highlight: settings.highlight,
+            shade_back: settings.shade_back,
+            attenuation_clamp: settings.attenuation_clamp,
+        }
+    }
 }
 
 /// The tree of one sample (one camera ray) of a pixel.
@@ -251,6 +278,12 @@ pub enum Visibility {
     /// No shadow ray was cast: the light faces the surface, but the material has no diffuse
     /// and no specular colour, so it could add nothing.
     Unshaded,
+    /// No shadow ray was cast because the scene has `shadows none`: the light counts as
+    /// unblocked.
+    NoShadows,
+    /// The light adds nothing and no shadow ray was cast: the surface is seen from its back
+    /// and the scene has `shade_back off`.
+    BackFace,
 }
 
 /// What a shadow ray was cast for and what it found.

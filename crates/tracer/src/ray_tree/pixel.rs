@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use whitted_ir::Scene;
 
-use super::model::{RayTree, SampleChoice, SampleTree};
+use super::model::{RayTree, SampleChoice, SampleTree, ShadingModel};
 use super::tree_recorder::TreeRecorder;
 use crate::recorder::NoRecord;
 use crate::render::{trace_pixel_with, PixelAccumulator, RenderOptions};
@@ -178,6 +178,7 @@ pub fn trace_pixel_request(
         samples_per_pixel,
         max_depth: options.depth_limit(),
         min_weight: options.min_weight,
+        model: ShadingModel::of(prepared.settings()),
         node_budget,
         unrecorded: recorder.unrecorded(),
         samples,

@@ -8,6 +8,7 @@ use super::model::{
     ShadowOutcome, Visibility,
 };
 use crate::recorder::{RayKind, Termination};
+use whitted_ir::{Highlight, ShadowMode};
 
 /// How to print a tree.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -35,6 +36,27 @@ pub fn format_text(tree: &RayTree, options: TextOptions) -> String {
         tree.max_depth,
         num(tree.min_weight)
     );
+    // Only the switches that leave the classic model are named, so that a tree traced with
+    // the defaults reads as it always did.
+    let model = &tree.model;
+    let mut switches = Vec::new();
+    match model.shadows {
+        ShadowMode::Opaque => {}
+        ShadowMode::Filtered => switches.push("filtered shadows"),
+        ShadowMode::None => switches.push("no shadow rays (shadows none)"),
+    }
+    if model.highlight == Highlight::Blinn {
+        switches.push("Blinn-Phong highlights");
+    }
+    if !model.shade_back {
+        switches.push("back faces unlit (shade_back off)");
+    }
+    if !model.attenuation_clamp {
+        switches.push("attenuation not clamped at 1");
+    }
+    if !switches.is_empty() {
+        let _ = writeln!(out, "model: {}", switches.join(", "));
+    }
     if tree.unrecorded > 0 {
         let _ = writeln!(
             out,
@@ -219,6 +241,10 @@ impl Printer {
             (Visibility::Unshaded, _) => {
                 "no shadow ray (no diffuse or specular colour to light)".to_string()
             }
+            (Visibility::NoShadows, _) => "no shadow ray (shadows none): lit".to_string(),
+            (Visibility::BackFace, _) => {
+                "no shadow ray (seen from its back, shade_back off): unlit".to_string()
+            }
             (visibility, Some(index)) => {
                 format!("shadow ray {index}: {}", visibility_text(visibility))
             }
@@ -353,6 +379,8 @@ fn visibility_text(visibility: Visibility) -> &'static str {
         Visibility::Blocked => "blocked",
         Visibility::NotFacing => "not facing",
         Visibility::Unshaded => "unshaded",
+        Visibility::NoShadows => "no shadows",
+        Visibility::BackFace => "back face",
     }
 }
 

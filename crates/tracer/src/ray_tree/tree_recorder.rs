@@ -197,6 +197,8 @@ impl Recorder for TreeRecorder<'_> {
         let light = light_ref(scene, sample.light);
         let mut shadow_child = None;
         let visibility = match &sample.shadow_ray {
+            None if sample.back_face => Visibility::BackFace,
+            None if sample.shadows_off => Visibility::NoShadows,
             None if sample.unshaded => Visibility::Unshaded,
             None => Visibility::NotFacing,
             Some(shadow_ray) => {

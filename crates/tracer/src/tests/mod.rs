@@ -9,6 +9,7 @@ mod energy;
 mod media_scenes;
 mod optics_scenes;
 mod shadow_rays;
+mod switches;
 
 use glam::Vec3A;
 

@@ -1,0 +1,458 @@
+//! `whitted mit6837`: the MIT 6.837 (Fall 2004) course's command line, its single-dash flags
+//! taken verbatim (`-input scene.txt -size 200 200 -output out.tga -shadows -bounces 4`),
+//! writing what the course's reference ray tracer wrote: the image, and the depth and
+//! normals images, as 8-bit linear values (colour times 255, no sRGB curve).
+//!
+//! The flags are read by hand rather than by clap: clap's long flags take two dashes, and
+//! the course's command lines must work as the assignments wrote them.
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+use whitted_ir::limits;
+use whitted_mit6837::CourseOptions;
+use whitted_tracer::{PreparedScene, RayKind, RayStart, Recorder, RenderOptions, SurfaceHit};
+
+use crate::cli::{ImageFormat, SceneArgs};
+use crate::image_output::{to_linear8, write_image, Pixels};
+use crate::scene_input::load_scene_with;
+use crate::Failure;
+
+/// What `whitted mit6837 -help` prints.
+pub const USAGE: &str = "\
+usage: whitted mit6837 -input SCENE.txt -size W H [-output OUT.tga|.png|.ppm]
+                       [-shadows] [-transparent_shadows] [-shade_back]
+                       [-bounces N] [-weight W]
+                       [-depth T0 T1 DEPTH.tga] [-normals NORMALS.tga]
+
+The MIT 6.837 (Fall 2004) ray tracer's command line, flags as the course wrote them.
+Images are 8-bit linear (colour times 255, clamped), as the course's were.
+
+  -input F            the 6.837 scene file
+  -size W H           image width and height in pixels
+  -output F           the rendered image (.tga, .png or .ppm)
+  -shadows            cast shadow rays (any object blocks the light)
+  -transparent_shadows  shadow rays pass through transparent objects, tinted
+  -shade_back         light surfaces seen from behind (otherwise lights skip them)
+  -bounces N          reflected and refracted rays up to depth N (default 0)
+  -weight W           do not trace rays that contribute less than W (default 0)
+  -depth T0 T1 F      the distance to the first hit, T0 white to T1 black
+  -normals F          the first hit's normal, |x| |y| |z| as red, green, blue
+
+See docs/courses.md.";
+
+/// The course's flags of later assignments (OpenGL previews, grids, sampling and filters),
+/// which whitted does not have: named in their error so that it does not read as a typo.
+const LATER_ASSIGNMENTS: &[&str] = &[
+    "-gui",
+    "-tessellation",
+    "-gouraud",
+    "-grid",
+    "-visualize_grid",
+    "-stats",
+    "-random_samples",
+    "-uniform_samples",
+    "-jittered_samples",
+    "-box_filter",
+    "-tent_filter",
+    "-gaussian_filter",
+    "-render_samples",
+    "-filter_samples",
+    "-zoom_factor",
+];
+
+/// A parsed command line.
+#[derive(Debug, PartialEq)]
+pub enum Request {
+    Help,
+    Run(CourseRun),
+}
+
+#[derive(Debug, PartialEq)]
+pub struct CourseRun {
+    pub input: PathBuf,
+    pub options: CourseOptions,
+    pub output: Option<PathBuf>,
+    /// `-depth t0 t1 file`.
+    pub depth: Option<(f64, f64, PathBuf)>,
+    pub normals: Option<PathBuf>,
+}
+
+/// Reads the course's flags. Every mistake is one message naming the flag.
+pub fn parse(args: &[OsString]) -> Result<Request, String> {
+    let mut words = args.iter();
+    let mut input = None;
+    let mut size = None;
+    let mut output = None;
+    let mut depth = None;
+    let mut normals = None;
+    let mut options = CourseOptions::default();
+    let mut seen: Vec<String> = Vec::new();
+    while let Some(word) = words.next() {
+        let flag = word.to_string_lossy().into_owned();
+        if seen.contains(&flag) {
+            return Err(format!("{flag} is given twice"));
+        }
+        let mut value = |what: &str| -> Result<OsString, String> {
+            words
+                .next()
+                .cloned()
+                .ok_or_else(|| format!("{flag} needs {what}"))
+        };
+        match flag.as_str() {
+            "-help" | "--help" | "-h" => return Ok(Request::Help),
+            "-input" => input = Some(PathBuf::from(value("a scene file")?)),
+            "-size" => {
+                let side = |text: OsString, what: &str| {
+                    number::<u32>(&text, "-size", what).and_then(|n| {
+                        if (1..=limits::MAX_IMAGE_SIDE).contains(&n) {
+                            Ok(n)
+                        } else {
+                            Err(format!(
+                                "-size: the {what} must be from 1 to {} (the image side limit), not {n}",
+                                limits::MAX_IMAGE_SIDE
+                            ))
+                        }
+                    })
+                };
+                let width = side(value("a width and a height")?, "width")?;
+                let height = side(value("a width and a height")?, "height")?;
+                size = Some((width, height));
+            }
+            "-output" => output = Some(image_path(value("an image file")?, "-output")?),
+            "-shadows" => options.shadows = true,
+            "-transparent_shadows" => options.transparent_shadows = true,
+            "-shade_back" => options.shade_back = true,
+            "-bounces" => {
+                let n = number::<u32>(&value("a number of bounces")?, "-bounces", "count")?;
+                if n > limits::MAX_DEPTH {
+                    return Err(format!(
+                        "-bounces {n} is past {}",
+                        limits::describe("max depth")
+                    ));
+                }
+                options.bounces = n;
+            }
+            "-weight" => {
+                let w = number::<f64>(&value("a weight")?, "-weight", "weight")?;
+                if !(0.0..=1.0).contains(&w) {
+                    return Err(format!("-weight must be from 0 to 1, not {w}"));
+                }
+                options.weight = w;
+            }
+            "-depth" => {
+                let what = "a near and a far distance and an image file";
+                let near = number::<f64>(&value(what)?, "-depth", "near distance")?;
+                let far = number::<f64>(&value(what)?, "-depth", "far distance")?;
+                if !(near.is_finite() && far.is_finite() && near < far) {
+                    return Err(format!(
+                        "-depth {near} {far}: the near distance must be less than the far one"
+                    ));
+                }
+                depth = Some((near, far, image_path(value(what)?, "-depth")?));
+            }
+            "-normals" => normals = Some(image_path(value("an image file")?, "-normals")?),
+            later if LATER_ASSIGNMENTS.contains(&later) => {
+                return Err(format!(
+                "{later} is a flag of the course's later assignments, which whitted does not have \
+                     (see whitted mit6837 -help)"
+            ))
+            }
+            other => {
+                return Err(format!(
+                    "unknown flag `{other}` (see whitted mit6837 -help for the flags)"
+                ))
+            }
+        }
+        seen.push(flag);
+    }
+    let Some(input) = input else {
+        return Err("-input SCENE.txt is required (see whitted mit6837 -help)".into());
+    };
+    let Some((width, height)) = size else {
+        return Err("-size W H is required (see whitted mit6837 -help)".into());
+    };
+    if output.is_none() && depth.is_none() && normals.is_none() {
+        return Err("nothing to write: give -output, -depth or -normals".into());
+    }
+    options.width = width;
+    options.height = height;
+    Ok(Request::Run(CourseRun {
+        input,
+        options,
+        output,
+        depth,
+        normals,
+    }))
+}
+
+fn number<T: std::str::FromStr>(text: &OsString, flag: &str, what: &str) -> Result<T, String> {
+    let text = text.to_string_lossy();
+    text.trim()
+        .parse::<T>()
+        .map_err(|_| format!("{flag}: `{text}` is not a {what}"))
+}
+
+/// An output path whose extension is one the course's images can have.
+fn image_path(text: OsString, flag: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    match ImageFormat::from_path(&path) {
+        Some(ImageFormat::Tga | ImageFormat::Png | ImageFormat::Ppm) => Ok(path),
+        _ => Err(format!(
+            "{flag} {}: the course's images are .tga, .png or .ppm",
+            path.display()
+        )),
+    }
+}
+
+/// Runs a parsed command line: `whitted mit6837 ...`.
+pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
+    let run = match parse(args).map_err(Failure::Usage)? {
+        Request::Help => return crate::scene_input::write_stdout(&format!("{USAGE}\n")),
+        Request::Run(run) => run,
+    };
+    let outputs: Vec<&Path> = [
+        run.output.as_deref(),
+        run.depth.as_ref().map(|(_, _, path)| path.as_path()),
+        run.normals.as_deref(),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    for (i, path) in outputs.iter().enumerate() {
+        if outputs[..i].contains(path) {
+            return Err(Failure::Usage(format!(
+                "{} is named for two images: each needs its own file",
+                path.display()
+            )));
+        }
+        if crate::render_cmd::same_file(path, &run.input) {
+            return Err(Failure::Usage(format!(
+                "the output {} is the scene file: choose another",
+                path.display()
+            )));
+        }
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            if !dir.is_dir() {
+                return Err(Failure::Message(format!(
+                    "cannot write {}: the directory {} does not exist",
+                    path.display(),
+                    dir.display()
+                )));
+            }
+        }
+    }
+    if std::fs::metadata(&run.input).is_ok() && !crate::front_end::is_course_scene(&run.input) {
+        return Err(Failure::Message(format!(
+            "{} is not a 6.837 scene: its first word is not one of {}",
+            run.input.display(),
+            whitted_mit6837::TOP_LEVEL_KEYWORDS.join(", ")
+        )));
+    }
+    crate::interrupt::install();
+    let scene_args = SceneArgs {
+        scene: run.input.clone(),
+        define: Vec::new(),
+        set: Vec::new(),
+    };
+    let loaded = load_scene_with(&scene_args, false, &run.options)?;
+    let options = RenderOptions::from_settings(&loaded.scene.settings);
+    crate::render_cmd::check_image_size(options.width, options.height)?;
+    let prepared = PreparedScene::new(&loaded.scene);
+    let (width, height) = (options.width, options.height);
+    if let Some(path) = &run.output {
+        let Some((image, _)) =
+            whitted_tracer::render(&prepared, &options, &whitted_tracer::NoObserver)
+        else {
+            return Err(Failure::Message("the render was cancelled".into()));
+        };
+        write(path, width, height, to_linear8(&image.pixels))?;
+    }
+    if run.depth.is_some() || run.normals.is_some() {
+        let hits = first_hits(&prepared, &options);
+        if let Some((near, far, path)) = &run.depth {
+            write(path, width, height, depth_image(&hits, *near, *far))?;
+        }
+        if let Some(path) = &run.normals {
+            write(path, width, height, normals_image(&hits))?;
+        }
+    }
+    Ok(())
+}
+
+fn write(path: &Path, width: u32, height: u32, bytes: Vec<u8>) -> Result<(), Failure> {
+    let format = ImageFormat::from_path(path).unwrap_or(ImageFormat::Tga);
+    write_image(path, format, width, height, Pixels::Linear8(bytes)).map_err(Failure::Message)
+}
+
+/// The camera ray's hit: distance and world-space outward normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FirstHit {
+    pub t: f32,
+    pub normal: [f32; 3],
+}
+
+/// Records the camera ray's hit, through the renderer's own tracing code.
+#[derive(Default)]
+struct FirstHitRecorder {
+    in_camera_ray: bool,
+    hit: Option<FirstHit>,
+}
+
+impl Recorder for FirstHitRecorder {
+    fn ray_started(&mut self, ray: &RayStart) {
+        self.in_camera_ray = ray.kind == RayKind::Camera;
+    }
+
+    fn surface_hit(&mut self, hit: &SurfaceHit) {
+        if self.in_camera_ray && self.hit.is_none() {
+            self.hit = Some(FirstHit {
+                t: hit.t,
+                normal: hit.geometric_normal.to_array(),
+            });
+        }
+    }
+}
+
+/// Every pixel's first hit (row-major, top first), traced as the render traces its rays.
+fn first_hits(scene: &PreparedScene, options: &RenderOptions) -> Vec<Option<FirstHit>> {
+    (0..options.height)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            (0..options.width).map(move |x| {
+                let mut recorder = FirstHitRecorder::default();
+                whitted_tracer::trace_pixel_with(scene, options, x, y, 0, &mut recorder);
+                recorder.hit
+            })
+        })
+        .collect()
+}
+
+/// The course's depth image: `t` from `near` (white) to `far` (black), clamped; black where
+/// nothing is hit.
+pub fn depth_image(hits: &[Option<FirstHit>], near: f64, far: f64) -> Vec<u8> {
+    hits.iter()
+        .flat_map(|hit| {
+            let v = hit.map_or(0.0, |h| {
+                ((far - f64::from(h.t)) / (far - near)).clamp(0.0, 1.0)
+            });
+            [(v * 255.0).round() as u8; 3]
+        })
+        .collect()
+}
+
+/// The course's normals image: the absolute value of each component of the hit's unit
+/// normal as red, green and blue; black where nothing is hit.
+pub fn normals_image(hits: &[Option<FirstHit>]) -> Vec<u8> {
+    hits.iter()
+        .flat_map(|hit| {
+            let n = hit.map_or([0.0; 3], |h| h.normal);
+            n.map(|c| (c.abs().min(1.0) * 255.0).round() as u8)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse_words(text: &str) -> Result<Request, String> {
+        let words: Vec<OsString> = text.split_whitespace().map(OsString::from).collect();
+        parse(&words)
+    }
+
+    #[test]
+    fn the_assignment_command_lines_read_verbatim() {
+        let request = parse_words(
+            "-input scene4_03.txt -size 200 150 -output out.tga -shadows -bounces 4 \
+             -weight 0.01 -shade_back -depth 9 11 depth.tga -normals normals.png",
+        );
+        let Ok(Request::Run(run)) = request else {
+            panic!("{request:?}");
+        };
+        assert_eq!(run.input, PathBuf::from("scene4_03.txt"));
+        assert_eq!((run.options.width, run.options.height), (200, 150));
+        assert!(run.options.shadows && run.options.shade_back);
+        assert!(!run.options.transparent_shadows);
+        assert_eq!((run.options.bounces, run.options.weight), (4, 0.01));
+        assert_eq!(run.output, Some(PathBuf::from("out.tga")));
+        assert_eq!(run.depth, Some((9.0, 11.0, PathBuf::from("depth.tga"))));
+        assert_eq!(run.normals, Some(PathBuf::from("normals.png")));
+        assert_eq!(parse_words("-input a.txt -help"), Ok(Request::Help));
+    }
+
+    #[test]
+    fn mistakes_name_their_flag() {
+        let cases = [
+            ("-size 10 10 -output a.tga", "-input SCENE.txt is required"),
+            ("-input a.txt -output a.tga", "-size W H is required"),
+            ("-input a.txt -size 10", "-size needs a width and a height"),
+            (
+                "-input a.txt -size 10 0 -output a.tga",
+                "the height must be from 1",
+            ),
+            ("-input a.txt -size ten 10", "-size: `ten` is not a width"),
+            ("-input a.txt -size 10 10", "nothing to write"),
+            (
+                "-input a.txt -size 10 10 -output a.jpg",
+                "the course's images are .tga, .png or .ppm",
+            ),
+            (
+                "-input a.txt -size 10 10 -output a.tga -bounces 999",
+                "-bounces 999 is past the max depth limit (256)",
+            ),
+            (
+                "-input a.txt -size 10 10 -output a.tga -weight 2",
+                "-weight must be from 0 to 1",
+            ),
+            (
+                "-input a.txt -size 10 10 -depth 5 2 d.tga",
+                "the near distance must be less",
+            ),
+            (
+                "-input a.txt -size 10 10 -output a.tga -gui",
+                "-gui is a flag of the course's later assignments",
+            ),
+            (
+                "-input a.txt -size 10 10 -output a.tga --shadows",
+                "unknown flag `--shadows`",
+            ),
+            ("-input a.txt -input b.txt", "-input is given twice"),
+        ];
+        for (line, expected) in cases {
+            match parse_words(line) {
+                Err(message) => assert!(message.contains(expected), "{line}: {message}"),
+                Ok(request) => panic!("{line} was accepted: {request:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn depth_and_normals_follow_the_course_by_hand() {
+        let hits = [
+            None,
+            Some(FirstHit {
+                t: 9.0,
+                normal: [0.0, -0.6, 0.8],
+            }),
+            Some(FirstHit {
+                t: 10.0,
+                normal: [1.0, 0.0, 0.0],
+            }),
+            Some(FirstHit {
+                t: 12.0,
+                normal: [0.0, 0.0, -1.0],
+            }),
+        ];
+        // 9 is the near distance (white), 11 the far one (black), 10 half way, 12 past it.
+        assert_eq!(
+            depth_image(&hits, 9.0, 11.0),
+            vec![0, 0, 0, 255, 255, 255, 128, 128, 128, 0, 0, 0]
+        );
+        assert_eq!(
+            normals_image(&hits),
+            vec![0, 0, 0, 0, 153, 204, 255, 0, 0, 0, 0, 255]
+        );
+    }
+}
