@@ -26,6 +26,8 @@ pub enum Command {
     Ir(IrArgs),
     /// Record every ray behind one pixel and print its ray tree, as text or JSON.
     Trace(TraceArgs),
+    /// Explain one pixel: the light paths that make its colour, and what may be wrong.
+    Explain(ExplainArgs),
     /// Explore a scene in the terminal: pick a pixel, walk its ray tree, see the source.
     Debug(DebugArgs),
     /// Run the MIT 6.837 course's command line, flags as it wrote them (see -help).
@@ -128,6 +130,20 @@ pub struct TraceArgs {
     #[arg(long, value_name = "K")]
     pub sample: Option<u32>,
     /// Print the versioned JSON document (docs/ray-tree.md) instead of text.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub overrides: RenderOverrides,
+}
+
+#[derive(Args)]
+pub struct ExplainArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// The pixel to explain: X,Y counted from the top-left corner (0,0).
+    #[arg(long, value_name = "X,Y", value_parser = parse_pixel, allow_hyphen_values = true)]
+    pub pixel: [u32; 2],
+    /// Print the versioned JSON document (docs/explain.md) instead of text.
     #[arg(long)]
     pub json: bool,
     #[command(flatten)]

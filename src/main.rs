@@ -8,6 +8,7 @@
 mod allocator;
 mod cli;
 mod debug_cmd;
+mod explain_cmd;
 mod front_end;
 mod image_output;
 mod interrupt;
@@ -50,6 +51,7 @@ fn main() -> ExitCode {
         Command::Ir(args) => scene_input::ir(&args),
         Command::Render(args) => render_cmd::render(&args),
         Command::Trace(args) => trace_cmd::trace(&args),
+        Command::Explain(args) => explain_cmd::explain_pixel(&args),
         Command::Debug(args) => debug_cmd::debug(&args),
         Command::Mit6837(args) => mit6837_cmd::mit6837(&args.args),
     };

@@ -47,6 +47,20 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
             "whitted-lang",
             "whitted-mit6837",
             "whitted-debugger",
+            "whitted-explain",
+            "pest",
+            "pest_derive",
+            "ratatui",
+        ],
+    ),
+    // Analysis reads recorded ray trees and the IR; it never sees syntax or the terminal,
+    // and the debugger may use it later, never the other way round.
+    (
+        "whitted-explain",
+        &[
+            "whitted-lang",
+            "whitted-mit6837",
+            "whitted-debugger",
             "pest",
             "pest_derive",
             "ratatui",
@@ -64,6 +78,7 @@ const REQUIRED: &[(&str, &str)] = &[
     ("whitted-mit6837", "whitted-ir"),
     ("whitted-tracer", "whitted-ir"),
     ("whitted-debugger", "whitted-tracer"),
+    ("whitted-explain", "whitted-tracer"),
 ];
 
 pub fn run(args: &[String]) -> anyhow::Result<()> {

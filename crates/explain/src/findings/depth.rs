@@ -1,0 +1,263 @@
+//! Findings about where recursion stopped: the depth limit or the weight cut-off dropped a
+//! path that matters (`max_depth`, `weight_cutoff`), and light trapped by total internal
+//! reflection (`tir_trapped`). The first two ask the tracer, through [`crate::probe`],
+//! which setting would bring the light back and what the pixel would then be.
+
+use whitted_tracer::ray_tree::RayNode;
+use whitted_tracer::{RayKind, RenderOptions, Termination};
+
+use super::{
+    material_location, material_of, push_unique, rgb, walk, weight_of, Context, SIGNIFICANT,
+};
+use crate::locate::setting_or_scene;
+use crate::model::{Finding, FindingKind};
+use crate::probe::{color_with, depth_needed, largest, DepthSearch};
+
+pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
+    max_depth(context, findings);
+    weight_cutoff(context, findings);
+    tir_trapped(context, findings);
+}
+
+fn is_tir(node: &RayNode) -> bool {
+    node.interface
+        .as_ref()
+        .is_some_and(|i| i.total_internal_reflection)
+}
+
+/// How to set a setting, for fixes.
+fn how_to_set(name: &str, value: &str, written: bool) -> String {
+    if written {
+        format!("set `{name} {value}` there (or run with --set {name}={value})")
+    } else {
+        format!("add `settings {{ {name} {value} }}` (or run with --set {name}={value})")
+    }
+}
+
+fn max_depth(context: &Context<'_>, findings: &mut Vec<Finding>) {
+    // The heaviest ray cut by the depth limit, with its surface and the TIR bounces above.
+    let mut worst: Option<(f32, &RayNode, RayKind, usize)> = None;
+    walk(context.tree, &mut |node, above| {
+        for skipped in &node.skipped {
+            let weight = largest(skipped.weight);
+            if skipped.reason != Termination::MaxDepth || weight < SIGNIFICANT {
+                continue;
+            }
+            if worst.as_ref().is_some_and(|w| w.0 >= weight) {
+                continue;
+            }
+            let bounces = above.iter().filter(|n| is_tir(n)).count() + usize::from(is_tir(node));
+            worst = Some((weight, node, skipped.kind, bounces));
+        }
+    });
+    let Some((weight, node, kind, bounces)) = worst else {
+        return;
+    };
+    let object = node.hit.as_ref().map_or("the scene".to_string(), |h| {
+        format!("{} ({})", h.object.label, h.object.location)
+    });
+    let depth = context.tree.max_depth;
+    let (location, written) = setting_or_scene(context.scene, "max_depth");
+    let tir = match bounces {
+        0 => String::new(),
+        1 => " after 1 total internal reflection".to_string(),
+        n => format!(" after {n} total internal reflections"),
+    };
+    let message = format!(
+        "the depth limit (max_depth {depth}) cut the {} ray leaving {object}{tir}; it carried a \
+         path weight of {:.1}% of the pixel",
+        kind.name(),
+        weight * 100.0
+    );
+    let [x, y] = context.tree.pixel;
+    let fix = match depth_needed(context.prepared, context.options, x, y, SIGNIFICANT) {
+        DepthSearch::Found { max_depth, color } => format!(
+            "raise max_depth to {max_depth}: {}; the pixel then becomes {} (now {})",
+            how_to_set("max_depth", &max_depth.to_string(), written),
+            rgb(color),
+            rgb(context.tree.color)
+        ),
+        DepthSearch::NotFound { tried } => format!(
+            "no max_depth up to {tried} lets this path end: the light is trapped (see \
+             tir_trapped); raising max_depth will not help"
+        ),
+        DepthSearch::TooManyRays { max_depth } => format!(
+            "raise max_depth, together with min_weight: at max_depth {max_depth} this pixel \
+             already takes over {} rays",
+            crate::probe::PROBE_RAY_BUDGET
+        ),
+    };
+    push_unique(
+        findings,
+        Finding {
+            kind: FindingKind::MaxDepth,
+            message,
+            location,
+            fix,
+            weight,
+        },
+    );
+}
+
+fn weight_cutoff(context: &Context<'_>, findings: &mut Vec<Finding>) {
+    let scale = 1.0 / context.tree.samples_per_pixel.max(1) as f32;
+    let mut total = [0.0f32; 3];
+    let mut count = 0u32;
+    let mut heaviest: Option<(f32, &RayNode, RayKind)> = None;
+    walk(context.tree, &mut |node, _| {
+        for skipped in &node.skipped {
+            if skipped.reason != Termination::WeightCutoff {
+                continue;
+            }
+            count += 1;
+            for (t, w) in total.iter_mut().zip(skipped.weight) {
+                *t += w * scale;
+            }
+            let weight = largest(skipped.weight);
+            if heaviest.as_ref().is_none_or(|h| h.0 < weight) {
+                heaviest = Some((weight, node, skipped.kind));
+            }
+        }
+    });
+    let weight = largest(total);
+    let Some((_, node, kind)) = heaviest.filter(|_| weight >= SIGNIFICANT) else {
+        return;
+    };
+    let min_weight = context.tree.min_weight;
+    let lower = (min_weight / 10.0).max(1e-6);
+    let (location, written) = setting_or_scene(context.scene, "min_weight");
+    let object = node
+        .hit
+        .as_ref()
+        .map_or("the scene".to_string(), |h| h.object.label.clone());
+    let message = format!(
+        "the weight cut-off (min_weight {min_weight}) dropped {count} ray{} that together carry \
+         a path weight of {:.1}% of the pixel (the heaviest: a {} ray leaving {object})",
+        if count == 1 { "" } else { "s" },
+        weight * 100.0,
+        kind.name()
+    );
+    let [x, y] = context.tree.pixel;
+    let options = RenderOptions {
+        min_weight: lower,
+        ..context.options.clone()
+    };
+    let value = format!("{lower}");
+    let fix = match color_with(context.prepared, &options, x, y) {
+        Some(color) => format!(
+            "lower min_weight to {value}: {}; the pixel then becomes {} (now {})",
+            how_to_set("min_weight", &value, written),
+            rgb(color),
+            rgb(context.tree.color)
+        ),
+        None => format!(
+            "lower min_weight to {value} ({}), and expect a slow pixel: it then takes over {} \
+             rays",
+            how_to_set("min_weight", &value, written),
+            crate::probe::PROBE_RAY_BUDGET
+        ),
+    };
+    push_unique(
+        findings,
+        Finding {
+            kind: FindingKind::WeightCutoff,
+            message,
+            location,
+            fix,
+            weight,
+        },
+    );
+}
+
+fn tir_trapped(context: &Context<'_>, findings: &mut Vec<Finding>) {
+    let scene = context.scene;
+    walk(context.tree, &mut |node, above| {
+        let Some(hit) = &node.hit else {
+            return;
+        };
+        // Without Fresnel, total internal reflection drops the transmitted share: light
+        // that should have been mirrored inside the solid is lost (a black glass).
+        for skipped in &node.skipped {
+            let lost = largest(skipped.weight);
+            if skipped.reason != Termination::TotalInternalReflection || lost < SIGNIFICANT {
+                continue;
+            }
+            let Some((material, handle)) = material_of(scene, hit.leaf.handle) else {
+                continue;
+            };
+            let name = scene.material_label(handle);
+            let at = material_location(scene, handle);
+            push_unique(
+                findings,
+                Finding {
+                    kind: FindingKind::TirTrapped,
+                    message: format!(
+                        "total internal reflection inside {} ({}) with `fresnel off` drops the \
+                         transmitted share: a path weight of {:.1}% of the pixel is lost there",
+                        hit.object.label,
+                        hit.object.location,
+                        lost * 100.0
+                    ),
+                    location: at.clone(),
+                    fix: if material.reflective.is_black() {
+                        format!(
+                            "set `fresnel exact` in material {name} ({at}), so that total \
+                             internal reflection mirrors the light instead of dropping it"
+                        )
+                    } else {
+                        format!(
+                            "set `fresnel exact` in material {name} ({at}): only its \
+                             `reflective` part is mirrored now"
+                        )
+                    },
+                    weight: lost,
+                },
+            );
+        }
+        // Bounce after bounce inside the same solid.
+        if node.kind != RayKind::Reflected || !is_tir(node) {
+            return;
+        }
+        let in_a_row = 1 + above.iter().rev().take_while(|n| is_tir(n)).count();
+        let weight = weight_of(node);
+        if in_a_row < 3 || weight < SIGNIFICANT {
+            return;
+        }
+        let critical = node
+            .interface
+            .as_ref()
+            .and_then(|i| i.ior)
+            .filter(|[from, to]| from > to)
+            .map(|[from, to]| (to / from).asin().to_degrees());
+        let critical = critical.map_or(String::new(), |c| {
+            format!(" (the critical angle is {c:.1}°)")
+        });
+        let (name, at) = match material_of(scene, hit.leaf.handle) {
+            Some((_, handle)) => (
+                scene.material_label(handle),
+                material_location(scene, handle),
+            ),
+            None => (hit.material.label.clone(), hit.material.location.clone()),
+        };
+        push_unique(
+            findings,
+            Finding {
+                kind: FindingKind::TirTrapped,
+                message: format!(
+                    "light is trapped in {} by total internal reflection: {in_a_row} bounces in \
+                     a row{critical}, carrying a path weight of {:.1}% of the pixel",
+                    hit.object.label,
+                    weight * 100.0
+                ),
+                location: hit.object.location.clone(),
+                fix: format!(
+                    "this is what a solid with parallel faces does at steep angles; to let the \
+                     light out, tilt or round the faces of {} or lower the ior of material \
+                     {name} ({at})",
+                    hit.object.label
+                ),
+                weight,
+            },
+        );
+    });
+}

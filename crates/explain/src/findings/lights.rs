@@ -1,0 +1,169 @@
+//! Findings about lights at the surfaces that matter: a light behind the surface
+//! (`light_behind`, N·L <= 0), a shadow ray stopped by an object (`shadow_blocked`, and
+//! whether that object is transparent while shadows are opaque), and a light inside a
+//! solid (`light_inside_solid`).
+
+use glam::DVec3;
+use whitted_ir::{Handle, LightKind, Object, ShadowMode};
+use whitted_tracer::ray_tree::{RayNode, ShadowOutcome, Visibility};
+
+use super::{material_of, push_unique, walk, weight_of, Context, SIGNIFICANT};
+use crate::inside::contains;
+use crate::model::{Finding, FindingKind};
+
+pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
+    walk(context.tree, &mut |node, _| {
+        if weight_of(node) < SIGNIFICANT {
+            return;
+        }
+        // Glass with only a highlight has lights behind it and shadow rays stopped by its
+        // own walls all the time, which explains nothing about the pixel.
+        if !diffuse_surface(context, node) {
+            return;
+        }
+        light_behind(context, node, findings);
+        blocked(context, node, findings);
+    });
+}
+
+/// Whether the surface a ray hit has a diffuse colour.
+fn diffuse_surface(context: &Context<'_>, node: &RayNode) -> bool {
+    let Some(hit) = &node.hit else {
+        return false;
+    };
+    let handle = Handle::from_index(hit.resolved_material.handle as usize);
+    context
+        .scene
+        .materials
+        .get(handle)
+        .is_some_and(|m| !m.diffuse.is_black())
+}
+
+fn light_behind(context: &Context<'_>, node: &RayNode, findings: &mut Vec<Finding>) {
+    let (Some(hit), Some(local)) = (&node.hit, &node.local) else {
+        return;
+    };
+    for light in &local.lights {
+        if light.visibility != Visibility::NotFacing || light.n_dot_l > 0.0 {
+            continue;
+        }
+        let what = match hit.object.kind.as_str() {
+            "plane" | "disk" | "triangle" => "side",
+            _ => "point",
+        };
+        push_unique(
+            findings,
+            Finding {
+                kind: FindingKind::LightBehind,
+                message: format!(
+                    "{} ({}) is behind the surface of {} ({}) at the {what} the camera sees \
+                     (N·L = {:.3}): it adds nothing there",
+                    light.light.label,
+                    light.light.location,
+                    hit.object.label,
+                    hit.object.location,
+                    light.n_dot_l
+                ),
+                location: light.light.location.clone(),
+                fix: format!(
+                    "move {} to the side of {} that the camera sees, or add a light there",
+                    light.light.label, hit.object.label
+                ),
+                weight: weight_of(node),
+            },
+        );
+    }
+}
+
+/// A point or spot light's position.
+fn light_position(context: &Context<'_>, handle: u32) -> Option<DVec3> {
+    let light = context
+        .scene
+        .lights
+        .get(Handle::from_index(handle as usize))?;
+    match light.kind {
+        LightKind::Point { position, .. } | LightKind::Spot { position, .. } => Some(position),
+        LightKind::Directional { .. } => None,
+    }
+}
+
+fn blocked(context: &Context<'_>, node: &RayNode, findings: &mut Vec<Finding>) {
+    let scene = context.scene;
+    let weight = weight_of(node);
+    for shadow_ray in node.children.iter().filter_map(|c| c.shadow.as_ref()) {
+        if shadow_ray.result != ShadowOutcome::Blocked {
+            continue;
+        }
+        let Some(blocker) = &shadow_ray.blocker else {
+            continue;
+        };
+        let light = &shadow_ray.light;
+        let inside = light_position(context, light.handle).is_some_and(|p| {
+            contains(
+                scene,
+                Handle::<Object>::from_index(blocker.object.handle as usize),
+                p,
+            ) == Some(true)
+        });
+        if inside {
+            push_unique(
+                findings,
+                Finding {
+                    kind: FindingKind::LightInsideSolid,
+                    message: format!(
+                        "{} ({}) is inside {}: every shadow ray to it from outside is stopped \
+                         by {}'s surface",
+                        light.label, light.location, blocker.object.label, blocker.object.label
+                    ),
+                    location: blocker.object.location.clone(),
+                    fix: format!(
+                        "move {} out of {} (or make {} smaller)",
+                        light.label, blocker.object.label, blocker.object.label
+                    ),
+                    weight,
+                },
+            );
+            continue;
+        }
+        let transparent = material_of(scene, blocker.leaf.handle)
+            .filter(|(m, _)| !m.transmissive.is_black())
+            .map(|(_, handle)| scene.material_label(handle));
+        let surface = node
+            .hit
+            .as_ref()
+            .map_or("the surface".to_string(), |h| h.object.label.clone());
+        let (message, fix) = match transparent {
+            Some(material) if scene.settings.shadows == ShadowMode::Opaque => (
+                format!(
+                    "the shadow ray from {surface} to {} is blocked by {} ({}), which is \
+                     transparent (material {material}), but shadows are opaque",
+                    light.label, blocker.object.label, blocker.object.location
+                ),
+                "set `shadows filtered` in settings (or run with --set shadows=filtered) so \
+                 that light passes through transparent objects"
+                    .to_string(),
+            ),
+            _ => (
+                format!(
+                    "the shadow ray from {surface} to {} is blocked by {} ({}) at distance {:.3}",
+                    light.label, blocker.object.label, blocker.object.location, blocker.t
+                ),
+                format!(
+                    "if this point should be lit by {}, move {} or {} ({}) so that nothing \
+                     stands between them",
+                    light.label, blocker.object.label, light.label, light.location
+                ),
+            ),
+        };
+        push_unique(
+            findings,
+            Finding {
+                kind: FindingKind::ShadowBlocked,
+                message,
+                location: blocker.object.location.clone(),
+                fix,
+                weight,
+            },
+        );
+    }
+}

@@ -1,0 +1,130 @@
+//! Findings about surfaces met again at once: a secondary or shadow ray that hits its own
+//! surface a hair from where it left (`self_hit`: surface acne), or another surface there
+//! (`coincident_surfaces`: two surfaces in the same place).
+
+use whitted_tracer::ray_tree::{HitInfo, ObjectRef, ShadowOutcome};
+
+use super::{push_unique, walk, weight_of, Context, SIGNIFICANT};
+use crate::locate::setting_location;
+use crate::model::{Finding, FindingKind};
+
+/// A hit closer than this fraction of the point's distance from the origin (at least of
+/// 1) is "at once": far more than the tracer's error-bounded offset, far less than any
+/// object's own size in a sensible scene.
+pub const TINY: f32 = 1e-4;
+
+pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
+    walk(context.tree, &mut |node, above| {
+        let Some(from) = above.last().and_then(|p| p.hit.as_ref()) else {
+            return;
+        };
+        if let Some(hit) = &node.hit {
+            if weight_of(node) >= SIGNIFICANT && tiny(hit.t, from) {
+                report(
+                    context,
+                    from,
+                    &hit.object,
+                    hit.t,
+                    node.kind.name(),
+                    weight_of(node),
+                    findings,
+                );
+            }
+        }
+    });
+    // Shadow rays leave from their parent's hit.
+    walk(context.tree, &mut |node, _| {
+        let Some(from) = &node.hit else {
+            return;
+        };
+        if weight_of(node) < SIGNIFICANT {
+            return;
+        }
+        for child in &node.children {
+            let Some(shadow) = &child.shadow else {
+                continue;
+            };
+            let Some(blocker) = shadow
+                .blocker
+                .as_ref()
+                .filter(|_| shadow.result == ShadowOutcome::Blocked)
+            else {
+                continue;
+            };
+            if tiny(blocker.t, from) {
+                report(
+                    context,
+                    from,
+                    &blocker.object,
+                    blocker.t,
+                    "shadow",
+                    weight_of(node),
+                    findings,
+                );
+            }
+        }
+    });
+}
+
+fn tiny(t: f32, from: &HitInfo) -> bool {
+    let scale = from.point.iter().fold(1.0f32, |m, c| m.max(c.abs()));
+    t < TINY * scale
+}
+
+fn report(
+    context: &Context<'_>,
+    from: &HitInfo,
+    object: &ObjectRef,
+    t: f32,
+    ray: &str,
+    weight: f32,
+    findings: &mut Vec<Finding>,
+) {
+    if object.handle == from.object.handle {
+        let epsilon = setting_location(context.scene, "epsilon");
+        let fix = match &epsilon {
+            Some(at) => format!(
+                "the surface offset `epsilon` ({at}) is too small for this scene's size: \
+                 remove it (the tracer then offsets by each hit's error bound) or raise it"
+            ),
+            None => format!(
+                "scale the scene so that {} is nearer the origin, or set `epsilon` in settings \
+                 to an offset larger than {t:e}",
+                object.label
+            ),
+        };
+        push_unique(
+            findings,
+            Finding {
+                kind: FindingKind::SelfHit,
+                message: format!(
+                    "a {ray} ray leaving {} hits {} again at t = {t:e}, where it started: \
+                     surface acne",
+                    from.object.label, object.label
+                ),
+                location: object.location.clone(),
+                fix,
+                weight,
+            },
+        );
+    } else {
+        push_unique(
+            findings,
+            Finding {
+                kind: FindingKind::CoincidentSurfaces,
+                message: format!(
+                    "{} ({}) and {} ({}) are in the same place here: a {ray} ray leaving one \
+                     hits the other at t = {t:e}",
+                    from.object.label, from.object.location, object.label, object.location
+                ),
+                location: object.location.clone(),
+                fix: format!(
+                    "move {} off {} by more than a hair (for example 0.001), or, if both are \
+                     media meant to touch (water in a glass), give their materials a `priority`",
+                    object.label, from.object.label
+                ),
+                weight,
+            },
+        );
+    }
+}

@@ -1,0 +1,78 @@
+//! The text form of an explanation: the pixel, one line per main contribution with its
+//! share, then each finding with its location and fix.
+
+use std::fmt::Write;
+
+use crate::contributions::describe_path;
+use crate::model::{Contribution, Explanation, Term};
+
+fn rgb(c: [f32; 3]) -> String {
+    format!("rgb({:.4}, {:.4}, {:.4})", c[0], c[1], c[2])
+}
+
+fn what(contribution: &Contribution) -> String {
+    let light = contribution.light.as_deref().unwrap_or("a light");
+    match contribution.term {
+        Term::Ambient => "ambient".to_string(),
+        Term::Emission => "emission".to_string(),
+        Term::Diffuse => format!("diffuse from {light}"),
+        Term::Specular => format!("specular from {light}"),
+        Term::Background => "background".to_string(),
+        Term::Other => format!("{} other paths", contribution.paths),
+        Term::Unrecorded => "rays not recorded (the ray tree's node budget)".to_string(),
+    }
+}
+
+/// The explanation for people.
+pub fn format_text(explanation: &Explanation) -> String {
+    let mut out = String::new();
+    let [x, y] = explanation.pixel;
+    let [w, h] = explanation.image_size;
+    let _ = writeln!(
+        out,
+        "pixel ({x}, {y}) of {w}x{h}: {}",
+        rgb(explanation.color)
+    );
+    let _ = writeln!(
+        out,
+        "{} sample{} per pixel, max depth {}, min weight {}",
+        explanation.samples_per_pixel,
+        if explanation.samples_per_pixel == 1 {
+            ""
+        } else {
+            "s"
+        },
+        explanation.max_depth,
+        explanation.min_weight
+    );
+    out.push('\n');
+    if explanation.contributions.is_empty() {
+        out.push_str("no recorded path brings any light to this pixel\n");
+    } else {
+        out.push_str("contributions (they sum to the pixel):\n");
+        for c in &explanation.contributions {
+            let share = c
+                .share
+                .map_or("     ".to_string(), |s| format!("{:5.1}%", s * 100.0));
+            let path = describe_path(&c.path);
+            let line = if path.is_empty() {
+                what(c)
+            } else {
+                format!("{path}: {}", what(c))
+            };
+            let _ = writeln!(out, "  {share}  {}  {line}", rgb(c.color));
+        }
+    }
+    out.push('\n');
+    if explanation.findings.is_empty() {
+        out.push_str("no findings\n");
+    } else {
+        out.push_str("findings:\n");
+        for f in &explanation.findings {
+            let _ = writeln!(out, "  {} at {}", f.kind.name(), f.location);
+            let _ = writeln!(out, "    {}", f.message);
+            let _ = writeln!(out, "    fix: {}", f.fix);
+        }
+    }
+    out
+}

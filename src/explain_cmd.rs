@@ -1,0 +1,28 @@
+//! `whitted explain`: compile a scene, explain one pixel (its main light paths and the
+//! findings, `whitted_explain`), print it as text or JSON.
+
+use whitted_explain::{explain, format_text};
+use whitted_tracer::ray_tree::{check_request, SampleChoice};
+use whitted_tracer::PreparedScene;
+
+use crate::cli::ExplainArgs;
+use crate::render_cmd::render_options;
+use crate::scene_input::{load_scene, write_json_stdout, write_stdout};
+use crate::Failure;
+
+pub fn explain_pixel(args: &ExplainArgs) -> Result<(), Failure> {
+    let loaded = load_scene(&args.scene, false)?;
+    let options = render_options(&loaded.scene.settings, &args.overrides);
+    let [x, y] = args.pixel;
+    // A pixel outside the image is a usage error (exit 2), found before the BVH build.
+    check_request(&options, x, y, SampleChoice::All)
+        .map_err(|error| Failure::Usage(error.to_string()))?;
+    let prepared = PreparedScene::new(&loaded.scene);
+    let explanation = explain(&prepared, &loaded.scene, &options, x, y)
+        .map_err(|error| Failure::Usage(error.to_string()))?;
+    if args.json {
+        write_json_stdout(&explanation.document())
+    } else {
+        write_stdout(&format_text(&explanation))
+    }
+}
