@@ -18,6 +18,7 @@ fn what(contribution: &Contribution) -> String {
         Term::Diffuse => format!("diffuse from {light}"),
         Term::Specular => format!("specular from {light}"),
         Term::Background => "background".to_string(),
+        Term::Other if contribution.paths == 1 => "1 other path".to_string(),
         Term::Other => format!("{} other paths", contribution.paths),
         Term::Unrecorded => "rays not recorded (the ray tree's node budget)".to_string(),
     }

@@ -220,9 +220,15 @@ fn tir_trapped(context: &Context<'_>, findings: &mut Vec<Finding>) {
         }
         let in_a_row = 1 + above.iter().rev().take_while(|n| is_tir(n)).count();
         let weight = weight_of(node);
-        if in_a_row < 3 || weight < SIGNIFICANT {
+        // Trapped means the light never got out: the chain was cut where it stands. A
+        // chain that escapes (as it does through a glass's walls) is just a reflection.
+        let cut = node.skipped.iter().find(|s| {
+            matches!(s.reason, Termination::MaxDepth | Termination::WeightCutoff)
+                && s.kind == RayKind::Reflected
+        });
+        let Some(cut) = cut.filter(|_| in_a_row >= 2 && weight >= SIGNIFICANT) else {
             return;
-        }
+        };
         let critical = node
             .interface
             .as_ref()
@@ -245,15 +251,17 @@ fn tir_trapped(context: &Context<'_>, findings: &mut Vec<Finding>) {
                 kind: FindingKind::TirTrapped,
                 message: format!(
                     "light is trapped in {} by total internal reflection: {in_a_row} bounces in \
-                     a row{critical}, carrying a path weight of {:.1}% of the pixel",
+                     a row{critical}, carrying a path weight of {:.1}% of the pixel, until {} cut \
+                     the path",
                     hit.object.label,
-                    weight * 100.0
+                    weight * 100.0,
+                    cut.reason.name()
                 ),
                 location: hit.object.location.clone(),
                 fix: format!(
-                    "this is what a solid with parallel faces does at steep angles; to let the \
-                     light out, tilt or round the faces of {} or lower the ior of material \
-                     {name} ({at})",
+                    "raise max_depth to follow the light until it leaves (see max_depth), or, \
+                     to let it out sooner, tilt or round the faces of {} or lower the ior of \
+                     material {name} ({at})",
                     hit.object.label
                 ),
                 weight,

@@ -21,7 +21,7 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
         if !diffuse_surface(context, node) {
             return;
         }
-        light_behind(context, node, findings);
+        light_behind(node, findings);
         blocked(context, node, findings);
     });
 }
@@ -39,7 +39,7 @@ fn diffuse_surface(context: &Context<'_>, node: &RayNode) -> bool {
         .is_some_and(|m| !m.diffuse.is_black())
 }
 
-fn light_behind(context: &Context<'_>, node: &RayNode, findings: &mut Vec<Finding>) {
+fn light_behind(node: &RayNode, findings: &mut Vec<Finding>) {
     let (Some(hit), Some(local)) = (&node.hit, &node.local) else {
         return;
     };
