@@ -7,6 +7,7 @@ mod cli;
 mod conventions;
 mod debug_cli;
 mod debug_tmux;
+mod explain;
 mod extremes;
 mod guards;
 mod json_schema;

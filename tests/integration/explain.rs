@@ -1,0 +1,258 @@
+//! `whitted explain`: on every feature scene the contributions sum to the rendered pixel (the
+//! oracle), each finding kind fires on its scene in tests/explain/ with the right location
+//! and fix, the JSON has the documented fields, and bad input is a usage error.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+use whitted_tracer::{render, NoObserver, RenderOptions};
+
+use crate::ray_trees::{feature_scenes, load};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_whitted"))
+        .current_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")))
+        .env("NO_COLOR", "1")
+        .args(args)
+        .output()
+        .expect("the whitted binary runs")
+}
+
+fn explain_json(scene: &str, pixel: &str) -> Value {
+    let output = run(&["explain", scene, "--pixel", pixel, "--json"]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).expect("explain --json prints JSON")
+}
+
+#[test]
+fn on_every_scene_the_contributions_sum_to_the_rendered_pixel() {
+    let scenes = feature_scenes();
+    assert!(scenes.len() >= 15, "found {} scenes", scenes.len());
+    let (width, height) = (32, 24);
+    let mut lit = 0;
+    for path in scenes {
+        let name = path.display().to_string();
+        let loaded = load(&name);
+        let options = RenderOptions {
+            width,
+            height,
+            ..RenderOptions::from_settings(&loaded.scene.settings)
+        };
+        let Some((image, _)) = render(&loaded.prepared, &options, &NoObserver) else {
+            panic!("{name}: the render was cancelled");
+        };
+        for (x, y) in [(16, 12), (8, 6), (24, 18), (4, 20), (28, 3), (16, 20)] {
+            let explanation =
+                whitted_explain::explain(&loaded.prepared, &loaded.scene, &options, x, y)
+                    .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let rendered = image.pixel(x, y).unwrap_or([f32::NAN; 3]);
+            let mut sum = [0.0f64; 3];
+            for c in &explanation.contributions {
+                for (s, v) in sum.iter_mut().zip(c.color) {
+                    *s += f64::from(v);
+                }
+            }
+            for channel in 0..3 {
+                let expected = f64::from(rendered[channel]);
+                assert!(
+                    (sum[channel] - expected).abs() <= 1e-5 * expected.abs().max(1.0),
+                    "{name} pixel ({x}, {y}) channel {channel}: contributions sum to {} but \
+                     the pixel is {expected}: {:#?}",
+                    sum[channel],
+                    explanation.contributions
+                );
+            }
+            if rendered.iter().any(|&c| c > 0.0) {
+                lit += 1;
+            }
+        }
+    }
+    assert!(lit > 50, "only {lit} lit pixels were checked");
+}
+
+/// Each finding kind's scene: the kind, where it points and a word of its fix.
+#[test]
+fn each_finding_kind_fires_on_its_scene_with_location_and_fix() {
+    let cases: &[(&str, &str, &str, &str, &str)] = &[
+        // scene, pixel, kind, location, part of the fix
+        (
+            "max-depth",
+            "20,15",
+            "max_depth",
+            "max-depth.scene:3:31",
+            "raise max_depth to 2",
+        ),
+        (
+            "weight-cutoff",
+            "20,15",
+            "weight_cutoff",
+            "weight-cutoff.scene:3:31",
+            "lower min_weight to 0.095",
+        ),
+        (
+            "light-behind",
+            "20,15",
+            "light_behind",
+            "light-behind.scene:4:1",
+            "move under to the side of floor",
+        ),
+        (
+            "shadow-blocked-opaque",
+            "20,15",
+            "shadow_blocked",
+            "shadow-blocked-opaque.scene:9:1",
+            "move wall or side",
+        ),
+        (
+            "shadow-blocked-transparent",
+            "20,15",
+            "shadow_blocked",
+            "shadow-blocked-transparent.scene:9:1",
+            "set `shadows filtered`",
+        ),
+        (
+            "light-inside-solid",
+            "20,15",
+            "light_inside_solid",
+            "light-inside-solid.scene:8:1",
+            "move lamp out of shade",
+        ),
+        (
+            "tir-fresnel-off",
+            "21,24",
+            "tir_trapped",
+            "tir-fresnel-off.scene:8:1",
+            "set `fresnel exact` in material dense_glass",
+        ),
+        (
+            "absorption",
+            "20,15",
+            "absorption",
+            "absorption.scene:5:1",
+            "lower `absorption` in material ink",
+        ),
+        (
+            "background",
+            "20,15",
+            "background",
+            "background.scene:6:1",
+            "put something",
+        ),
+    ];
+    for &(scene, pixel, kind, location, fix) in cases {
+        let path = format!("tests/explain/{scene}.scene");
+        let json = explain_json(&path, pixel);
+        let findings = json["findings"].as_array().cloned().unwrap_or_default();
+        let found = findings.iter().find(|f| f["kind"] == kind);
+        let Some(finding) = found else {
+            panic!("{scene}: no {kind} finding in {findings:#?}");
+        };
+        assert_eq!(
+            finding["location"].as_str(),
+            Some(format!("tests/explain/{location}").as_str()),
+            "{scene}: {finding:#?}"
+        );
+        let text = finding["fix"].as_str().unwrap_or("");
+        assert!(
+            text.contains(fix),
+            "{scene}: the fix `{text}` lacks `{fix}`"
+        );
+        assert!(!finding["message"].as_str().unwrap_or("").is_empty());
+    }
+}
+
+#[test]
+fn a_plain_lit_pixel_has_no_findings_and_one_main_path() {
+    // The floor of the glass-of-water scene, lit by both lights, nothing in the way.
+    let json = explain_json("scenes/glass-of-water.scene", "100,100");
+    assert_eq!(
+        json["findings"].as_array().map(Vec::len),
+        Some(0),
+        "{json:#?}"
+    );
+    let contributions = json["contributions"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default();
+    assert_eq!(contributions[0]["term"], "diffuse");
+    assert_eq!(contributions[0]["light"], "light #0");
+    assert_eq!(contributions[0]["path"][0]["object"], "plane #0");
+}
+
+#[test]
+fn a_black_glass_pixel_is_explained_by_the_depth_limit_with_the_depth_that_reaches_the_light() {
+    // Through the water, max_depth 4 stops the light bouncing inside the glass wall.
+    let output = run(&[
+        "explain",
+        "scenes/glass-of-water.scene",
+        "--set",
+        "max_depth=4",
+        "--pixel",
+        "226,312",
+    ]);
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{text}");
+    assert!(
+        text.contains("max_depth at <--set max_depth=4>:1:1"),
+        "{text}"
+    );
+    assert!(
+        text.contains("after 3 total internal reflections"),
+        "{text}"
+    );
+    assert!(text.contains("raise max_depth to 7"), "{text}");
+    assert!(
+        text.contains("tir_trapped at scenes/glass-of-water.scene:26:1"),
+        "{text}"
+    );
+}
+
+#[test]
+fn the_json_has_the_documented_fields() {
+    let json = explain_json("scenes/tir.scene", "240,200");
+    assert_eq!(json["version"], whitted_explain::EXPLAIN_JSON_VERSION);
+    assert_eq!(json["pixel"], serde_json::json!([240, 200]));
+    for key in [
+        "color",
+        "image_size",
+        "samples_per_pixel",
+        "max_depth",
+        "min_weight",
+        "unrecorded",
+    ] {
+        assert!(!json[key].is_null(), "{key} missing");
+    }
+    let contribution = &json["contributions"][0];
+    for key in ["term", "light", "path", "color", "share", "paths"] {
+        assert!(contribution.get(key).is_some(), "contribution lacks {key}");
+    }
+    for key in ["ray", "tir", "object", "location", "repeat"] {
+        assert!(
+            contribution["path"][0].get(key).is_some(),
+            "step lacks {key}"
+        );
+    }
+    let finding = &json["findings"][0];
+    for key in ["kind", "message", "location", "fix"] {
+        assert!(
+            finding[key].is_string(),
+            "finding lacks {key}: {finding:#?}"
+        );
+    }
+}
+
+#[test]
+fn bad_pixels_are_usage_errors() {
+    for pixel in ["480,0", "1,2,3", "x,y", "-1,3"] {
+        let output = run(&["explain", "scenes/tir.scene", "--pixel", pixel]);
+        assert_eq!(output.status.code(), Some(2), "--pixel {pixel}");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains("error"), "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}
