@@ -31,8 +31,13 @@ fn explain_json(scene: &str, pixel: &str) -> Value {
 
 #[test]
 fn on_every_scene_the_contributions_sum_to_the_rendered_pixel() {
-    let scenes = feature_scenes();
+    let mut scenes = feature_scenes();
     assert!(scenes.len() >= 15, "found {} scenes", scenes.len());
+    scenes.extend(
+        std::fs::read_dir("tests/explain")
+            .expect("tests/explain")
+            .filter_map(|e| e.ok().map(|e| e.path())),
+    );
     let (width, height) = (32, 24);
     let mut lit = 0;
     for path in scenes {
