@@ -8,8 +8,8 @@ use super::{push_unique, walk, weight_of, Context, SIGNIFICANT};
 use crate::locate::setting_location;
 use crate::model::{Finding, FindingKind};
 
-/// A hit closer than this fraction of the point's distance from the origin (at least of
-/// 1) is "at once": far more than the tracer's error-bounded offset, far less than any
+/// A hit closer than this fraction of the point's largest coordinate (or of 1, if larger)
+/// is "at once": far more than the tracer's error-bounded offset, far less than any
 /// object's own size in a sensible scene.
 pub const TINY: f32 = 1e-4;
 
