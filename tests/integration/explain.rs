@@ -128,6 +128,20 @@ fn each_finding_kind_fires_on_its_scene_with_location_and_fix() {
             "move lamp out of shade",
         ),
         (
+            "self-hit",
+            "18,6",
+            "self_hit",
+            "self-hit.scene:3:31",
+            "the surface offset `epsilon`",
+        ),
+        (
+            "coincident",
+            "20,15",
+            "coincident_surfaces",
+            "coincident.scene:8:1",
+            "move wall off slab",
+        ),
+        (
             "tir-fresnel-off",
             "21,24",
             "tir_trapped",

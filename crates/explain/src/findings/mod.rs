@@ -8,7 +8,7 @@
 mod depth;
 mod lights;
 mod media;
-mod surfaces;
+pub(crate) mod surfaces;
 
 use whitted_ir::{Handle, Material, Object, Scene};
 use whitted_tracer::ray_tree::{RayNode, RayTree};

@@ -4,7 +4,9 @@
 
 use whitted_tracer::ray_tree::{HitInfo, ObjectRef, ShadowOutcome};
 
-use super::{push_unique, walk, weight_of, Context, SIGNIFICANT};
+use whitted_ir::{Handle, Object, ObjectKind};
+
+use super::{material_of, push_unique, walk, weight_of, Context, SIGNIFICANT};
 use crate::locate::setting_location;
 use crate::model::{Finding, FindingKind};
 
@@ -18,18 +20,29 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
         let Some(from) = above.last().and_then(|p| p.hit.as_ref()) else {
             return;
         };
-        if let Some(hit) = &node.hit {
-            if weight_of(node) >= SIGNIFICANT && tiny(hit.t, from) {
-                report(
-                    context,
-                    from,
-                    &hit.object,
-                    hit.t,
-                    node.kind.name(),
-                    weight_of(node),
-                    findings,
-                );
-            }
+        let Some(hit) = &node.hit else {
+            return;
+        };
+        if weight_of(node) < SIGNIFICANT {
+            return;
+        }
+        if tiny(hit.t, from) {
+            report(
+                context,
+                from,
+                &hit.object,
+                hit.t,
+                node.kind.name(),
+                weight_of(node),
+                findings,
+            );
+        } else if !hit.front_face
+            && hit.object.handle != from.object.handle
+            && opaque_solid(context, hit)
+        {
+            // No ray can enter an opaque solid, so one that meets its inside started
+            // there: the surface it left is inside that solid or on its surface.
+            starts_inside(from, hit, node.kind.name(), weight_of(node), findings);
         }
     });
     // Shadow rays leave from their parent's hit.
@@ -64,6 +77,52 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
             }
         }
     });
+}
+
+/// Whether the hit object is a solid whose material lets no light through.
+fn opaque_solid(context: &Context<'_>, hit: &HitInfo) -> bool {
+    let Some(object) = context
+        .scene
+        .objects
+        .get(Handle::<Object>::from_index(hit.leaf.handle as usize))
+    else {
+        return false;
+    };
+    let solid = match &object.kind {
+        ObjectKind::Shape { shape } => shape.is_solid(),
+        ObjectKind::Csg { .. } => true,
+        ObjectKind::Group { .. } => false,
+    };
+    solid
+        && material_of(context.scene, hit.leaf.handle)
+            .is_some_and(|(m, _)| m.transmissive.is_black())
+}
+
+fn starts_inside(
+    from: &HitInfo,
+    hit: &HitInfo,
+    ray: &str,
+    weight: f32,
+    findings: &mut Vec<Finding>,
+) {
+    push_unique(
+        findings,
+        Finding {
+            kind: FindingKind::CoincidentSurfaces,
+            message: format!(
+                "a {ray} ray leaving {} ({}) starts inside {}, which is opaque: it meets {}'s \
+                 surface from inside at t = {:.4}, so the two surfaces coincide or overlap here",
+                from.object.label, from.object.location, hit.object.label, hit.object.label, hit.t
+            ),
+            location: hit.object.location.clone(),
+            fix: format!(
+                "move {} off {} by more than a hair (for example 0.001), so that no surface of \
+                 one lies on or inside the other",
+                hit.object.label, from.object.label
+            ),
+            weight,
+        },
+    );
 }
 
 fn tiny(t: f32, from: &HitInfo) -> bool {
@@ -102,7 +161,8 @@ fn report(
                      surface acne",
                     from.object.label, object.label
                 ),
-                location: object.location.clone(),
+                // The setting to change when the scene sets it; the object otherwise.
+                location: epsilon.unwrap_or_else(|| object.location.clone()),
                 fix,
                 weight,
             },
