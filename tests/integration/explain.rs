@@ -232,6 +232,28 @@ fn a_black_glass_pixel_is_explained_by_the_depth_limit_with_the_depth_that_reach
 }
 
 #[test]
+fn the_json_matches_the_documented_schema_on_every_finding_scene() {
+    let text =
+        std::fs::read_to_string("docs/explain.schema.json").expect("docs/explain.schema.json");
+    let schema: Value = serde_json::from_str(&text).expect("the schema is JSON");
+    let mut documents = vec![explain_json("scenes/glass-of-water.scene", "240,300")];
+    for entry in std::fs::read_dir("tests/explain")
+        .expect("tests/explain")
+        .flatten()
+    {
+        documents.push(explain_json(&entry.path().display().to_string(), "20,15"));
+    }
+    for document in documents {
+        let errors = crate::json_schema::validate(&schema, &document);
+        assert!(errors.is_empty(), "{errors:#?}");
+    }
+    // The check can fail: a finding of an unknown kind breaks it.
+    let mut broken = explain_json("tests/explain/background.scene", "20,15");
+    broken["findings"][0]["kind"] = Value::from("glass_is_black");
+    assert!(!crate::json_schema::validate(&schema, &broken).is_empty());
+}
+
+#[test]
 fn the_json_has_the_documented_fields() {
     let json = explain_json("scenes/tir.scene", "240,200");
     assert_eq!(json["version"], whitted_explain::EXPLAIN_JSON_VERSION);
