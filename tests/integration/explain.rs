@@ -297,3 +297,23 @@ fn bad_pixels_are_usage_errors() {
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
 }
+
+/// docs/explain.md's example is the real output of the command it names.
+#[test]
+fn the_docs_example_is_what_the_command_prints() {
+    let docs = std::fs::read_to_string("docs/explain.md").expect("docs/explain.md");
+    let command = "whitted explain scenes/glass-of-water.scene --set max_depth=4 --pixel 226,312";
+    assert!(
+        docs.contains(command),
+        "docs/explain.md no longer names `{command}`"
+    );
+    let example = docs
+        .split("## Example")
+        .nth(1)
+        .and_then(|rest| rest.split("```").nth(1))
+        .map(|block| block.trim_start_matches('\n'))
+        .unwrap_or_default();
+    let args: Vec<&str> = command.split(' ').skip(1).collect();
+    let output = run(&args);
+    assert_eq!(String::from_utf8_lossy(&output.stdout), example);
+}

@@ -26,8 +26,12 @@ fn is_tir(node: &RayNode) -> bool {
 }
 
 /// How to set a setting, for fixes.
-fn how_to_set(name: &str, value: &str, written: bool) -> String {
-    if written {
+/// `location` is where the setting is written (`written`), which may be a `--set` flag's
+/// pseudo-file (`<--set max_depth=4>`).
+fn how_to_set(name: &str, value: &str, location: &str, written: bool) -> String {
+    if location.starts_with("<--set") {
+        format!("run with --set {name}={value} instead")
+    } else if written {
         format!("set `{name} {value}` there (or run with --set {name}={value})")
     } else {
         format!("add `settings {{ {name} {value} }}` (or run with --set {name}={value})")
@@ -73,7 +77,7 @@ fn max_depth(context: &Context<'_>, findings: &mut Vec<Finding>) {
     let fix = match depth_needed(context.prepared, context.options, x, y, SIGNIFICANT) {
         DepthSearch::Found { max_depth, color } => format!(
             "raise max_depth to {max_depth}: {}; the pixel then becomes {} (now {})",
-            how_to_set("max_depth", &max_depth.to_string(), written),
+            how_to_set("max_depth", &max_depth.to_string(), &location, written),
             rgb(color),
             rgb(context.tree.color)
         ),
@@ -146,14 +150,14 @@ fn weight_cutoff(context: &Context<'_>, findings: &mut Vec<Finding>) {
     let fix = match color_with(context.prepared, &options, x, y) {
         Some(color) => format!(
             "lower min_weight to {value}: {}; the pixel then becomes {} (now {})",
-            how_to_set("min_weight", &value, written),
+            how_to_set("min_weight", &value, &location, written),
             rgb(color),
             rgb(context.tree.color)
         ),
         None => format!(
             "lower min_weight to {value} ({}), and expect a slow pixel: it then takes over {} \
              rays",
-            how_to_set("min_weight", &value, written),
+            how_to_set("min_weight", &value, &location, written),
             crate::probe::PROBE_RAY_BUDGET
         ),
     };
