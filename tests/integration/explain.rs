@@ -317,3 +317,43 @@ fn the_docs_example_is_what_the_command_prints() {
     let output = run(&args);
     assert_eq!(String::from_utf8_lossy(&output.stdout), example);
 }
+
+/// A tree cut by its node budget: the light of the rays not kept is one `unrecorded` line,
+/// and the lines still sum to the rendered pixel.
+#[test]
+fn a_cut_tree_still_sums_to_the_pixel_with_an_unrecorded_line() {
+    let loaded = load("tests/explain/hall-of-mirrors.scene");
+    let options = RenderOptions::from_settings(&loaded.scene.settings);
+    let Some((image, _)) = render(&loaded.prepared, &options, &NoObserver) else {
+        panic!("the render was cancelled");
+    };
+    let request = whitted_explain::ExplainRequest {
+        x: 20,
+        y: 15,
+        node_budget: 40,
+        cancel: None,
+    };
+    let explanation =
+        whitted_explain::explain_request(&loaded.prepared, &loaded.scene, &options, &request)
+            .unwrap_or_else(|e| panic!("{e}"));
+    assert!(explanation.unrecorded > 0);
+    let unrecorded = explanation
+        .contributions
+        .iter()
+        .find(|c| c.term == whitted_explain::Term::Unrecorded)
+        .map(|c| c.color)
+        .unwrap_or_default();
+    assert!(unrecorded.iter().any(|&c| c > 0.01), "{unrecorded:?}");
+    let rendered = image.pixel(20, 15).unwrap_or([f32::NAN; 3]);
+    for channel in 0..3 {
+        let sum: f64 = explanation
+            .contributions
+            .iter()
+            .map(|c| f64::from(c.color[channel]))
+            .sum();
+        assert!(
+            (sum - f64::from(rendered[channel])).abs() <= 1e-5,
+            "{sum} vs {rendered:?}"
+        );
+    }
+}

@@ -22,8 +22,10 @@ pub use json::{ExplanationDocument, EXPLAIN_JSON_VERSION};
 pub use model::{Contribution, Explanation, Finding, FindingKind, Step, Term};
 pub use text::format_text;
 
+use std::sync::atomic::AtomicBool;
+
 use whitted_ir::Scene;
-use whitted_tracer::ray_tree::{trace_pixel, SampleChoice, TraceError};
+use whitted_tracer::ray_tree::{trace_pixel_request, SampleChoice, TraceError, TraceRequest};
 use whitted_tracer::{PreparedScene, RenderOptions};
 
 /// Explains pixel `(x, y)`: records its ray tree (every sample) and analyses it.
@@ -36,7 +38,43 @@ pub fn explain(
     x: u32,
     y: u32,
 ) -> Result<Explanation, TraceError> {
-    let tree = trace_pixel(prepared, scene, options, x, y, SampleChoice::All)?;
+    let request = ExplainRequest {
+        x,
+        y,
+        node_budget: whitted_ir::limits::MAX_RAY_TREE_NODES,
+        cancel: None,
+    };
+    explain_request(prepared, scene, options, &request)
+}
+
+/// One pixel to explain, with the ray tree's node budget and an optional cancel flag.
+#[derive(Clone, Copy, Debug)]
+pub struct ExplainRequest<'c> {
+    pub x: u32,
+    pub y: u32,
+    /// The most nodes the ray tree may hold; past it the light of the rays not kept is one
+    /// `unrecorded` contribution.
+    pub node_budget: usize,
+    /// When set (from another thread) the trace stops soon and returns `Cancelled`.
+    pub cancel: Option<&'c AtomicBool>,
+}
+
+/// [`explain`] with a node budget and a cancel flag (the debugger records trees off its UI
+/// thread and cancels them). Every sample is recorded, so that the paths sum to the pixel.
+pub fn explain_request(
+    prepared: &PreparedScene,
+    scene: &Scene,
+    options: &RenderOptions,
+    request: &ExplainRequest<'_>,
+) -> Result<Explanation, TraceError> {
+    let trace_request = TraceRequest {
+        x: request.x,
+        y: request.y,
+        which: SampleChoice::All,
+        node_budget: request.node_budget,
+        cancel: request.cancel,
+    };
+    let tree = trace_pixel_request(prepared, scene, options, &trace_request)?;
     let contributions = contributions::decompose(&tree);
     let context = findings::Context {
         prepared,
