@@ -357,3 +357,22 @@ fn a_cut_tree_still_sums_to_the_pixel_with_an_unrecorded_line() {
         );
     }
 }
+
+/// A 6.837 scene (no bounces by default): the refractive sphere is black because the depth
+/// limit cuts its transmitted ray, and the sphere is located in the course's file.
+#[test]
+fn a_course_scene_is_explained_too() {
+    let json = explain_json("scenes/mit6837/reflect-refract.txt", "300,250");
+    let finding = &json["findings"][0];
+    assert_eq!(finding["kind"], "max_depth", "{json:#?}");
+    let message = finding["message"].as_str().unwrap_or("");
+    assert!(
+        message.contains("sphere #3 (scenes/mit6837/reflect-refract.txt:62:5)"),
+        "{message}"
+    );
+    let fix = finding["fix"].as_str().unwrap_or("");
+    assert!(
+        fix.starts_with("raise max_depth to 2: run with --set max_depth=2"),
+        "{fix}"
+    );
+}

@@ -34,7 +34,12 @@ fn how_to_set(name: &str, value: &str, location: &str, written: bool) -> String 
     } else if written {
         format!("set `{name} {value}` there (or run with --set {name}={value})")
     } else {
-        format!("add `settings {{ {name} {value} }}` (or run with --set {name}={value})")
+        // Not written: the default (or, for a 6.837 scene, the course's flag) applies, and
+        // the way to change it that works for every front end is the flag.
+        format!(
+            "run with --set {name}={value} (a .scene file can say `settings {{ {name} {value} }}`; \
+             `whitted mit6837` takes -bounces and -weight)"
+        )
     }
 }
 
