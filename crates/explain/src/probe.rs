@@ -8,21 +8,32 @@ use whitted_tracer::{
     SkippedRay, Termination, Vec3A,
 };
 
-/// The most rays one probe may trace before it gives up (a hall of mirrors with no weight
-/// cut-off doubles its rays at every level).
+/// The most rays one question to the tracer may trace, over all its traces, before it gives
+/// up (a hall of mirrors with no weight cut-off doubles its rays at every level).
 pub const PROBE_RAY_BUDGET: u64 = 2_000_000;
 
 /// Watches one pixel's trace for rays the depth limit cut, and counts rays.
-#[derive(Default)]
 struct DepthWatch {
     /// The largest channel of the heaviest path weight cut by the depth limit.
     cut: f32,
     rays: u64,
+    /// The most rays this trace may start.
+    budget: u64,
+}
+
+impl DepthWatch {
+    fn new(budget: u64) -> DepthWatch {
+        DepthWatch {
+            cut: 0.0,
+            rays: 0,
+            budget,
+        }
+    }
 }
 
 impl Recorder for DepthWatch {
     fn should_stop(&self) -> bool {
-        self.rays > PROBE_RAY_BUDGET
+        self.rays > self.budget
     }
 
     fn ray_started(&mut self, _ray: &RayStart) {
@@ -52,7 +63,8 @@ pub enum DepthSearch {
 pub const MAX_EXTRA_DEPTH: u32 = 64;
 
 /// The smallest `max_depth` above the current one at which no path weight of at least
-/// `threshold` (largest channel) is cut by the depth limit at pixel `(x, y)`.
+/// `threshold` (largest channel) is cut by the depth limit at pixel `(x, y)`. The whole
+/// search traces at most [`PROBE_RAY_BUDGET`] rays.
 pub fn depth_needed(
     prepared: &PreparedScene,
     options: &RenderOptions,
@@ -64,6 +76,7 @@ pub fn depth_needed(
     let last = current
         .saturating_add(MAX_EXTRA_DEPTH)
         .min(whitted_ir::limits::MAX_DEPTH);
+    let mut spent = 0u64;
     for max_depth in current + 1..=last {
         let probe_options = RenderOptions {
             max_depth,
@@ -72,11 +85,12 @@ pub fn depth_needed(
         let mut accumulator = PixelAccumulator::new();
         let mut cut = 0.0f32;
         for sample in 0..options.samples_per_pixel.max(1) {
-            let mut watch = DepthWatch::default();
+            let mut watch = DepthWatch::new(PROBE_RAY_BUDGET.saturating_sub(spent));
             let color = trace_pixel_with(prepared, &probe_options, x, y, sample, &mut watch);
             if watch.should_stop() {
                 return DepthSearch::TooManyRays { max_depth };
             }
+            spent += watch.rays;
             cut = cut.max(watch.cut);
             accumulator.add(color);
         }
@@ -91,7 +105,7 @@ pub fn depth_needed(
 }
 
 /// The pixel's colour with other options (a lower `min_weight`), or `None` when it takes
-/// more than [`PROBE_RAY_BUDGET`] rays per sample.
+/// more than [`PROBE_RAY_BUDGET`] rays.
 pub fn color_with(
     prepared: &PreparedScene,
     options: &RenderOptions,
@@ -99,12 +113,14 @@ pub fn color_with(
     y: u32,
 ) -> Option<[f32; 3]> {
     let mut accumulator = PixelAccumulator::new();
+    let mut spent = 0u64;
     for sample in 0..options.samples_per_pixel.max(1) {
-        let mut watch = DepthWatch::default();
+        let mut watch = DepthWatch::new(PROBE_RAY_BUDGET.saturating_sub(spent));
         let color = trace_pixel_with(prepared, options, x, y, sample, &mut watch);
         if watch.should_stop() {
             return None;
         }
+        spent += watch.rays;
         accumulator.add(color);
     }
     Some(accumulator.mean())

@@ -91,8 +91,8 @@ fn max_depth(context: &Context<'_>, findings: &mut Vec<Finding>) {
              tir_trapped); raising max_depth will not help"
         ),
         DepthSearch::TooManyRays { max_depth } => format!(
-            "raise max_depth, together with min_weight: at max_depth {max_depth} this pixel \
-             already takes over {} rays",
+            "raise max_depth, together with min_weight: by max_depth {max_depth} the search \
+             for the depth that reaches the light had traced over {} rays",
             crate::probe::PROBE_RAY_BUDGET
         ),
     };

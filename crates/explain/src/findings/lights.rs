@@ -66,7 +66,8 @@ fn light_behind(node: &RayNode, findings: &mut Vec<Finding>) {
                 ),
                 location: light.light.location.clone(),
                 fix: format!(
-                    "move {} to the side of {} that the camera sees, or add a light there",
+                    "if it should be lit, move {} to the side of {} that the camera sees, or add \
+                     a light there",
                     light.light.label, hit.object.label
                 ),
                 weight: weight_of(node),
