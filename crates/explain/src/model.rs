@@ -103,6 +103,10 @@ pub struct Finding {
     /// involved), for ordering; not in the JSON.
     #[serde(skip)]
     pub weight: f32,
+    /// The text of the line at `location`, for people; not in the JSON (scripts have the
+    /// location).
+    #[serde(skip)]
+    pub source_line: Option<String>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]

@@ -71,6 +71,9 @@ pub fn format_text(explanation: &Explanation) -> String {
         out.push_str("findings:\n");
         for f in &explanation.findings {
             let _ = writeln!(out, "  {} at {}", f.kind.name(), f.location);
+            if let Some(line) = &f.source_line {
+                let _ = writeln!(out, "    | {line}");
+            }
             let _ = writeln!(out, "    {}", f.message);
             let _ = writeln!(out, "    fix: {}", f.fix);
         }

@@ -104,6 +104,7 @@ fn max_depth(context: &Context<'_>, findings: &mut Vec<Finding>) {
             location,
             fix,
             weight,
+            source_line: None,
         },
     );
 }
@@ -174,6 +175,7 @@ fn weight_cutoff(context: &Context<'_>, findings: &mut Vec<Finding>) {
             location,
             fix,
             weight,
+            source_line: None,
         },
     );
 }
@@ -220,6 +222,7 @@ fn tir_trapped(context: &Context<'_>, findings: &mut Vec<Finding>) {
                         )
                     },
                     weight: lost,
+                    source_line: None,
                 },
             );
         }
@@ -274,6 +277,7 @@ fn tir_trapped(context: &Context<'_>, findings: &mut Vec<Finding>) {
                     hit.object.label
                 ),
                 weight,
+                source_line: None,
             },
         );
     });

@@ -71,6 +71,7 @@ fn light_behind(node: &RayNode, findings: &mut Vec<Finding>) {
                     light.light.label, hit.object.label
                 ),
                 weight: weight_of(node),
+                source_line: None,
             },
         );
     }
@@ -131,6 +132,7 @@ fn blocked(context: &Context<'_>, node: &RayNode, findings: &mut Vec<Finding>) {
                         light.label, blocker.object.label, blocker.object.label
                     ),
                     weight,
+                    source_line: None,
                 },
             );
             continue;
@@ -173,6 +175,7 @@ fn blocked(context: &Context<'_>, node: &RayNode, findings: &mut Vec<Finding>) {
                 location: blocker.object.location.clone(),
                 fix,
                 weight,
+                source_line: None,
             },
         );
     }

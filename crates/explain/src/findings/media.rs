@@ -90,6 +90,7 @@ fn absorption(context: &Context<'_>, findings: &mut Vec<Finding>) {
                      80% over this distance; or make the object thinner"
                 ),
                 weight: weight_of(node) * (1.0 - kept),
+                source_line: None,
             },
         );
     });
@@ -160,6 +161,7 @@ fn background(context: &Context<'_>, findings: &mut Vec<Finding>) {
                      camera looks through {label}, or set `background` in settings to a colour"
                 ),
                 weight,
+                source_line: None,
             },
         );
     }

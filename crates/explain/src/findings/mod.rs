@@ -52,7 +52,21 @@ pub fn find(context: &Context<'_>) -> Vec<Finding> {
         *count += 1;
         *count <= MAX_PER_KIND
     });
+    for finding in &mut findings {
+        finding.source_line = source_line(context.scene, &finding.location);
+    }
     findings
+}
+
+/// The text of the line a `path:line:col` location points at, when it is in the sources.
+fn source_line(scene: &Scene, location: &str) -> Option<String> {
+    let mut parts = location.rsplitn(3, ':');
+    let _column = parts.next()?;
+    let line: u32 = parts.next()?.parse().ok()?;
+    let path = parts.next()?;
+    let (_, file) = scene.sources.files().find(|(_, f)| f.path == path)?;
+    let text = file.line_text(line).trim();
+    (!text.is_empty()).then(|| text.to_string())
 }
 
 /// Calls `f` on every ray of every sample with the rays above it (the camera ray first).

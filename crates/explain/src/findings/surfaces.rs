@@ -121,6 +121,7 @@ fn starts_inside(
                 hit.object.label, from.object.label
             ),
             weight,
+            source_line: None,
         },
     );
 }
@@ -165,6 +166,7 @@ fn report(
                 location: epsilon.unwrap_or_else(|| object.location.clone()),
                 fix,
                 weight,
+                source_line: None,
             },
         );
     } else {
@@ -184,6 +186,7 @@ fn report(
                     object.label, from.object.label
                 ),
                 weight,
+                source_line: None,
             },
         );
     }
