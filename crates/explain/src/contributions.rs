@@ -235,3 +235,40 @@ pub fn describe_path(path: &[Step]) -> String {
     }
     words.join(", ")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn step(ray: RayKind, tir: bool, object: Option<&str>) -> Step {
+        Step {
+            ray,
+            tir,
+            object: object.map(str::to_string),
+            location: object.map(|o| format!("{o}.scene:1:1")),
+            repeat: 1,
+        }
+    }
+
+    #[test]
+    fn repeated_bounces_are_one_step_in_words() {
+        let path = [
+            step(RayKind::Camera, false, Some("glass")),
+            step(RayKind::Transmitted, false, Some("glass")),
+            step(RayKind::Reflected, true, Some("glass")),
+            step(RayKind::Reflected, true, Some("glass")),
+            step(RayKind::Reflected, true, Some("glass")),
+            step(RayKind::Transmitted, false, None),
+        ];
+        let compressed = compress(&path);
+        assert_eq!(compressed.len(), 4);
+        assert_eq!(compressed[2].repeat, 3);
+        assert_eq!(
+            describe_path(&compressed),
+            "glass, transmitted to glass, reflected (TIR) ×3 to glass, transmitted to the \
+             background"
+        );
+        // A camera step never merges with the ray after it, even on the same object.
+        assert_eq!(compress(&path[..2]).len(), 2);
+    }
+}
