@@ -6,6 +6,7 @@
 use glam::DVec3;
 use whitted_ir::{Handle, LightKind, Object, ShadowMode};
 use whitted_tracer::ray_tree::{RayNode, ShadowOutcome, Visibility};
+use whitted_tracer::RayKind;
 
 use super::{material_of, push_unique, walk, weight_of, Context, SIGNIFICANT};
 use crate::inside::contains;
@@ -43,6 +44,16 @@ fn light_behind(node: &RayNode, findings: &mut Vec<Finding>) {
     let (Some(hit), Some(local)) = (&node.hit, &node.local) else {
         return;
     };
+    // Seen from inside a solid (through glass), every light outside is "behind" the wall:
+    // that is the model at work, not a cause.
+    if !hit.front_face && hit.object.kind != "plane" {
+        return;
+    }
+    let seen_by = if node.kind == RayKind::Camera {
+        "the camera"
+    } else {
+        "this path"
+    };
     for light in &local.lights {
         if light.visibility != Visibility::NotFacing || light.n_dot_l > 0.0 {
             continue;
@@ -56,7 +67,7 @@ fn light_behind(node: &RayNode, findings: &mut Vec<Finding>) {
             Finding {
                 kind: FindingKind::LightBehind,
                 message: format!(
-                    "{} ({}) is behind the surface of {} ({}) at the {what} the camera sees \
+                    "{} ({}) is behind the surface of {} ({}) at the {what} {seen_by} sees \
                      (N·L = {:.3}): it adds nothing there",
                     light.light.label,
                     light.light.location,
@@ -66,7 +77,7 @@ fn light_behind(node: &RayNode, findings: &mut Vec<Finding>) {
                 ),
                 location: light.light.location.clone(),
                 fix: format!(
-                    "if it should be lit, move {} to the side of {} that the camera sees, or add \
+                    "if it should be lit, move {} to the side of {} that {seen_by} sees, or add \
                      a light there",
                     light.light.label, hit.object.label
                 ),
