@@ -679,8 +679,7 @@ impl<'a> Evaluator<'a> {
         );
         let saved_base = std::mem::replace(&mut self.base, base);
         self.call_depth += 1;
-        self.trail
-            .enter_call(id, call.span, &self.stack[base..base + call.args.len()]);
+        self.trail.enter_call(id, call.span, base, call.args.len());
         // A function written in another file runs that file's code: its stack shows the
         // import line that brought the file in.
         let function_file = function.name.span.file.0 as usize;

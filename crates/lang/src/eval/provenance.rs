@@ -27,7 +27,9 @@ enum PendingKind {
         var: Sym,
         value: f64,
     },
-    /// The call's arguments are `args[first..first + count]` of the trail.
+    /// The call's arguments are `stack[first..first + count]` of the evaluator: the first
+    /// slots of the callee's frame, which hold them for the whole call (parameters cannot be
+    /// assigned to).
     Call {
         function: FnId,
         first: usize,
@@ -50,9 +52,6 @@ struct Pending {
 #[derive(Default)]
 pub(super) struct Trail {
     pending: Vec<Pending>,
-    /// The arguments of the active calls, copied when each call starts (a function may assign
-    /// to its parameters).
-    args: Vec<Value>,
     /// Sites already in the IR, by kind and span, so that a loop run many times (an inner
     /// loop, a function called again) has one site.
     sites: HashMap<(u8, Span), SiteId>,
@@ -107,14 +106,13 @@ impl Trail {
         self.push(PendingKind::Import, span);
     }
 
-    pub(super) fn enter_call(&mut self, function: FnId, span: Span, args: &[Value]) {
-        let first = self.args.len();
-        self.args.extend_from_slice(args);
+    /// Enters a call whose `count` arguments are on the evaluator's stack from `first`.
+    pub(super) fn enter_call(&mut self, function: FnId, span: Span, first: usize, count: usize) {
         self.push(
             PendingKind::Call {
                 function,
                 first,
-                count: args.len(),
+                count,
             },
             span,
         );
@@ -122,13 +120,7 @@ impl Trail {
 
     /// Leaves the innermost loop, call or import.
     pub(super) fn leave(&mut self) {
-        if let Some(Pending {
-            kind: PendingKind::Call { first, .. },
-            ..
-        }) = self.pending.pop()
-        {
-            self.args.truncate(first);
-        }
+        self.pending.pop();
     }
 }
 
@@ -167,7 +159,8 @@ impl<'a> Evaluator<'a> {
                 PendingKind::Loop { value, .. } => provenance.push_loop(parent, site, value),
                 PendingKind::Import => provenance.push_import(parent, site),
                 PendingKind::Call { first, count, .. } => {
-                    let args: Vec<ArgValue> = self.trail.args[first..first + count]
+                    let values = self.stack.get(first..first + count).unwrap_or(&[]);
+                    let args: Vec<ArgValue> = values
                         .iter()
                         .map(|&value| self.arg_value(value, 0))
                         .collect();
