@@ -124,6 +124,12 @@ fn trace_text_shows_the_stack_of_the_hit_object() {
         made_by.ends_with(&format!("made by    {STACK}")),
         "{made_by}"
     );
+    // docs/ray-tree.md shows this very line.
+    let doc = std::fs::read_to_string(workspace().join("docs/ray-tree.md")).expect("the doc");
+    assert!(
+        doc.contains(&format!("\n{made_by}\n")),
+        "docs/ray-tree.md's `made by` example is out of date: it should be\n{made_by}"
+    );
 }
 
 #[test]
