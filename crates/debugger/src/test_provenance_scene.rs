@@ -1,4 +1,4 @@
-//! For tests: scenes/provenance (three rings of beads made by `ring` from `lib.scene`, called
+//! For tests: scenes/provenance (three rings of beads made by `ring` from scenes/provenance/lib.scene, called
 //! in a loop) built by hand in the IR with its instantiation stacks, as the language would
 //! compile it, since the debugger must not depend on the language.
 
