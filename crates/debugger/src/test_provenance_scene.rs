@@ -1,6 +1,7 @@
-//! For tests: scenes/provenance (three rings of beads made by `ring` from scenes/provenance/lib.scene, called
-//! in a loop) built by hand in the IR with its instantiation stacks, as the language would
-//! compile it, since the debugger must not depend on the language.
+//! For tests: scenes/provenance (three rings of beads made by `ring` from
+//! scenes/provenance/lib.scene, called in a loop) built by hand in the IR with its
+//! instantiation stacks, as the language would compile it, since the debugger must not
+//! depend on the language.
 
 use whitted_ir::{
     validate, ArgValue, Attenuation, Camera, Color, DMat4, DVec3, Light, LightKind, Material,
