@@ -291,7 +291,7 @@ impl fmt::Display for Number {
         let magnitude = x.abs();
         if x == 0.0 {
             write!(f, "0")
-        } else if magnitude >= 1e15 || magnitude < 1e-6 {
+        } else if !(1e-6..1e15).contains(&magnitude) {
             write!(f, "{x:e}")
         } else {
             write!(f, "{x}")
