@@ -3,10 +3,11 @@
 //! object was made, kept in a side table beside the object arena, like spans.
 //!
 //! Frames form a tree shared by every object made under them: one frame per loop iteration,
-//! call or import that made at least one object, pointing at its parent. An object made at
-//! the top level of the root file has no frame and costs nothing: the per-object table only
-//! grows up to the last object that has a stack. Values are stored as numbers and formatted
-//! only when shown.
+//! call or import that made at least one object, pointing at its parent (12 bytes each). The
+//! objects' table is run-length coded in arena order: a run of objects that share a frame,
+//! or that each have the next frame (a loop making one object per iteration), is one entry.
+//! An object made at the top level of the root file has no frame and costs nothing. Values
+//! are stored as numbers and formatted only when shown.
 
 use std::fmt::{self, Write as _};
 
@@ -64,13 +65,27 @@ pub enum ArgValue {
 /// keeps the tables far smaller).
 const NONE: u32 = u32::MAX;
 
-/// One frame, packed: 16 bytes, since a scene made by loops has one per iteration.
+/// One frame, packed: 12 bytes, since a scene made by loops has one per iteration.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Frame {
     parent: u32,
     site: u32,
-    /// A loop's value (f64 bits), or the index of a call's first argument in `args`.
-    payload: u64,
+    /// A call's first argument in `args`; a loop's value when [`SMALL`] is set (a whole
+    /// number from 0 to 2^31 - 1, the usual case), or else its index in `values`.
+    payload: u32,
+}
+
+/// Marks a loop value stored in the frame itself.
+const SMALL: u32 = 1 << 31;
+
+/// Objects `first_object..` (up to the next run, or to `Provenance::recorded` for the
+/// last) have frame `frame` each (`NONE`: no stack), or, when `consecutive`, the frames
+/// `frame, frame + 1, ...` in turn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Run {
+    first_object: u32,
+    frame: u32,
+    consecutive: bool,
 }
 
 /// The instantiation stacks of a scene's objects (see the module documentation).
@@ -79,8 +94,13 @@ pub struct Provenance {
     sites: Vec<Site>,
     frames: Vec<Frame>,
     args: Vec<ArgValue>,
-    /// The innermost frame of each object, by handle index; objects past the end have none.
-    objects: Vec<u32>,
+    /// Loop values that are not small whole numbers.
+    values: Vec<f64>,
+    /// The innermost frame of each object, run-length coded in arena order; objects before
+    /// the first run and from `recorded` on have none.
+    runs: Vec<Run>,
+    /// One past the last object recorded.
+    recorded: u32,
 }
 
 /// One step of an object's stack, as shown: innermost first.
@@ -110,7 +130,7 @@ impl Provenance {
 
     /// Whether no object has a stack.
     pub fn is_empty(&self) -> bool {
-        self.objects.is_empty()
+        self.runs.is_empty()
     }
 
     /// Adds a site and returns its id.
@@ -126,7 +146,15 @@ impl Provenance {
 
     /// A frame for one iteration of the loop at `site`, with its variable's value.
     pub fn push_loop(&mut self, parent: Option<FrameId>, site: SiteId, value: f64) -> FrameId {
-        self.push_frame(parent, site, value.to_bits())
+        let small = value >= 0.0 && value < f64::from(SMALL) && value.fract() == 0.0;
+        let payload = if small && !(value == 0.0 && value.is_sign_negative()) {
+            value as u32 | SMALL
+        } else {
+            let index = u32::try_from(self.values.len()).unwrap_or(NONE) & !SMALL;
+            self.values.push(value);
+            index
+        };
+        self.push_frame(parent, site, payload)
     }
 
     /// A frame for one call from `site`, with its arguments in parameter order.
@@ -136,7 +164,7 @@ impl Provenance {
         site: SiteId,
         args: impl IntoIterator<Item = ArgValue>,
     ) -> FrameId {
-        let first = self.args.len() as u64;
+        let first = u32::try_from(self.args.len()).unwrap_or(NONE);
         self.args.extend(args);
         self.push_frame(parent, site, first)
     }
@@ -146,7 +174,7 @@ impl Provenance {
         self.push_frame(parent, site, 0)
     }
 
-    fn push_frame(&mut self, parent: Option<FrameId>, site: SiteId, payload: u64) -> FrameId {
+    fn push_frame(&mut self, parent: Option<FrameId>, site: SiteId, payload: u32) -> FrameId {
         let id = FrameId(u32::try_from(self.frames.len()).unwrap_or(NONE));
         self.frames.push(Frame {
             parent: parent.map_or(NONE, |p| p.0),
@@ -156,31 +184,68 @@ impl Provenance {
         id
     }
 
-    /// Records that `object` was made inside `frame` (nothing to do for `None`, the top level
-    /// of the root file, unless an earlier record for the same object is replaced).
-    pub fn set_object(&mut self, object: Handle<Object>, frame: Option<FrameId>) {
-        let index = object.index();
-        match frame {
-            Some(frame) => {
-                if self.objects.len() <= index {
-                    self.objects.resize(index + 1, NONE);
-                }
-                self.objects[index] = frame.0;
+    /// Records that `object` was made inside `frame` (`None`: at the top level of the root
+    /// file). Objects are recorded in arena order, as they are made; objects skipped have no
+    /// stack, and an object before the last one recorded is left as it was (returns false).
+    pub fn set_object(&mut self, object: Handle<Object>, frame: Option<FrameId>) -> bool {
+        let Ok(index) = u32::try_from(object.index()) else {
+            return false;
+        };
+        if index < self.recorded {
+            return false;
+        }
+        let Some(frame) = frame else {
+            // Nothing to store: objects from `recorded` on have no stack.
+            return true;
+        };
+        if let Some(last) = self.runs.last_mut() {
+            let length = self.recorded - last.first_object;
+            let contiguous = index == self.recorded && last.frame != NONE;
+            if contiguous && !last.consecutive && frame.0 == last.frame {
+                self.recorded = index + 1;
+                return true;
             }
-            None => {
-                if let Some(slot) = self.objects.get_mut(index) {
-                    *slot = NONE;
-                }
+            let next = last.frame.wrapping_add(length);
+            if contiguous && (last.consecutive || length == 1) && frame.0 == next {
+                last.consecutive = true;
+                self.recorded = index + 1;
+                return true;
+            }
+            if index > self.recorded {
+                // The objects in between were made without a stack.
+                self.runs.push(Run {
+                    first_object: self.recorded,
+                    frame: NONE,
+                    consecutive: false,
+                });
             }
         }
+        self.runs.push(Run {
+            first_object: index,
+            frame: frame.0,
+            consecutive: false,
+        });
+        self.recorded = index + 1;
+        true
     }
 
     /// The innermost frame of an object, if it has a stack.
     pub fn frame_of(&self, object: Handle<Object>) -> Option<FrameId> {
-        match self.objects.get(object.index()) {
-            Some(&id) if id != NONE => Some(FrameId(id)),
-            _ => None,
+        let index = u32::try_from(object.index()).ok()?;
+        if index >= self.recorded {
+            return None;
         }
+        let after = self.runs.partition_point(|run| run.first_object <= index);
+        let run = self.runs.get(after.checked_sub(1)?)?;
+        if run.frame == NONE {
+            return None;
+        }
+        let offset = if run.consecutive {
+            index - run.first_object
+        } else {
+            0
+        };
+        Some(FrameId(run.frame.wrapping_add(offset)))
     }
 
     /// The steps of an object's stack, innermost first (empty for an object made at the top
@@ -203,13 +268,19 @@ impl Provenance {
                 SiteKind::Import => Step::Import { span: site.span },
                 SiteKind::Loop => Step::Loop {
                     var: &site.name,
-                    value: f64::from_bits(frame.payload),
+                    value: if frame.payload & SMALL != 0 {
+                        f64::from(frame.payload & !SMALL)
+                    } else {
+                        // A malformed index shows as NaN rather than panicking.
+                        self.values
+                            .get(frame.payload as usize)
+                            .copied()
+                            .unwrap_or(f64::NAN)
+                    },
                     span: site.span,
                 },
                 SiteKind::Call => {
-                    let first = usize::try_from(frame.payload)
-                        .unwrap_or(usize::MAX)
-                        .min(self.args.len());
+                    let first = (frame.payload as usize).min(self.args.len());
                     let end = first.saturating_add(site.params.len()).min(self.args.len());
                     Step::Call {
                         name: &site.name,
@@ -390,9 +461,78 @@ mod tests {
     fn objects_at_the_top_level_cost_nothing() {
         let mut p = Provenance::new();
         for index in 0..1000 {
-            p.set_object(Handle::from_index(index), None);
+            assert!(p.set_object(Handle::from_index(index), None));
         }
         assert!(p.is_empty());
+        assert_eq!(p.runs.capacity(), 0);
+    }
+
+    #[test]
+    fn runs_cover_shared_and_consecutive_frames_and_gaps() {
+        let mut p = Provenance::new();
+        let site = p.add_site(Site {
+            kind: SiteKind::Loop,
+            span: Span::detached(),
+            name: "i".into(),
+            params: vec![],
+        });
+        let outer = p.push_loop(None, site, 0.0);
+        let frames: Vec<FrameId> = (0..4)
+            .map(|i| p.push_loop(Some(outer), site, f64::from(i)))
+            .collect();
+        let object = Handle::from_index;
+        // Objects 2..6 one frame each in turn, 6 and 7 sharing the last, 8 none, 9 the first.
+        for (i, frame) in frames.iter().enumerate() {
+            assert!(p.set_object(object(2 + i), Some(*frame)));
+        }
+        assert!(p.set_object(object(6), Some(frames[3])));
+        assert!(p.set_object(object(7), Some(frames[3])));
+        assert!(p.set_object(object(8), None));
+        assert!(p.set_object(object(10), Some(frames[0])));
+        // Out of order: refused, and nothing changes.
+        assert!(!p.set_object(object(3), Some(outer)));
+        let expected = [
+            None,
+            None,
+            Some(frames[0]),
+            Some(frames[1]),
+            Some(frames[2]),
+            Some(frames[3]),
+            Some(frames[3]),
+            Some(frames[3]),
+            None,
+            None,
+            Some(frames[0]),
+            None,
+        ];
+        for (i, frame) in expected.iter().enumerate() {
+            assert_eq!(p.frame_of(object(i)), *frame, "object {i}");
+        }
+        // Four runs, not one entry per object: 2..6 in turn, 6..8 shared, the gap, 10.
+        assert_eq!(p.runs.len(), 4);
+    }
+
+    #[test]
+    fn loop_values_of_every_size_and_sign_read_back() {
+        let mut p = Provenance::new();
+        let site = p.add_site(Site {
+            kind: SiteKind::Loop,
+            span: Span::detached(),
+            name: "i".into(),
+            params: vec![],
+        });
+        let values = [0.0, -0.0, 7.0, -3.0, 2147483647.0, 2147483648.0, 1e300, 0.5];
+        for (i, &value) in values.iter().enumerate() {
+            let frame = p.push_loop(None, site, value);
+            p.set_object(Handle::from_index(i), Some(frame));
+        }
+        for (i, &value) in values.iter().enumerate() {
+            let stack = p.stack(Handle::from_index(i));
+            let Step::Loop { value: read, .. } = stack[0] else {
+                panic!("a loop step");
+            };
+            assert_eq!(read.to_bits(), value.to_bits(), "{value}");
+        }
     }
 
     #[test]
