@@ -12,6 +12,7 @@ mod extremes;
 mod guards;
 mod json_schema;
 mod mit6837;
+mod provenance;
 mod ray_trees;
 mod reshade;
 mod tidy;

@@ -28,6 +28,8 @@ pub mod update;
 mod watch;
 
 #[cfg(test)]
+mod test_provenance_scene;
+#[cfg(test)]
 mod test_scene;
 
 pub use run::{run, DebugError};

@@ -9,7 +9,9 @@ use serde::ser::{Serialize, SerializeStruct, Serializer};
 use serde_json::Value;
 
 use crate::arena::{Arena, Handle};
+use crate::provenance::Step;
 use crate::scene::{Camera, Object, Scene, Settings};
+use crate::source::SourceMap;
 
 #[derive(serde::Serialize)]
 struct Entry<'a, T: Serialize> {
@@ -36,6 +38,105 @@ impl<T: Serialize> Serialize for Entries<'_, T> {
                     value,
                 }),
         )
+    }
+}
+
+/// The objects, each with its handle, location and, when it was made inside an import, call
+/// or loop, its instantiation stack as `made_by` (innermost first).
+struct Objects<'a>(&'a Scene);
+
+#[derive(serde::Serialize)]
+struct ObjectEntry<'a> {
+    handle: usize,
+    location: String,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    made_by: Vec<StepJson<'a>>,
+    #[serde(flatten)]
+    value: &'a Object,
+}
+
+impl Serialize for Objects<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let scene = self.0;
+        serializer.collect_seq(
+            scene
+                .objects
+                .iter_with_spans()
+                .map(|(handle, value, span)| ObjectEntry {
+                    handle: handle.index(),
+                    location: scene.sources.location(span),
+                    made_by: scene
+                        .provenance
+                        .stack(handle)
+                        .iter()
+                        .map(|step| StepJson::new(step, &scene.sources))
+                        .collect(),
+                    value,
+                }),
+        )
+    }
+}
+
+/// One step of an instantiation stack in JSON: `{"kind": "loop", "var": "i", "value": 7,
+/// "location"}`, `{"kind": "call", "function": "ring", "args": [{"name", "value"}], "text":
+/// "ring(12, 2)", "location"}` or `{"kind": "import", "location"}`. Also the ray tree's form.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct StepJson<'a> {
+    pub kind: &'static str,
+    /// The step as `whitted ir` writes it: `i = 7`, `ring(12, 2)`, `import`.
+    pub text: String,
+    pub location: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub var: Option<&'a str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub value: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub function: Option<&'a str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub args: Option<Vec<ArgJson<'a>>>,
+}
+
+/// A call's argument in JSON: the parameter's name and the value as text.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ArgJson<'a> {
+    pub name: &'a str,
+    pub value: String,
+}
+
+impl<'a> StepJson<'a> {
+    pub fn new(step: &Step<'a>, sources: &SourceMap) -> Self {
+        let mut json = StepJson {
+            kind: step.kind_name(),
+            text: step.label(),
+            location: sources.location(step.span()),
+            var: None,
+            value: None,
+            function: None,
+            args: None,
+        };
+        match *step {
+            Step::Import { .. } => {}
+            Step::Loop { var, value, .. } => {
+                json.var = Some(var);
+                json.value = Some(value);
+            }
+            Step::Call {
+                name, params, args, ..
+            } => {
+                json.function = Some(name);
+                json.args = Some(
+                    params
+                        .iter()
+                        .zip(args)
+                        .map(|(name, value)| ArgJson {
+                            name,
+                            value: value.to_string(),
+                        })
+                        .collect(),
+                );
+            }
+        }
+        json
     }
 }
 
@@ -87,13 +188,7 @@ impl Serialize for IrDocument<'_> {
                 arena: &scene.materials,
             },
         )?;
-        map.serialize_field(
-            "objects",
-            &Entries::<Object> {
-                scene,
-                arena: &scene.objects,
-            },
-        )?;
+        map.serialize_field("objects", &Objects(scene))?;
         map.serialize_field("roots", &scene.roots as &Vec<Handle<Object>>)?;
         map.serialize_field("settings", &scene.settings as &Settings)?;
         map.serialize_field("version", &1)?;

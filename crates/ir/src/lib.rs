@@ -9,6 +9,7 @@ mod json;
 pub mod limits;
 mod print;
 pub mod properties;
+mod provenance;
 mod ranges;
 mod scene;
 mod source;
@@ -16,8 +17,9 @@ mod validate;
 
 pub use arena::{Arena, Handle};
 pub use diagnostic::{Diagnostic, Label, Severity};
-pub use json::{document as json_document, to_json, IrDocument};
+pub use json::{document as json_document, to_json, ArgJson, IrDocument, StepJson};
 pub use print::print;
+pub use provenance::{ArgValue, FrameId, Provenance, Site, SiteId, SiteKind, Step};
 pub use scene::{
     Attenuation, Camera, Color, CsgOp, Fresnel, Highlight, Light, LightKind, Material, Object,
     ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, Scene, Settings,

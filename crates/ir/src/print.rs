@@ -170,9 +170,16 @@ fn print_object(scene: &Scene, handle: Handle<Object>, depth: usize, out: &mut S
         ObjectKind::Group { .. } => "group".to_string(),
     };
     let location = scene.sources.location(scene.objects.span(handle));
+    // The instantiation stack, when the object was made inside an import, call or loop.
+    let stack = scene.provenance.describe(handle, &scene.sources);
+    let made_by = if stack.is_empty() {
+        String::new()
+    } else {
+        format!("  made by {stack}")
+    };
     let _ = writeln!(
         out,
-        "{indent}object {handle}{name} {what} material {}{}  @ {location}",
+        "{indent}object {handle}{name} {what} material {}{}  @ {location}{made_by}",
         object.material,
         matrix_suffix(&object.world_from_object)
     );

@@ -8,6 +8,7 @@ use glam::{DMat4, DVec3};
 use serde::Serialize;
 
 use crate::arena::{Arena, Handle};
+use crate::provenance::Provenance;
 use crate::source::{SourceMap, Span};
 
 /// A linear RGB triple. Not clamped: light intensities may exceed 1.
@@ -507,6 +508,8 @@ pub struct Scene {
     /// The top-level objects, in source order. Every other object is reachable from these.
     pub roots: Vec<Handle<Object>>,
     pub sources: SourceMap,
+    /// How each object was made: the imports, calls and loop iterations around it.
+    pub provenance: Provenance,
 }
 
 impl Default for Span {

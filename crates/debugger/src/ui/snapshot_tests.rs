@@ -139,3 +139,44 @@ fn a_terminal_too_small_says_so() {
     let app = rendered_app(40, 10);
     assert_snapshot!(draw(&app).backend());
 }
+
+#[test]
+fn source_pane_shows_the_instantiation_stack_of_a_bead_made_by_a_call_in_a_loop() {
+    use crate::test_provenance_scene::{provenance_scene, BEAD_PIXEL, MAIN_PATH};
+    let mut app = App::new(
+        MAIN_PATH.into(),
+        LoadedScene::new(provenance_scene()),
+        Rect::new(0, 0, 120, 40),
+        "/tmp".into(),
+    );
+    app.cursor = BEAD_PIXEL;
+    update(&mut app, Action::TraceCursor);
+    crate::test_scene::finish_trace(&mut app);
+    if let Some(picked) = &mut app.picked {
+        picked.trace_time = Duration::from_micros(60);
+    }
+    let hit = app
+        .picked
+        .as_ref()
+        .and_then(|p| p.tree.selected_node())
+        .and_then(|node| node.hit.as_ref())
+        .expect("the camera ray hits a bead");
+    assert_eq!((hit.leaf.label.as_str(), hit.leaf.handle), ("bead 7", 19));
+    let screen = draw(&app);
+    let text: String = screen
+        .backend()
+        .buffer()
+        .content()
+        .iter()
+        .map(|cell| cell.symbol())
+        .collect();
+    for step in [
+        "i = 7  scenes/provenance/lib.scene:6:5",
+        "ring(12, 2)  scenes/provenance/main.scene:12:5",
+        "k = 1  scenes/provenance/main.scene:11:1",
+        "import  scenes/provenance/main.scene:5:1",
+    ] {
+        assert!(text.contains(step), "the source pane shows `{step}`");
+    }
+    assert_snapshot!(screen.backend());
+}

@@ -1,5 +1,6 @@
 //! The source pane: the scene text around the definition of the selected ray's object (or,
-//! with `m`, its material), the definition highlighted, titled with its file:line.
+//! with `m`, its material), the definition highlighted, titled with its file:line; under it,
+//! for an object made inside a loop, a call or an imported file, its instantiation stack.
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -7,16 +8,18 @@ use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Paragraph, Widget, Wrap};
 use whitted_ir::{SourceMap, Span as SourceSpan};
-use whitted_tracer::ray_tree::ShadowOutcome;
+use whitted_tracer::ray_tree::{ShadowOutcome, StackStep};
 
 use crate::app::{App, SourceTarget};
 
 use super::pane_block;
 
-/// What the pane shows: a definition's span and what to call it.
-struct Target {
+/// What the pane shows: a definition's span, what to call it and, for an object, the
+/// loops, calls and imports that made it (innermost first).
+struct Target<'a> {
     span: SourceSpan,
     what: String,
+    made_by: &'a [StackStep],
 }
 
 pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
@@ -34,8 +37,20 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let location = sources.location(target.span);
     let title = format!(" Source · {location} · {} ", target.what);
     let block = pane_block(Line::from(title), false);
-    let area = block.inner(pane);
+    let mut area = block.inner(pane);
     block.render(pane, buf);
+    // The stack goes under the excerpt, which keeps at least a third of the pane.
+    let stack = stack_lines(target.made_by);
+    let stack_height = (stack.len() as u16).min(area.height.saturating_sub(area.height / 3));
+    if stack_height > 0 {
+        let below = Rect {
+            y: area.y + area.height - stack_height,
+            height: stack_height,
+            ..area
+        };
+        area.height -= stack_height;
+        Paragraph::new(stack).render(below, buf);
+    }
     let lines = excerpt(sources, target.span, area.height);
     match lines {
         Some(lines) => Paragraph::new(lines).render(area, buf),
@@ -47,7 +62,7 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
 }
 
 /// The definition to show for the selected ray, or a note saying why there is none.
-fn target(app: &App) -> (Option<Target>, String) {
+fn target(app: &App) -> (Option<Target<'_>>, String) {
     let Some(picked) = &app.picked else {
         return (
             None,
@@ -66,10 +81,12 @@ fn target(app: &App) -> (Option<Target>, String) {
             Some(blocker) => Target {
                 span: blocker.leaf.span,
                 what: format!("blocker {}", blocker.leaf.label),
+                made_by: &blocker.leaf.made_by,
             },
             None => Target {
                 span: shadow.light.span,
                 what: format!("light {}", shadow.light.label),
+                made_by: &[],
             },
         };
         return (Some(target), String::new());
@@ -84,13 +101,32 @@ fn target(app: &App) -> (Option<Target>, String) {
         SourceTarget::Object => Target {
             span: hit.leaf.span,
             what: hit.leaf.label.clone(),
+            made_by: &hit.leaf.made_by,
         },
         SourceTarget::Material => Target {
             span: hit.material.span,
             what: format!("material {}", hit.material.label),
+            made_by: &[],
         },
     };
     (Some(target), String::new())
+}
+
+/// The instantiation stack as the pane shows it: a heading, then one line per step,
+/// innermost first, each with its `file:line:col`; nothing for an object without one.
+fn stack_lines(made_by: &[StackStep]) -> Vec<Line<'static>> {
+    if made_by.is_empty() {
+        return Vec::new();
+    }
+    let place = Style::new().fg(Color::DarkGray);
+    let mut lines = vec![Line::styled("made by", Style::new().fg(Color::Cyan))];
+    lines.extend(made_by.iter().map(|step| {
+        Line::from(vec![
+            Span::raw(format!("  {}", step.text)),
+            Span::styled(format!("  {}", step.location), place),
+        ])
+    }));
+    lines
 }
 
 /// Up to `height` numbered lines around `span`, its text highlighted; `None` when the span

@@ -46,6 +46,7 @@ impl<'a> Evaluator<'a> {
         let mut value = first;
         for _ in 0..count {
             self.set_slot(slot, Value::Number(value as f64));
+            self.trail.next_iteration(value as f64);
             if let flow @ Flow::Return(_) = self.items(&body.items)? {
                 return Ok(flow);
             }

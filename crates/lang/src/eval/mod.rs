@@ -17,6 +17,7 @@ mod loops;
 mod materials;
 mod objects;
 mod properties;
+mod provenance;
 mod strings;
 
 use std::collections::HashSet;
@@ -119,6 +120,8 @@ pub(crate) struct Evaluator<'a> {
     files_run: Vec<bool>,
     camera_span: Option<Span>,
     settings_set: Vec<(crate::schema::Prop, Span)>,
+    /// The active imports, calls and loop iterations, for each object's instantiation stack.
+    trail: provenance::Trail,
 }
 
 /// What the command line adds to a scene: `-D` constants and `--set` settings.
@@ -181,6 +184,7 @@ impl<'a> Evaluator<'a> {
             files_run: vec![false; program.files.len()],
             camera_span: None,
             settings_set: Vec::new(),
+            trail: provenance::Trail::default(),
         }
     }
 
@@ -367,7 +371,14 @@ impl<'a> Evaluator<'a> {
         match &item.kind {
             ItemKind::Import { file, .. } => {
                 if let Some(index) = *file {
-                    self.run_file(index)?;
+                    if !self.files_run.get(index).copied().unwrap_or(true) {
+                        // The imported file's objects are made "through" this line.
+                        self.trail.note_import(index, item.span);
+                        self.trail.enter_import(item.span);
+                        let result = self.run_file(index);
+                        self.trail.leave();
+                        result?;
+                    }
                 }
             }
             ItemKind::Const(binding) => {
@@ -382,22 +393,22 @@ impl<'a> Evaluator<'a> {
             }
             ItemKind::Fn(_) => {}
             ItemKind::For {
+                var,
                 slot,
                 start,
                 end,
                 inclusive,
-                step: Some(step),
+                step,
                 body,
-                ..
-            } => return self.stepped_loop(*slot, start, end, *inclusive, step, body),
-            ItemKind::For {
-                slot,
-                start,
-                end,
-                inclusive,
-                body,
-                ..
-            } => return self.for_loop(*slot, start, end, *inclusive, body),
+            } => {
+                self.trail.enter_loop(var.sym, item.span);
+                let result = match step {
+                    Some(step) => self.stepped_loop(*slot, start, end, *inclusive, step, body),
+                    None => self.for_loop(*slot, start, end, *inclusive, body),
+                };
+                self.trail.leave();
+                return result;
+            }
             ItemKind::While { condition, body } => return self.while_loop(condition, body),
             ItemKind::Assign { target, value } => self.assign(target, value)?,
             ItemKind::If {
@@ -536,6 +547,7 @@ impl<'a> Evaluator<'a> {
         self.steps += count;
         for i in first..stop {
             self.set_slot(slot, Value::Number(i as f64));
+            self.trail.next_iteration(i as f64);
             match self.items(&body.items)? {
                 Flow::Normal => {}
                 flow @ Flow::Return(_) => return Ok(flow),
@@ -667,7 +679,21 @@ impl<'a> Evaluator<'a> {
         );
         let saved_base = std::mem::replace(&mut self.base, base);
         self.call_depth += 1;
+        self.trail.enter_call(id, call.span, base, call.args.len());
+        // A function written in another file runs that file's code: its stack shows the
+        // import line that brought the file in.
+        let function_file = function.name.span.file.0 as usize;
+        let import = (function_file != call.span.file.0 as usize)
+            .then(|| self.trail.import_of(function_file))
+            .flatten();
+        if let Some(span) = import {
+            self.trail.enter_import(span);
+        }
         let result = self.items(&function.body.items);
+        if import.is_some() {
+            self.trail.leave();
+        }
+        self.trail.leave();
         self.call_depth -= 1;
         self.base = saved_base;
         self.stack.truncate(base);

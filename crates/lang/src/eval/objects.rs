@@ -86,6 +86,7 @@ impl<'a> Evaluator<'a> {
             material: material.unwrap_or_else(inherit),
         };
         let handle = self.scene.objects.append(object, header);
+        self.record_provenance(handle);
         self.emit(handle);
         Ok(())
     }

@@ -11,6 +11,7 @@ mod fuzz;
 mod limits;
 mod material_colors;
 mod overrides;
+mod provenance;
 mod scenes;
 mod second_step;
 mod support;

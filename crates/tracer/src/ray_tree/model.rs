@@ -194,8 +194,39 @@ pub struct ObjectRef {
     pub kind: String,
     /// `file:line:column` of its definition, or `<built-in>`.
     pub location: String,
+    /// Its instantiation stack, innermost first: the loop iterations, calls and imports that
+    /// were running when it was made (empty for an object written at the top level of the
+    /// root file, and for scenes from the 6.837 front end).
+    pub made_by: Vec<StackStep>,
     #[serde(skip)]
     pub span: Span,
+}
+
+/// One step of an object's instantiation stack. Keys that do not apply to the step's kind
+/// are `null`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StackStep {
+    /// `"loop"`, `"call"` or `"import"`.
+    pub kind: &'static str,
+    /// As `whitted ir` writes it: `i = 7`, `ring(12, 2)`, `import`.
+    pub text: String,
+    /// `file:line:column` of the loop, the call or the import line.
+    pub location: String,
+    /// A loop's variable and its value in this iteration.
+    pub var: Option<String>,
+    pub value: Option<f64>,
+    /// A call's function and its arguments, by parameter name.
+    pub function: Option<String>,
+    pub args: Option<Vec<StackArg>>,
+    #[serde(skip)]
+    pub span: Span,
+}
+
+/// A call's argument: the parameter's name and the value as the scene language writes it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StackArg {
+    pub name: String,
+    pub value: String,
 }
 
 /// An IR material, named for people and located in the source.

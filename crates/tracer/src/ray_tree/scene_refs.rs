@@ -3,7 +3,7 @@
 
 use whitted_ir::{Handle, Light, LightKind, Material, Object, ObjectKind, Scene, Span};
 
-use super::model::{LightRef, MaterialRef, ObjectRef};
+use super::model::{LightRef, MaterialRef, ObjectRef, StackArg, StackStep};
 
 /// A reference for a handle the scene does not have: only reachable when the caller passes
 /// a different scene from the one that was prepared. Labelled, not a panic.
@@ -28,6 +28,7 @@ pub(crate) fn object_ref(scene: &Scene, handle: Handle<Object>) -> ObjectRef {
             label,
             kind,
             location,
+            made_by: Vec::new(),
             span,
         };
     };
@@ -43,8 +44,37 @@ pub(crate) fn object_ref(scene: &Scene, handle: Handle<Object>) -> ObjectRef {
         label: scene.object_label(handle),
         kind: kind.to_string(),
         location: scene.sources.location(span),
+        made_by: made_by(scene, handle),
         span,
     }
+}
+
+/// An object's instantiation stack, as the ray tree shows it.
+fn made_by(scene: &Scene, handle: Handle<Object>) -> Vec<StackStep> {
+    let steps = scene.provenance.stack(handle);
+    steps
+        .iter()
+        .map(|step| {
+            let json = whitted_ir::StepJson::new(step, &scene.sources);
+            StackStep {
+                kind: json.kind,
+                text: json.text,
+                location: json.location,
+                var: json.var.map(str::to_string),
+                value: json.value,
+                function: json.function.map(str::to_string),
+                args: json.args.map(|args| {
+                    args.into_iter()
+                        .map(|arg| StackArg {
+                            name: arg.name.to_string(),
+                            value: arg.value,
+                        })
+                        .collect()
+                }),
+                span: step.span(),
+            }
+        })
+        .collect()
 }
 
 pub(crate) fn material_ref(scene: &Scene, handle: Handle<Material>) -> MaterialRef {

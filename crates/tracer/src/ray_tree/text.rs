@@ -206,6 +206,7 @@ impl Printer {
             ),
             format!("object     {}", object_text(&hit.object)),
         ];
+        push_made_by(&mut lines, &hit.object);
         if hit.leaf.handle != hit.object.handle {
             let path: Vec<String> = hit.csg_path.iter().map(|o| printable(&o.label)).collect();
             lines.push(format!(
@@ -213,6 +214,7 @@ impl Printer {
                 object_text(&hit.leaf),
                 path.join(" > ")
             ));
+            push_made_by(&mut lines, &hit.leaf);
         }
         let material = &hit.material;
         if hit.resolved_material.handle == material.handle {
@@ -338,6 +340,20 @@ fn interface_text(interface: &InterfaceInfo) -> String {
         text.push_str(", total internal reflection");
     }
     text
+}
+
+/// The `made by` line of an object made inside a loop, call or import: its instantiation
+/// stack, innermost first. Objects written at the top level of the root file have none.
+fn push_made_by(lines: &mut Vec<String>, object: &ObjectRef) {
+    if object.made_by.is_empty() {
+        return;
+    }
+    let steps: Vec<String> = object
+        .made_by
+        .iter()
+        .map(|step| format!("{} at {}", step.text, step.location))
+        .collect();
+    lines.push(printable(&format!("made by    {}", steps.join(", "))));
 }
 
 fn object_text(object: &ObjectRef) -> String {
