@@ -7,6 +7,7 @@ mod arena;
 mod diagnostic;
 mod json;
 pub mod limits;
+mod mesh;
 mod print;
 pub mod properties;
 mod ranges;
@@ -17,6 +18,7 @@ mod validate;
 pub use arena::{Arena, Handle};
 pub use diagnostic::{Diagnostic, Label, Severity};
 pub use json::{document as json_document, to_json, IrDocument};
+pub use mesh::Mesh;
 pub use print::print;
 pub use scene::{
     Attenuation, Camera, Color, CsgOp, Fresnel, Highlight, Light, LightKind, Material, Object,
