@@ -193,7 +193,7 @@ where
 }
 
 /// `a/./b/../c` → `a/c`, without touching the disk (the loader decides what paths mean).
-fn normalize(path: &Path) -> PathBuf {
+pub(crate) fn normalize(path: &Path) -> PathBuf {
     let mut out = PathBuf::new();
     for component in path.components() {
         match component {
@@ -486,6 +486,7 @@ fn compile_root(
     let overrides = parse_setting_overrides(&mut loading, &options.settings);
 
     let Loading {
+        loader,
         sources,
         mut program,
         interner,
@@ -537,9 +538,13 @@ fn compile_root(
         sources.clone(),
         max_evaluation_depth,
     );
-    let (scene, eval_diagnostics, failed) = evaluator.run();
+    let (mut scene, eval_diagnostics, failed) = evaluator.run();
     diagnostics.extend(eval_diagnostics);
     if failed || has_error(&diagnostics) {
+        return finish(sources, None, diagnostics, work);
+    }
+    crate::mesh::load_meshes(&mut scene, loader, limits, &mut diagnostics);
+    if has_error(&diagnostics) {
         return finish(sources, None, diagnostics, work);
     }
     match whitted_ir::validate(scene) {
