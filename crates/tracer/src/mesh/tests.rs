@@ -148,7 +148,8 @@ fn agree(walked: Option<f32>, brute: Option<f32>, tmin: f32, tmax: f32) -> bool 
 }
 
 /// Planted bug, seen failing: the walk stopped at the first triangle it found
-/// (`Step::Stop` for `Step::Shrink` in `first_hit`) instead of the nearest.
+/// (`Step::Stop` for `Step::Shrink` in `first_hit`) instead of the nearest: 737 of the
+/// sphere's 18,000 queries disagreed.
 #[test]
 fn mesh_bvh_agrees_with_brute_force_on_awkward_rays() {
     let mut rng = Rng(7);
@@ -219,8 +220,8 @@ fn difference(a: &Image, b: &Image, tolerance: f32) -> (f32, f32) {
 }
 
 /// Planted bug, seen failing: meshes reported as not solid (`is_solid` false), so the
-/// glass ball was two thin sheets that bend nothing, and the glass render differed from
-/// the sphere in 14% of pixels.
+/// glass ball was thin sheets that bend nothing, and the glass render differed from the
+/// sphere's in 8.3% of pixels (mean difference 0.020).
 #[test]
 fn a_tessellated_sphere_renders_like_the_sphere_matte_and_glass() {
     for (material, name) in [(matte(0.8, 0.3, 0.2), "matte"), (glass(), "glass")] {
@@ -355,6 +356,7 @@ fn smooth_meshes_interpolate_vertex_normals_and_others_use_the_face() {
 
 /// A thousand instances of one mesh hold one copy of its triangles and one BVH: the
 /// prepared scene counts one mesh, and every instance shares it.
+/// Planted bug, seen failing: each instance prepared its own copy of the mesh.
 #[test]
 fn a_thousand_instances_share_one_mesh() {
     let mut b = SceneBuilder::new();
