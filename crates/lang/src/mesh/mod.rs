@@ -107,18 +107,22 @@ pub(crate) fn load_meshes(
                 too_many: Some(count),
                 ..
             }) => {
-                let (name, limit) = if limits.max_mesh_triangles <= scene_left {
-                    ("mesh triangles", limits.max_mesh_triangles)
+                let message = if limits.max_mesh_triangles <= scene_left {
+                    format!(
+                        "the mesh `{file}` has {count} triangles or more, over the mesh triangles limit of {}",
+                        limits.max_mesh_triangles
+                    )
                 } else {
-                    ("scene triangles", limits.max_scene_triangles)
+                    format!(
+                        "the mesh `{file}` brings the scene's meshes to {} triangles or more, over the scene triangles limit of {}",
+                        total.saturating_add(count),
+                        limits.max_scene_triangles
+                    )
                 };
                 diagnostics.push(
-                    Diagnostic::error(
-                        format!("the mesh `{file}` has {count} triangles or more, over the {name} limit of {limit}"),
-                        span,
-                    )
-                    .with_label("the mesh file")
-                    .with_hint("see \"Limits\" in docs/language.md; instances of one file share its triangles"),
+                    Diagnostic::error(message, span)
+                        .with_label("the mesh file")
+                        .with_hint("see \"Limits\" in docs/language.md; instances of one file share its triangles"),
                 );
             }
             Err(error) => {

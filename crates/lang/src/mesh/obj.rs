@@ -143,7 +143,11 @@ fn numbers<'a>(
 /// One index of a face corner: 1 to `defined` counts from the start, -1 to -`defined` back
 /// from the latest (OBJ's relative indices); 0 and anything else name nothing.
 fn index(word: &str, defined: usize, slot: usize, line: usize) -> Result<(), MeshError> {
-    let what = ["vertex", "texture coordinate", "normal"][slot];
+    let (what, plural) = [
+        ("vertex", "vertices"),
+        ("texture coordinate", "texture coordinates"),
+        ("normal", "normals"),
+    ][slot];
     let Ok(i) = word.parse::<i64>() else {
         return Err(MeshError::at(
             line,
@@ -157,10 +161,10 @@ fn index(word: &str, defined: usize, slot: usize, line: usize) -> Result<(), Mes
     } else {
         Err(MeshError::at(
             line,
-            format!(
-                "{what} index {i} is out of range: {defined} {what}{} defined before this line",
-                if defined == 1 { " is" } else { "s are" }
-            ),
+            match defined {
+                1 => format!("{what} index {i} is out of range: 1 {what} is defined before this line"),
+                _ => format!("{what} index {i} is out of range: {defined} {plural} are defined before this line"),
+            },
         ))
     }
 }
