@@ -1,6 +1,6 @@
 //! Mesh files: after evaluation, each mesh the scene named is read through the
 //! [`SourceLoader`] (bytes in, the library never touches the disk) and parsed by its
-//! extension, `.obj` (`obj.rs`, with tobj) or `.ply` (`ply.rs`). Every problem is an error
+//! extension, `.obj` (`obj.rs`, with tobj) or `.ply` (`ply.rs`, a reader of its own). Every problem is an error
 //! at the `file` property that first named the mesh, naming the file and, where a line of
 //! the file is at fault, that line.
 

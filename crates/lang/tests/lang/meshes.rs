@@ -100,6 +100,7 @@ fn mesh_errors_name_the_file_and_line() {
         ("empty.obj", "# nothing but a comment\nv 0 0 0\n"),
         ("notes.txt", "v 0 0 0\n"),
         ("open.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+        ("bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"),
     ];
     check_errors_with(
         "mesh_errors",
@@ -113,6 +114,10 @@ fn mesh_errors_name_the_file_and_line() {
             ("a vertex that is not finite", "mesh { file \"nan.obj\" }"),
             ("no triangles", "mesh { file \"empty.obj\" }"),
             ("not a mesh file", "mesh { file \"notes.txt\" }"),
+            (
+                "a PLY face index past the vertices",
+                "mesh { file \"bad.ply\" }",
+            ),
             ("no file", "mesh \"gem\" { smooth false }"),
             ("file is not a string", "mesh { file 3 }"),
             (
