@@ -397,3 +397,71 @@ fn a_thousand_instances_share_one_mesh() {
     let (t, _) = hit_t(&scene, origin, Vec3A::NEG_Y).expect("an instance below");
     assert!((t - 4.6).abs() < 1e-3, "{t}");
 }
+
+/// Filtered shadows through a closed mesh filter at each surface it crosses, as through the
+/// analytic solid of the same shape: a shadow ray through a tinted cube of twelve triangles
+/// crosses two surfaces and keeps `kt²`, exactly as through `box`.
+/// Planted bug, seen failing: the filter's walk along the ray restarted each query at
+/// `tmin` instead of beyond the previous crossing for meshes, so only the first surface
+/// was found (one blocker, `kt` once).
+#[test]
+fn filtered_shadows_cross_a_mesh_solid_at_each_surface() {
+    let corners: Vec<[f32; 3]> = (0..8)
+        .map(|i| [(i & 1) as f32 * 2.0 - 1.0, ((i >> 1) & 1) as f32 * 2.0 - 1.0, ((i >> 2) & 1) as f32 * 2.0 - 1.0])
+        .collect();
+    // Two triangles per face of the cube, wound so that their normals point out.
+    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let triangles: Vec<[u32; 3]> = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    let cube = Mesh::new("cube.obj".into(), corners, Vec::new(), triangles);
+    assert!(cube.solid);
+    let tint = Material {
+        transmissive: Color::new(0.5, 0.8, 0.9),
+        ..matte(0.1, 0.1, 0.1)
+    };
+    let mut results = Vec::new();
+    for meshed in [false, true] {
+        let mut b = SceneBuilder::new();
+        let m = b.material(tint.clone());
+        let shape = if meshed {
+            Shape::Mesh {
+                mesh: b.mesh(cube.clone()),
+                smooth: false,
+            }
+        } else {
+            Shape::Box {
+                min: DVec3::splat(-1.0),
+                max: DVec3::splat(1.0),
+            }
+        };
+        b.add(shape, DMat4::from_translation(DVec3::new(0.0, 2.0, 0.0)), m);
+        let scene = prepare(b);
+        let ray = Ray::new(Vec3A::new(0.3, 0.0, -0.2), Vec3A::Y);
+        let mut scratch = Scratch::default();
+        results.push(scene.filter_shadow(&ray, 1e-4, 10.0, &mut scratch));
+    }
+    let expected = crate::query::Shadow::Filtered {
+        transmittance: Vec3A::new(0.25, 0.64, 0.81),
+        blockers: 2,
+    };
+    for (result, what) in results.iter().zip(["box", "mesh"]) {
+        match (result, &expected) {
+            (
+                crate::query::Shadow::Filtered {
+                    transmittance,
+                    blockers,
+                },
+                crate::query::Shadow::Filtered {
+                    transmittance: want,
+                    blockers: want_blockers,
+                },
+            ) => {
+                assert_eq!(blockers, want_blockers, "{what}");
+                assert!((*transmittance - *want).abs().max_element() < 1e-6, "{what}: {transmittance}");
+            }
+            _ => panic!("{what}: {result:?}"),
+        }
+    }
+}
