@@ -401,16 +401,29 @@ fn a_thousand_instances_share_one_mesh() {
 /// Filtered shadows through a closed mesh filter at each surface it crosses, as through the
 /// analytic solid of the same shape: a shadow ray through a tinted cube of twelve triangles
 /// crosses two surfaces and keeps `kt²`, exactly as through `box`.
-/// Planted bug, seen failing: the filter's walk along the ray restarted each query at
-/// `tmin` instead of beyond the previous crossing for meshes, so only the first surface
-/// was found (one blocker, `kt` once).
+/// Planted bug, seen failing: the mesh walk stopped at the first triangle it found rather
+/// than the nearest, so the shadow ray's first crossing was the cube's far face and the
+/// near one was never counted (one blocker instead of two).
 #[test]
 fn filtered_shadows_cross_a_mesh_solid_at_each_surface() {
     let corners: Vec<[f32; 3]> = (0..8)
-        .map(|i| [(i & 1) as f32 * 2.0 - 1.0, ((i >> 1) & 1) as f32 * 2.0 - 1.0, ((i >> 2) & 1) as f32 * 2.0 - 1.0])
+        .map(|i| {
+            [
+                (i & 1) as f32 * 2.0 - 1.0,
+                ((i >> 1) & 1) as f32 * 2.0 - 1.0,
+                ((i >> 2) & 1) as f32 * 2.0 - 1.0,
+            ]
+        })
         .collect();
     // Two triangles per face of the cube, wound so that their normals point out.
-    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
     let triangles: Vec<[u32; 3]> = quads
         .iter()
         .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
@@ -459,7 +472,10 @@ fn filtered_shadows_cross_a_mesh_solid_at_each_surface() {
                 },
             ) => {
                 assert_eq!(blockers, want_blockers, "{what}");
-                assert!((*transmittance - *want).abs().max_element() < 1e-6, "{what}: {transmittance}");
+                assert!(
+                    (*transmittance - *want).abs().max_element() < 1e-6,
+                    "{what}: {transmittance}"
+                );
             }
             _ => panic!("{what}: {result:?}"),
         }
