@@ -18,7 +18,6 @@ pub(super) fn parse(bytes: &[u8], budget: usize) -> Result<MeshData, MeshError> 
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let mut reader = std::io::Cursor::new(bytes);
     let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {

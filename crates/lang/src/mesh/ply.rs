@@ -69,7 +69,12 @@ struct Element {
 
 /// Parses a PLY file of at most `budget` triangles.
 pub(super) fn parse(bytes: &[u8], budget: usize) -> Result<MeshData, MeshError> {
-    let (format, elements, body, header_lines) = header(bytes)?;
+    let Header {
+        format,
+        elements,
+        body,
+        lines: header_lines,
+    } = header(bytes)?;
     let mut reader = match format {
         Format::Ascii => Reader::Ascii {
             text: body,
@@ -99,7 +104,7 @@ pub(super) fn parse(bytes: &[u8], budget: usize) -> Result<MeshData, MeshError> 
                 "its `vertex` element lacks one of the properties `x`, `y`, `z`",
             ));
         }
-        if is_face && !corners.is_some_and(|i| element.properties[i].list.is_some()) {
+        if is_face && corners.is_none_or(|i| element.properties[i].list.is_none()) {
             return Err(MeshError::whole(
                 "its `face` element has no `vertex_indices` list",
             ));
@@ -182,8 +187,18 @@ pub(super) fn parse(bytes: &[u8], budget: usize) -> Result<MeshData, MeshError> 
     Ok(data)
 }
 
-/// The header: format, elements, the bytes after `end_header`, and how many lines it took.
-fn header(bytes: &[u8]) -> Result<(Format, Vec<Element>, &[u8], usize), MeshError> {
+/// What the header says, and where the body starts.
+struct Header<'a> {
+    format: Format,
+    elements: Vec<Element>,
+    /// The bytes after `end_header`.
+    body: &'a [u8],
+    /// How many lines the header took.
+    lines: usize,
+}
+
+/// Reads the header.
+fn header(bytes: &[u8]) -> Result<Header<'_>, MeshError> {
     let mut format = None;
     let mut elements: Vec<Element> = Vec::new();
     let mut at = 0usize;
@@ -260,7 +275,12 @@ fn header(bytes: &[u8]) -> Result<(Format, Vec<Element>, &[u8], usize), MeshErro
     let Some(format) = format else {
         return Err(MeshError::whole("its header has no `format` line"));
     };
-    Ok((format, elements, &bytes[at..], line_number))
+    Ok(Header {
+        format,
+        elements,
+        body: &bytes[at..],
+        lines: line_number,
+    })
 }
 
 /// Reads the numbers of the body, one at a time.
