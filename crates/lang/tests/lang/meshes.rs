@@ -139,10 +139,12 @@ fn mesh_errors_name_the_file_and_line() {
 #[test]
 fn too_many_triangles_is_an_error_naming_the_limit() {
     let files = [("a.obj", TETRAHEDRON), ("b.obj", TETRAHEDRON)];
-    let mut options = CompileOptions::default();
-    options.limits = Limits {
-        max_mesh_triangles: 3,
-        ..Limits::default()
+    let mut options = CompileOptions {
+        limits: Limits {
+            max_mesh_triangles: 3,
+            ..Limits::default()
+        },
+        ..CompileOptions::default()
     };
     check_errors_with(
         "mesh_triangle_limits",
