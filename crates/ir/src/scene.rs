@@ -414,8 +414,9 @@ pub enum Shape {
 
 impl Shape {
     /// Whether the shape encloses a volume, so it has an inside for CSG and refraction. A
-    /// mesh's answer is in its data: use [`Scene::is_solid_shape`].
-    pub fn is_solid(&self) -> bool {
+    /// mesh's answer is in its data, so outside this crate ask [`Scene::is_solid_shape`]
+    /// (a reshading oracle that asked the shape took every glass mesh for thin sheets).
+    pub(crate) fn is_solid(&self) -> bool {
         match self {
             Shape::Disk { .. } | Shape::Triangle { .. } | Shape::Mesh { .. } => false,
             Shape::Cylinder { capped, .. } | Shape::Cone { capped, .. } => *capped,
