@@ -28,7 +28,11 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
             )));
         }
     }
-    let watch = watch_list(&args.scene.scene, &loaded.scene.sources);
+    let watch = watch_list(
+        &args.scene.scene,
+        &loaded.scene.sources,
+        Some(loaded.scene.scene()),
+    );
     let scene_args = args.scene.clone();
     let recompile: Recompile = Box::new(move || compile(&scene_args));
     let session = Session {
@@ -50,7 +54,11 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
 /// and `--set` as the first compile), silently: the debugger shows the diagnostics itself.
 fn compile(args: &SceneArgs) -> Compiled {
     let compilation = crate::front_end::compile(args, &whitted_mit6837::CourseOptions::default());
-    let watch = watch_list(&args.scene, &compilation.sources);
+    let watch = watch_list(
+        &args.scene,
+        &compilation.sources,
+        compilation.scene.as_ref().map(|valid| valid.scene()),
+    );
     Compiled {
         scene: compilation.scene,
         diagnostics: compilation.diagnostics,
@@ -60,11 +68,15 @@ fn compile(args: &SceneArgs) -> Compiled {
 }
 
 /// The root file and every source file that exists on disk (imports; not the pseudo-files
-/// of `-D` values).
-fn watch_list(root: &Path, sources: &SourceMap) -> Vec<PathBuf> {
+/// of `-D` values), and the mesh files of a scene that compiled (saving a model reloads).
+fn watch_list(root: &Path, sources: &SourceMap, scene: Option<&whitted_ir::Scene>) -> Vec<PathBuf> {
     let mut files = vec![root.to_path_buf()];
-    for (_, file) in sources.files() {
-        let path = PathBuf::from(&file.path);
+    let meshes = scene
+        .into_iter()
+        .flat_map(|scene| scene.meshes.iter().map(|(_, mesh)| mesh.file.as_str()));
+    let paths = sources.files().map(|(_, file)| file.path.as_str());
+    for path in paths.chain(meshes) {
+        let path = PathBuf::from(path);
         if path.is_file() && !files.contains(&path) {
             files.push(path);
         }

@@ -377,7 +377,8 @@ impl Reshader<'_> {
         // Secondary rays: what the material asks for, split by Fresnel.
         let leaf = &self.scene.objects[Handle::from_index(hit.leaf.handle as usize)];
         let solid = match &leaf.kind {
-            ObjectKind::Shape { shape } => shape.is_solid(),
+            // A mesh is a solid when its data says so (closed and consistently oriented).
+            ObjectKind::Shape { shape } => self.scene.is_solid_shape(shape),
             _ => true,
         };
         let kr = c(&m.reflective);

@@ -157,6 +157,30 @@ impl Serialize for Files<'_> {
     }
 }
 
+#[derive(serde::Serialize)]
+struct MeshEntry<'a> {
+    handle: usize,
+    location: String,
+    #[serde(flatten)]
+    value: crate::mesh::MeshSummary<'a>,
+}
+
+/// The meshes by their counts (not their vertices), each with its handle and location.
+struct Meshes<'a>(&'a Scene);
+
+impl Serialize for Meshes<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let scene = self.0;
+        serializer.collect_seq(scene.meshes.iter_with_spans().map(|(handle, mesh, span)| {
+            MeshEntry {
+                handle: handle.index(),
+                location: scene.sources.location(span),
+                value: mesh.summary(),
+            }
+        }))
+    }
+}
+
 /// The whole scene as a serialisable document (format version 1).
 pub struct IrDocument<'a> {
     scene: &'a Scene,
@@ -171,7 +195,7 @@ impl Serialize for IrDocument<'_> {
     fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         let scene = self.scene;
         // Keys in alphabetical order, as the earlier `Value` form printed them.
-        let mut map = serializer.serialize_struct("IrDocument", 8)?;
+        let mut map = serializer.serialize_struct("IrDocument", 9)?;
         map.serialize_field("camera", &scene.camera as &Camera)?;
         map.serialize_field("files", &Files(scene))?;
         map.serialize_field(
@@ -188,6 +212,7 @@ impl Serialize for IrDocument<'_> {
                 arena: &scene.materials,
             },
         )?;
+        map.serialize_field("meshes", &Meshes(scene))?;
         map.serialize_field("objects", &Objects(scene))?;
         map.serialize_field("roots", &scene.roots as &Vec<Handle<Object>>)?;
         map.serialize_field("settings", &scene.settings as &Settings)?;

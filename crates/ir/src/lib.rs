@@ -7,6 +7,7 @@ mod arena;
 mod diagnostic;
 mod json;
 pub mod limits;
+mod mesh;
 mod print;
 pub mod properties;
 mod provenance;
@@ -18,6 +19,7 @@ mod validate;
 pub use arena::{Arena, Handle};
 pub use diagnostic::{Diagnostic, Label, Severity};
 pub use json::{document as json_document, to_json, ArgJson, IrDocument, StepJson};
+pub use mesh::Mesh;
 pub use print::print;
 pub use provenance::{ArgValue, FrameId, Provenance, Site, SiteId, SiteKind, Step};
 pub use scene::{

@@ -63,6 +63,14 @@ pub const MAX_RAY_TREE_NODES: usize = 100_000;
 /// Estimated memory of one render (image buffers, statistics, scene), refused up front.
 pub const MAX_RENDER_MEMORY_BYTES: u64 = 8 * 1024 * 1024 * 1024;
 
+/// Triangles in one mesh file. A triangle costs the tracer about 60 bytes (corners, its
+/// share of the vertices and of the mesh's BVH), so this is about a gigabyte.
+pub const MAX_MESH_TRIANGLES: usize = 16_000_000;
+
+/// Triangles over every distinct mesh of a scene (instances of a mesh do not count again:
+/// they share its geometry).
+pub const MAX_SCENE_TRIANGLES: usize = 64_000_000;
+
 /// The largest magnitude of a coordinate, size, distance, direction, transform entry or
 /// quadric coefficient, in the scene file and in world space after transforms. The tracer
 /// works in f32, where at 1e9 neighbouring numbers are already 64 units apart.
@@ -179,6 +187,16 @@ pub const ALL: &[Limit] = &[
         "bytes of source text over every file",
     ),
     count("lights", MAX_LIGHTS as u64, "lights in a scene"),
+    count(
+        "mesh triangles",
+        MAX_MESH_TRIANGLES as u64,
+        "triangles in one mesh file",
+    ),
+    count(
+        "scene triangles",
+        MAX_SCENE_TRIANGLES as u64,
+        "triangles over every distinct mesh of a scene (instances share theirs)",
+    ),
     count("materials", MAX_MATERIALS as u64, "materials in a scene"),
     count("image side", MAX_IMAGE_SIDE as u64, "image width or height, in pixels"),
     count("pixels", MAX_PIXELS, "pixels in an image (width times height)"),

@@ -122,6 +122,23 @@ pub fn print(scene: &Scene) -> String {
             );
         }
     }
+    // Meshes by their counts: a million vertices would bury the scene.
+    for (handle, mesh, span) in scene.meshes.iter_with_spans() {
+        let _ = writeln!(
+            out,
+            "mesh {handle} {:?} {} vertices, {} triangles, {}, {}  @ {}",
+            mesh.file,
+            mesh.positions.len(),
+            mesh.triangles.len(),
+            if mesh.normals.is_empty() {
+                "no normals"
+            } else {
+                "vertex normals"
+            },
+            if mesh.solid { "solid" } else { "open" },
+            scene.sources.location(span)
+        );
+    }
     for &root in &scene.roots {
         print_object(scene, root, 0, &mut out);
     }
@@ -231,6 +248,9 @@ fn shape_text(shape: &Shape) -> String {
         ),
         Shape::Triangle { a, b, c } => format!("triangle {} {} {}", v(*a), v(*b), v(*c)),
         Shape::Torus { major, minor } => format!("torus major {major} minor {minor}"),
+        Shape::Mesh { mesh, smooth } => {
+            format!("mesh {mesh}{}", if *smooth { " smooth" } else { "" })
+        }
         Shape::Quadric { quadric, .. } => {
             let c = quadric.coefficients();
             let list: Vec<String> = c.iter().map(|x| x.to_string()).collect();

@@ -65,8 +65,18 @@ pub(crate) fn check(scene: &Scene, errors: &mut Vec<Diagnostic>) {
     for (_, material, span) in scene.materials.iter_with_spans() {
         ranges.material(material, span);
     }
+    // Each mesh's box once, however many objects instance it.
+    let mesh_boxes: Vec<Option<(DVec3, DVec3)>> =
+        scene.meshes.iter().map(|(_, mesh)| mesh.bounds()).collect();
+    for (_, mesh, span) in scene.meshes.iter_with_spans() {
+        if let Some((lo, hi)) = mesh.bounds() {
+            let what = format!("mesh `{}`'s vertex", mesh.file);
+            ranges.vector(&what, lo, span);
+            ranges.vector(&what, hi, span);
+        }
+    }
     for (_, object, span) in scene.objects.iter_with_spans() {
-        ranges.object(object, span);
+        ranges.object(object, &mesh_boxes, span);
     }
 }
 
@@ -231,7 +241,7 @@ impl Ranges<'_> {
         }
     }
 
-    fn object(&mut self, object: &Object, span: Span) {
+    fn object(&mut self, object: &Object, mesh_boxes: &[Option<(DVec3, DVec3)>], span: Span) {
         let m = &object.world_from_object;
         self.matrix("object's transform", m, span);
         let ObjectKind::Shape { shape } = &object.kind else {
@@ -310,6 +320,7 @@ impl Ranges<'_> {
                 }
                 None
             }
+            Shape::Mesh { mesh, .. } => mesh_boxes.get(mesh.index()).copied().flatten(),
             Shape::Torus { major, minor } => {
                 self.size("torus's `major` radius", *major, span);
                 self.size("torus's `minor` radius", *minor, span);
@@ -337,7 +348,10 @@ impl Ranges<'_> {
             } => Some(base_radius.max(*apex_radius).min((*apex - *base).length())),
             // Intersected in the space where the major radius is 1.
             Shape::Torus { major, minor } => Some(major.min(*minor)),
-            Shape::Plane { .. } | Shape::Triangle { .. } | Shape::Quadric { .. } => None,
+            Shape::Plane { .. }
+            | Shape::Triangle { .. }
+            | Shape::Quadric { .. }
+            | Shape::Mesh { .. } => None,
         };
         if let Some(size) = smallest.filter(|s| *s >= MIN_SIZE && m.is_finite()) {
             let inverse = m.inverse().to_cols_array();

@@ -8,6 +8,7 @@ use glam::{DMat4, DVec3};
 use serde::Serialize;
 
 use crate::arena::{Arena, Handle};
+use crate::mesh::Mesh;
 use crate::provenance::Provenance;
 use crate::source::{SourceMap, Span};
 
@@ -414,13 +415,24 @@ pub enum Shape {
         major: f64,
         minor: f64,
     },
+    /// An instance of a triangle mesh of [`Scene::meshes`]. A solid when the mesh is one
+    /// ([`Mesh::solid`]); otherwise thin triangles, like `triangle`.
+    Mesh {
+        mesh: Handle<Mesh>,
+        /// Normals interpolated across each triangle (from the file's vertex normals, or
+        /// else the area-weighted average of the faces around each vertex); `false` uses
+        /// each triangle's own normal.
+        smooth: bool,
+    },
 }
 
 impl Shape {
-    /// Whether the shape encloses a volume, so it has an inside for CSG and refraction.
-    pub fn is_solid(&self) -> bool {
+    /// Whether the shape encloses a volume, so it has an inside for CSG and refraction. A
+    /// mesh's answer is in its data, so outside this crate ask [`Scene::is_solid_shape`]
+    /// (a reshading oracle that asked the shape took every glass mesh for thin sheets).
+    pub(crate) fn is_solid(&self) -> bool {
         match self {
-            Shape::Disk { .. } | Shape::Triangle { .. } => false,
+            Shape::Disk { .. } | Shape::Triangle { .. } | Shape::Mesh { .. } => false,
             Shape::Cylinder { capped, .. } | Shape::Cone { capped, .. } => *capped,
             _ => true,
         }
@@ -436,6 +448,7 @@ impl Shape {
             Shape::Disk { .. } => "disk",
             Shape::Triangle { .. } => "triangle",
             Shape::Torus { .. } => "torus",
+            Shape::Mesh { .. } => "mesh",
             Shape::Quadric { form, .. } => match form {
                 QuadricForm::General => "quadric",
                 QuadricForm::Ellipsoid => "ellipsoid",
@@ -505,6 +518,8 @@ pub struct Scene {
     pub lights: Arena<Light>,
     pub materials: Arena<Material>,
     pub objects: Arena<Object>,
+    /// Mesh geometry, each file once however many objects instance it.
+    pub meshes: Arena<Mesh>,
     /// The top-level objects, in source order. Every other object is reachable from these.
     pub roots: Vec<Handle<Object>>,
     pub sources: SourceMap,
@@ -532,6 +547,15 @@ impl Scene {
                 };
                 format!("{kind} {handle}")
             }
+        }
+    }
+
+    /// Whether a shape encloses a volume: [`Shape::is_solid`], with meshes answered by
+    /// their data (a missing mesh is no solid).
+    pub fn is_solid_shape(&self, shape: &Shape) -> bool {
+        match shape {
+            Shape::Mesh { mesh, .. } => self.meshes.get(*mesh).is_some_and(|m| m.solid),
+            _ => shape.is_solid(),
         }
     }
 

@@ -5,6 +5,7 @@ use glam::{DMat4, DVec3};
 
 use crate::arena::Handle;
 use crate::diagnostic::Diagnostic;
+use crate::limits::{MAX_MESH_TRIANGLES, MAX_SCENE_TRIANGLES};
 use crate::scene::{
     Attenuation, Color, LightKind, Material, Object, ObjectKind, Projection, Scene, Shape,
 };
@@ -52,6 +53,7 @@ pub fn validate(scene: Scene) -> Result<ValidScene, Box<InvalidScene>> {
     for (handle, material, span) in scene.materials.iter_with_spans() {
         checker.material(&scene, handle, material, span);
     }
+    checker.meshes(&scene);
     for (handle, object, span) in scene.objects.iter_with_spans() {
         checker.object(&scene, handle, object, span);
     }
@@ -307,6 +309,13 @@ impl Checker {
             );
         }
         match &object.kind {
+            ObjectKind::Shape {
+                shape: Shape::Mesh { mesh, .. },
+            } => {
+                if !scene.meshes.contains(*mesh) {
+                    self.error(format!("the object refers to a missing mesh {mesh}"), span);
+                }
+            }
             ObjectKind::Shape { shape } => self.shape(shape, span),
             ObjectKind::Csg { op, children } => {
                 if children.is_empty() {
@@ -324,7 +333,7 @@ impl Checker {
                                 child_span,
                             )
                             .with_secondary(span, "in this CSG operation")
-                            .with_hint("disks, triangles, open cylinders and cones, and groups have no inside; use a capped shape or a union"),
+                            .with_hint("disks, triangles, open cylinders and cones, open meshes, and groups have no inside; use a capped shape, a closed mesh or a union"),
                         );
                     }
                 }
@@ -352,6 +361,65 @@ impl Checker {
             return false;
         }
         true
+    }
+
+    /// Every mesh: indices in range, numbers finite, not empty, within the triangle limits.
+    /// Each problem is reported once per mesh, at the first object that uses it (the
+    /// `file` property's place), naming the file.
+    fn meshes(&mut self, scene: &Scene) {
+        let mut total = 0usize;
+        for (_, mesh, span) in scene.meshes.iter_with_spans() {
+            let file = &mesh.file;
+            let count = mesh.triangles.len();
+            total = total.saturating_add(count);
+            if count == 0 {
+                self.error(format!("the mesh `{file}` has no triangles"), span);
+            }
+            if count > MAX_MESH_TRIANGLES {
+                self.error(
+                    format!("the mesh `{file}` has {count} triangles, over the mesh triangles limit of {MAX_MESH_TRIANGLES}"),
+                    span,
+                );
+            }
+            let vertices = mesh.positions.len();
+            if let Some((i, t)) = mesh
+                .triangles
+                .iter()
+                .enumerate()
+                .find(|(_, t)| t.iter().any(|&k| k as usize >= vertices))
+            {
+                self.error(
+                    format!(
+                        "the mesh `{file}`'s triangle {i} uses vertex {} of {vertices}",
+                        t.iter().copied().max().unwrap_or(0)
+                    ),
+                    span,
+                );
+            }
+            if !mesh.normals.is_empty() && mesh.normals.len() != vertices {
+                self.error(
+                    format!(
+                        "the mesh `{file}` has {} normals for {vertices} vertices",
+                        mesh.normals.len()
+                    ),
+                    span,
+                );
+            }
+            for (what, list) in [("vertex", &mesh.positions), ("normal", &mesh.normals)] {
+                if let Some(i) = list.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
+                    self.error(
+                        format!("the mesh `{file}`'s {what} {i} is not finite"),
+                        span,
+                    );
+                }
+            }
+        }
+        if total > MAX_SCENE_TRIANGLES {
+            self.error(
+                format!("the scene's meshes have {total} triangles, over the scene triangles limit of {MAX_SCENE_TRIANGLES}"),
+                Span::detached(),
+            );
+        }
     }
 
     fn shape(&mut self, shape: &Shape, span: Span) {
@@ -468,6 +536,8 @@ impl Checker {
                     self,
                 );
             }
+            // Checked with its mesh in `meshes`.
+            Shape::Mesh { .. } => {}
             Shape::Torus { major, minor } => {
                 bad(
                     major.is_finite() && *major > 0.0,
@@ -499,7 +569,7 @@ impl Checker {
 
 fn is_solid(scene: &Scene, handle: Handle<Object>) -> bool {
     match &scene.objects[handle].kind {
-        ObjectKind::Shape { shape } => shape.is_solid(),
+        ObjectKind::Shape { shape } => scene.is_solid_shape(shape),
         ObjectKind::Csg { .. } => true,
         ObjectKind::Group { .. } => false,
     }

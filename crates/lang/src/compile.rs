@@ -234,7 +234,7 @@ where
 }
 
 /// `a/./b/../c` → `a/c`, without touching the disk (the loader decides what paths mean).
-fn normalize(path: &Path) -> PathBuf {
+pub(crate) fn normalize(path: &Path) -> PathBuf {
     let mut out = PathBuf::new();
     for component in path.components() {
         match component {
@@ -528,6 +528,7 @@ fn compile_root(
     let overrides = parse_setting_overrides(&mut loading, &options.settings);
 
     let Loading {
+        loader,
         sources,
         mut program,
         interner,
@@ -588,9 +589,13 @@ fn compile_root(
         sources.clone(),
         max_evaluation_depth,
     );
-    let (scene, eval_diagnostics, failed) = evaluator.run(root_items);
+    let (mut scene, eval_diagnostics, failed) = evaluator.run(root_items);
     diagnostics.extend(eval_diagnostics);
     if failed || has_error(&diagnostics) {
+        return finish(sources, None, diagnostics, work);
+    }
+    crate::mesh::load_meshes(&mut scene, loader, limits, &mut diagnostics);
+    if has_error(&diagnostics) {
         return finish(sources, None, diagnostics, work);
     }
     match whitted_ir::validate(scene) {

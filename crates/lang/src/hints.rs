@@ -89,12 +89,8 @@ const FOREIGN: &[(&str, &str)] = &[
         "whitted has no per-object `no_shadow`: every object casts shadows; `settings { shadows filtered }` lets transparent objects pass tinted light",
     ),
     (
-        "mesh",
-        "whitted has no meshes yet: write the faces as `triangle { vertices <...>, <...>, <...> }` objects, in a `group` to move them together",
-    ),
-    (
         "mesh2",
-        "whitted has no meshes yet: write the faces as `triangle { vertices <...>, <...>, <...> }` objects, in a `group` to move them together",
+        "whitted reads meshes from files: write the vertices and faces to an `.obj` file and use `mesh { file \"model.obj\" }`",
     ),
     ("merge", "whitted has no `merge`: use `union`"),
     (
@@ -132,7 +128,7 @@ const FOREIGN: &[(&str, &str)] = &[
     // POV-Ray shapes whitted lacks, each with the nearest whitted construction.
     (
         "smooth_triangle",
-        "whitted's triangles are flat: write `triangle { vertices <...>, <...>, <...> }` (the vertex normals have no counterpart)",
+        "a `triangle` is flat; for interpolated vertex normals, write the triangles with their normals to an `.obj` file and use `mesh { file \"model.obj\" }`",
     ),
     (
         "prism",

@@ -17,6 +17,7 @@ mod eval;
 mod hints;
 mod intern;
 mod lexical;
+mod mesh;
 mod parser;
 mod properties;
 mod random;
@@ -72,6 +73,10 @@ pub struct Limits {
     pub max_lights: usize,
     /// Materials in the scene, named and inline together.
     pub max_materials: usize,
+    /// Triangles in one mesh file.
+    pub max_mesh_triangles: usize,
+    /// Triangles over every distinct mesh of the scene.
+    pub max_scene_triangles: usize,
 }
 
 impl Default for Limits {
@@ -87,6 +92,8 @@ impl Default for Limits {
             max_source_bytes: limits::MAX_SOURCE_BYTES,
             max_lights: limits::MAX_LIGHTS,
             max_materials: limits::MAX_MATERIALS,
+            max_mesh_triangles: limits::MAX_MESH_TRIANGLES,
+            max_scene_triangles: limits::MAX_SCENE_TRIANGLES,
         }
     }
 }

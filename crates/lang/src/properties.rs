@@ -84,6 +84,10 @@ pub enum Kind {
     Transform,
     /// Shape parameters whose ranges the shape's builder and validation check together.
     ShapeParameter,
+    /// A string: a file's path.
+    Text,
+    /// `true` or `false`.
+    Bool,
 }
 
 /// How many values a property takes after its name.
@@ -318,6 +322,12 @@ properties! {
     }
     Minor "minor" {
         Shape(&[ObjectTag::Torus]) => Number { min: 0.0, open: true, max: ANY }, "0.25", "the radius of the tube";
+    }
+    File "file" {
+        Shape(&[ObjectTag::Mesh]) => Text, "", "the mesh file, `.obj` or `.ply`, relative to the scene file's folder";
+    }
+    Smooth "smooth" {
+        Shape(&[ObjectTag::Mesh]) => Bool, "true", "interpolate the file's vertex normals across each triangle (`false`: each triangle's own normal)";
     }
     Translate "translate" {
         Transforms => Transform, "", "move";

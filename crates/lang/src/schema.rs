@@ -21,6 +21,7 @@ pub enum ObjectTag {
     Hyperboloid,
     Hyperboloid2,
     Torus,
+    Mesh,
     Union,
     Intersection,
     Difference,
@@ -28,7 +29,7 @@ pub enum ObjectTag {
 }
 
 impl ObjectTag {
-    pub const ALL: [ObjectTag; 17] = [
+    pub const ALL: [ObjectTag; 18] = [
         ObjectTag::Sphere,
         ObjectTag::Plane,
         ObjectTag::Box,
@@ -42,6 +43,7 @@ impl ObjectTag {
         ObjectTag::Hyperboloid,
         ObjectTag::Hyperboloid2,
         ObjectTag::Torus,
+        ObjectTag::Mesh,
         ObjectTag::Union,
         ObjectTag::Intersection,
         ObjectTag::Difference,
@@ -63,6 +65,7 @@ impl ObjectTag {
             ObjectTag::Hyperboloid => "hyperboloid",
             ObjectTag::Hyperboloid2 => "hyperboloid2",
             ObjectTag::Torus => "torus",
+            ObjectTag::Mesh => "mesh",
             ObjectTag::Union => "union",
             ObjectTag::Intersection => "intersection",
             ObjectTag::Difference => "difference",

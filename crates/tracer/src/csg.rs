@@ -23,7 +23,7 @@ use crate::bounds::{inverse_direction, Bound};
 use crate::bvh::{Bvh, Step};
 use crate::ray::Ray;
 use crate::scene::Leaf;
-use crate::shapes::Part;
+use crate::shapes::{Geometry, Part, RawSpan};
 
 /// A point where the ray crosses into or out of a solid.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -161,6 +161,8 @@ pub struct CsgScratch {
     /// Child positions touched by the ray, one run per accelerated node on the stack.
     touched: Vec<u32>,
     bvh_stack: Vec<UVec2>,
+    /// A solid mesh's crossings along the ray, before they are paired into spans.
+    mesh_hits: Vec<(f32, Part, bool)>,
 }
 
 impl CsgTree {
@@ -211,18 +213,32 @@ impl CsgTree {
             match &self.nodes[frame.node as usize] {
                 CsgNode::Leaf { leaf, bound } => {
                     if bound.admits(ray, inv_direction, tmin, tmax) {
-                        let shape_spans = self.leaves[*leaf as usize].geometry.spans(ray);
-                        for raw in shape_spans.as_slice() {
+                        let leaf = *leaf;
+                        let to_span = |raw: &RawSpan| {
                             let boundary = |t, part| Boundary {
                                 t,
-                                leaf: *leaf,
+                                leaf,
                                 part,
                                 flip: false,
                             };
-                            scratch.spans.push(Span {
+                            Span {
                                 enter: boundary(raw.t_in, raw.part_in),
                                 exit: boundary(raw.t_out, raw.part_out),
-                            });
+                            }
+                        };
+                        match &self.leaves[leaf as usize].geometry {
+                            // Any number of spans, straight into the list.
+                            Geometry::Mesh(mesh) => {
+                                let CsgScratch {
+                                    spans, mesh_hits, ..
+                                } = scratch;
+                                mesh.push_spans(ray, mesh_hits, |raw| spans.push(to_span(&raw)));
+                            }
+                            geometry => {
+                                for raw in geometry.spans(ray).as_slice() {
+                                    scratch.spans.push(to_span(raw));
+                                }
+                            }
                         }
                     }
                     scratch.stack.pop();

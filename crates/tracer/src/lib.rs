@@ -15,6 +15,7 @@ pub mod display;
 mod light;
 mod material;
 mod media;
+mod mesh;
 mod noise;
 pub mod optics;
 mod query;

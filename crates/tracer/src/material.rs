@@ -189,7 +189,7 @@ impl PatternFrame {
                 p -= step * (normal.dot(p) - offset);
             }
             Snap::Box { min, max } => {
-                let axis = usize::from(part / 2).min(2);
+                let axis = (part / 2).min(2) as usize;
                 p[axis] = if part % 2 == 1 { max[axis] } else { min[axis] };
             }
         }

@@ -70,6 +70,9 @@ pub struct Surface<'a> {
     pub point: Vec3A,
     /// Outward unit normal of the solid (after the CSG flip).
     pub geometric_normal: Vec3A,
+    /// The normal shading uses, on the same side: the geometric normal, except on smooth
+    /// meshes (their interpolated vertex normals).
+    pub shading_normal: Vec3A,
     pub item: &'a Item,
     pub leaf: &'a Leaf,
 }
@@ -403,9 +406,18 @@ impl PreparedScene {
             Geometry::Plane { normal, .. } => unit_normal(*normal, ray),
             geometry => geometry.normal(ray, hit.t, hit.part),
         };
+        let shading = match &leaf.geometry {
+            Geometry::Mesh(_) => leaf
+                .geometry
+                .shading_normal(ray, hit.part, normal)
+                .unwrap_or(normal),
+            _ => normal,
+        };
+        let sign = if hit.flip { -1.0 } else { 1.0 };
         Surface {
             point,
-            geometric_normal: if hit.flip { -normal } else { normal },
+            geometric_normal: sign * normal,
+            shading_normal: sign * shading,
             item,
             leaf,
         }

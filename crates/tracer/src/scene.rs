@@ -2,6 +2,7 @@
 //! from a validated IR scene: f32 shapes with their transforms folded in, resolved materials
 //! and lights, the camera basis, CSG trees, and the BVH over bounded objects.
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{DAffine3, Vec3A};
@@ -17,6 +18,7 @@ use crate::camera::PreparedCamera;
 use crate::csg::{ChildAccel, CsgNode, CsgTree, NO_ACCEL};
 use crate::light::PreparedLight;
 use crate::material::{color, PatternFrame, PreparedMaterial, Snap};
+use crate::mesh::{MeshInstance, PreparedMesh};
 use crate::ray::Ray;
 use crate::shapes::Geometry;
 
@@ -85,6 +87,11 @@ pub struct PreparedScene {
     /// Whether any material has a nested-media priority: only then are coincident
     /// surfaces looked for and crossed together.
     pub(crate) nested_media: bool,
+    /// Distinct meshes prepared, their triangles and their BVHs' nodes (each counted once
+    /// however many objects instance it).
+    mesh_count: usize,
+    mesh_triangles: usize,
+    mesh_bvh_nodes: usize,
     build_seconds: f64,
 }
 
@@ -116,13 +123,25 @@ impl PreparedScene {
                 PreparedLight::new(handle, light, scene.settings.attenuation_clamp)
             })
             .collect();
+        // Each mesh once (in parallel), shared by every object that instances it.
+        let meshes: Vec<Arc<PreparedMesh>> = scene
+            .meshes
+            .iter()
+            .collect::<Vec<_>>()
+            .par_iter()
+            .map(|(_, mesh)| Arc::new(PreparedMesh::new(mesh)))
+            .collect();
+        let shared = Shared {
+            materials: &materials,
+            meshes: &meshes,
+        };
         let roots = flatten_groups(scene);
         // Memory traffic dominates scenes of a million objects, so items are made once and
         // moved once, into BVH order.
         let (mut items, bounds): (Vec<Option<Item>>, Vec<Bound>) = roots
             .par_iter()
             .map(|&handle| {
-                let (item, bound) = prepare_item(scene, &materials, handle);
+                let (item, bound) = prepare_item(scene, &shared, handle);
                 (Some(item), bound)
             })
             .unzip();
@@ -141,7 +160,12 @@ impl PreparedScene {
         }
         let (bounded, bvh) = build_bvh(&mut items, &bounded_slots, &aabbs);
         let settings = scene.settings.clone();
+        let mesh_triangles = meshes.iter().map(|m| m.triangle_count()).sum();
+        let mesh_bvh_nodes = meshes.iter().map(|m| m.bvh_node_count()).sum();
         PreparedScene {
+            mesh_count: meshes.len(),
+            mesh_triangles,
+            mesh_bvh_nodes,
             camera: PreparedCamera::new(&scene.camera),
             lights,
             materials,
@@ -177,6 +201,21 @@ impl PreparedScene {
         self.bvh.as_ref().map_or(0, Bvh::node_count)
     }
 
+    /// Distinct meshes the scene holds (instances share one).
+    pub fn mesh_count(&self) -> usize {
+        self.mesh_count
+    }
+
+    /// Triangles over the distinct meshes (instances do not add any).
+    pub fn mesh_triangle_count(&self) -> usize {
+        self.mesh_triangles
+    }
+
+    /// Nodes over the distinct meshes' own BVHs.
+    pub fn mesh_bvh_node_count(&self) -> usize {
+        self.mesh_bvh_nodes
+    }
+
     /// How many of those are unbounded (planes and the like) and kept out of the BVH.
     pub fn unbounded_count(&self) -> usize {
         self.unbounded.len()
@@ -197,14 +236,16 @@ fn flatten_groups(scene: &Scene) -> Vec<Handle<Object>> {
     out
 }
 
-fn prepare_item(
-    scene: &Scene,
-    materials: &[PreparedMaterial],
-    handle: Handle<Object>,
-) -> (Item, Bound) {
+/// What every item's preparation reads: the prepared materials and meshes.
+struct Shared<'a> {
+    materials: &'a [PreparedMaterial],
+    meshes: &'a [Arc<PreparedMesh>],
+}
+
+fn prepare_item(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (Item, Bound) {
     match &scene.objects[handle].kind {
         ObjectKind::Csg { .. } => {
-            let tree = build_csg(scene, materials, handle);
+            let tree = build_csg(scene, shared, handle);
             let bound = match tree.nodes.last() {
                 Some(CsgNode::Leaf { bound, .. } | CsgNode::Op { bound, .. }) => *bound,
                 None => Bound::Empty,
@@ -216,21 +257,36 @@ fn prepare_item(
             (item, bound)
         }
         ObjectKind::Shape { .. } | ObjectKind::Group { .. } => {
-            let (leaf, bound) = prepare_leaf(scene, materials, handle);
+            let (leaf, bound) = prepare_leaf(scene, shared, handle);
             (Item::Shape(leaf), bound)
         }
     }
 }
 
-fn prepare_leaf(
-    scene: &Scene,
-    materials: &[PreparedMaterial],
-    handle: Handle<Object>,
-) -> (Leaf, Bound) {
+fn prepare_leaf(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (Leaf, Bound) {
+    let materials = shared.materials;
     let object = &scene.objects[handle];
     // Projective rows are ignored: the language only makes affine transforms.
     let world_from_object = DAffine3::from_mat4(object.world_from_object);
     let (geometry, bound, snap) = match &object.kind {
+        ObjectKind::Shape {
+            shape: Shape::Mesh { mesh, smooth },
+        } => match shared.meshes.get(mesh.index()) {
+            Some(prepared) => {
+                let (instance, bound) =
+                    MeshInstance::new(Arc::clone(prepared), *smooth, &world_from_object);
+                (Geometry::Mesh(Box::new(instance)), bound, Snap::None)
+            }
+            // Validation refuses a missing mesh; should one arrive, it is nothing.
+            None => (
+                Geometry::Plane {
+                    normal: Vec3A::Y,
+                    offset: 0.0,
+                },
+                Bound::Empty,
+                Snap::None,
+            ),
+        },
         ObjectKind::Shape { shape } => {
             let (geometry, bound) = Geometry::new(shape, &world_from_object);
             let snap = match shape {
@@ -275,7 +331,7 @@ fn prepare_leaf(
 /// Builds a CSG tree bottom-up (post-order over an explicit stack). Node bounds: a union
 /// is bounded by its children's union, an intersection by their intersection, a
 /// difference by its first child.
-fn build_csg(scene: &Scene, materials: &[PreparedMaterial], root: Handle<Object>) -> CsgTree {
+fn build_csg(scene: &Scene, shared: &Shared<'_>, root: Handle<Object>) -> CsgTree {
     let mut tree = CsgTree::default();
     let mut work: Vec<(Handle<Object>, bool)> = vec![(root, false)];
     let mut finished: Vec<u32> = Vec::new();
@@ -318,7 +374,7 @@ fn build_csg(scene: &Scene, materials: &[PreparedMaterial], root: Handle<Object>
                 finished.push(tree.nodes.len() as u32 - 1);
             }
             ObjectKind::Shape { .. } | ObjectKind::Group { .. } => {
-                let (leaf, bound) = prepare_leaf(scene, materials, handle);
+                let (leaf, bound) = prepare_leaf(scene, shared, handle);
                 tree.leaves.push(leaf);
                 tree.nodes.push(CsgNode::Leaf {
                     leaf: tree.leaves.len() as u32 - 1,

@@ -12,12 +12,14 @@ use glam::{DAffine3, DMat3, DMat4, DVec3, DVec4, Mat3A, Vec3A};
 use whitted_ir::{Quadric, Shape};
 
 use crate::bounds::Bound;
+use crate::mesh::MeshInstance;
 use crate::ray::Ray;
 use crate::solve::{quadratic_f32, quadratic_f64};
 
 /// Which part of a shape a boundary lies on, so that the normal is computed for the right
-/// face even at an edge: cylinder and cone walls and caps, and box faces `axis·2 + side`.
-pub type Part = u8;
+/// face even at an edge: cylinder and cone walls and caps, box faces `axis·2 + side`, and
+/// a mesh's triangle index.
+pub type Part = u32;
 const WALL: Part = 0;
 const BASE_CAP: Part = 1;
 const APEX_CAP: Part = 2;
@@ -153,6 +155,7 @@ pub enum Geometry {
     Triangle(Box<WorldTriangle>),
     Quadric(Box<WorldQuadric>),
     Local(Box<LocalGeometry>),
+    Mesh(Box<MeshInstance>),
 }
 
 impl Geometry {
@@ -306,6 +309,15 @@ impl Geometry {
                     Bound::transformed_box(&world_from_canonical, -extent, extent),
                 )
             }
+            // Meshes need the scene's prepared meshes: `MeshInstance::new` makes them. Reached
+            // only by a mesh missing from the scene, which validation refuses: nothing.
+            Shape::Mesh { .. } => (
+                Geometry::Plane {
+                    normal: Vec3A::Y,
+                    offset: 0.0,
+                },
+                Bound::Empty,
+            ),
             Shape::Quadric { quadric, .. } => {
                 let object_matrix = quadric_matrix(quadric);
                 let object_from_world = DMat4::from(m.inverse());
@@ -333,6 +345,7 @@ impl Geometry {
     pub fn is_solid(&self) -> bool {
         match self {
             Geometry::Disk(_) | Geometry::Triangle(_) => false,
+            Geometry::Mesh(mesh) => mesh.is_solid(),
             Geometry::Local(local) => match local.shape {
                 Canonical::Disk => false,
                 Canonical::Cylinder { capped } | Canonical::Cone { capped, .. } => capped,
@@ -366,6 +379,7 @@ impl Geometry {
                 (t > tmin && t < tmax).then_some((t, WALL))
             }
             Geometry::Quadric(_) => self.spans(ray).first_boundary(tmin, tmax),
+            Geometry::Mesh(mesh) => mesh.first_hit(ray, tmin, tmax),
             Geometry::Local(local) => {
                 let o = local.canonical_from_world.transform_point3a(ray.origin);
                 let d = local.canonical_from_world.transform_vector3a(ray.direction);
@@ -430,7 +444,9 @@ impl Geometry {
                 let d = local.canonical_from_world.transform_vector3a(ray.direction);
                 canonical_spans(local.shape, o, d)
             }
-            Geometry::Disk(_) | Geometry::Triangle(_) => ShapeSpans::NONE,
+            // A mesh may have any number of spans: CSG asks it directly
+            // (`MeshInstance::push_spans`).
+            Geometry::Disk(_) | Geometry::Triangle(_) | Geometry::Mesh(_) => ShapeSpans::NONE,
         }
     }
 
@@ -442,6 +458,7 @@ impl Geometry {
             Geometry::Disk(disk) => disk.normal,
             Geometry::Triangle(triangle) => triangle.edge1.cross(triangle.edge2),
             Geometry::Quadric(quadric) => quadric.gradient(ray, t),
+            Geometry::Mesh(mesh) => mesh.geometric_normal(part),
             Geometry::Local(local) => {
                 let o = local.canonical_from_world.transform_point3a(ray.origin);
                 let d = local.canonical_from_world.transform_vector3a(ray.direction);
@@ -451,6 +468,24 @@ impl Geometry {
             }
         };
         unit_normal(n, ray)
+    }
+}
+
+impl Geometry {
+    /// The unit normal that shading uses where it differs from the geometric one (a smooth
+    /// mesh's interpolated vertex normal), on the same side of the surface as
+    /// [`Geometry::normal`]; `None` where they are the same.
+    pub fn shading_normal(&self, ray: &Ray, part: Part, geometric: Vec3A) -> Option<Vec3A> {
+        let Geometry::Mesh(mesh) = self else {
+            return None;
+        };
+        let n = mesh.shading_normal(ray, part)?.normalize_or_zero();
+        if n == Vec3A::ZERO {
+            return None;
+        }
+        // A vertex normal may lean past the face at a sharp crease: keep it on the face's
+        // side, where entering and leaving are decided.
+        Some(if n.dot(geometric) < 0.0 { -n } else { n })
     }
 }
 
@@ -585,7 +620,28 @@ fn sphere_roots(ray: &Ray, center: Vec3A, radius: f32) -> Option<(f32, f32)> {
     quadratic_f32(1.0, h, c, discriminant)
 }
 
-fn triangle_hit(ray: &Ray, a: Vec3A, edge1: Vec3A, edge2: Vec3A) -> Option<f32> {
+/// The barycentric `(u, v)` of the point where `ray` crosses the triangle (weights of the
+/// second and third corners), by the same arithmetic as [`triangle_hit`].
+pub(crate) fn triangle_hit_uv(
+    ray: &Ray,
+    a: Vec3A,
+    edge1: Vec3A,
+    edge2: Vec3A,
+) -> Option<(f32, f32)> {
+    let p = ray.direction.cross(edge2);
+    let determinant = edge1.dot(p);
+    if determinant == 0.0 {
+        return None;
+    }
+    let inverse = 1.0 / determinant;
+    let s = ray.origin - a;
+    let u = s.dot(p) * inverse;
+    let v = ray.direction.dot(s.cross(edge1)) * inverse;
+    (u.is_finite() && v.is_finite()).then_some((u.clamp(0.0, 1.0), v.clamp(0.0, 1.0)))
+}
+
+#[inline(always)]
+pub(crate) fn triangle_hit(ray: &Ray, a: Vec3A, edge1: Vec3A, edge2: Vec3A) -> Option<f32> {
     // Möller–Trumbore.
     let p = ray.direction.cross(edge2);
     let determinant = edge1.dot(p);

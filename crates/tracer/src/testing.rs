@@ -4,8 +4,8 @@
 use glam::{DMat4, DVec3};
 use whitted_ir::{
     validate, Attenuation, Camera, Color, CsgOp, Fresnel, Handle, InvalidScene, Light, LightKind,
-    Material, Object, ObjectKind, Pattern, PatternKind, Projection, Scene, Settings, Shape, Span,
-    ValidScene,
+    Material, Mesh, Object, ObjectKind, Pattern, PatternKind, Projection, Scene, Settings, Shape,
+    Span, ValidScene,
 };
 
 use crate::scene::PreparedScene;
@@ -110,6 +110,11 @@ impl SceneBuilder {
         self.scene.roots.retain(|&root| root != handle);
     }
 
+    /// A mesh's geometry, for [`Shape::Mesh`] objects to instance.
+    pub fn mesh(&mut self, mesh: Mesh) -> Handle<Mesh> {
+        self.scene.meshes.append(mesh, Span::detached())
+    }
+
     pub fn name(&mut self, handle: Handle<Object>, name: &str) {
         self.scene.objects[handle].name = Some(name.to_string());
     }
@@ -159,6 +164,42 @@ impl SceneBuilder {
                 .join("; ")),
         }
     }
+}
+
+/// A closed sphere of triangles around the origin: `stacks` bands from pole to pole, each
+/// of `slices` quads (two triangles; one at the poles), every vertex shared, wound outward.
+/// With `normals`, each vertex carries the sphere's exact normal there.
+pub fn tessellated_sphere(radius: f32, stacks: u32, slices: u32, normals: bool) -> Mesh {
+    let (stacks, slices) = (stacks.max(2), slices.max(3));
+    let mut positions = vec![[0.0, radius, 0.0], [0.0, -radius, 0.0]];
+    for i in 1..stacks {
+        let theta = std::f64::consts::PI * f64::from(i) / f64::from(stacks);
+        for j in 0..slices {
+            let phi = std::f64::consts::TAU * f64::from(j) / f64::from(slices);
+            let r = f64::from(radius);
+            positions.push([
+                (r * theta.sin() * phi.cos()) as f32,
+                (r * theta.cos()) as f32,
+                (r * theta.sin() * phi.sin()) as f32,
+            ]);
+        }
+    }
+    let v = |i: u32, j: u32| 2 + (i - 1) * slices + j % slices;
+    let mut triangles = Vec::new();
+    for j in 0..slices {
+        triangles.push([0, v(1, j + 1), v(1, j)]);
+        triangles.push([1, v(stacks - 1, j), v(stacks - 1, j + 1)]);
+        for i in 1..stacks - 1 {
+            triangles.push([v(i, j), v(i, j + 1), v(i + 1, j + 1)]);
+            triangles.push([v(i, j), v(i + 1, j + 1), v(i + 1, j)]);
+        }
+    }
+    let normals = if normals {
+        positions.iter().map(|p| p.map(|x| x / radius)).collect()
+    } else {
+        Vec::new()
+    };
+    Mesh::new("sphere.obj".to_string(), positions, normals, triangles)
 }
 
 pub fn sphere(x: f64, y: f64, z: f64, radius: f64) -> Shape {

@@ -269,10 +269,12 @@ impl<'a> Tracer<'a> {
         };
 
         let d = ray.direction;
+        // Shading (and the secondary rays) use the shading normal; which side the ray is on
+        // was decided by the geometric one.
         let n = if front_face {
-            surface.geometric_normal
+            surface.shading_normal
         } else {
-            -surface.geometric_normal
+            -surface.shading_normal
         };
         let point = surface.point;
         let m = &scene.materials[material_handle.index()];

@@ -493,6 +493,7 @@ fn mirror_shape(shape: &Shape) -> Shape {
             c: mirror(*c),
         },
         Shape::Quadric { .. } => panic!("the generator makes no quadrics"),
+        Shape::Mesh { .. } => panic!("the generator makes no meshes"),
     }
 }
 

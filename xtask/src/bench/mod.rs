@@ -12,11 +12,13 @@ use serde::Deserialize;
 
 use crate::{run_cargo, workspace_root};
 
+mod mesh;
 mod programs;
 
 /// One benchmark render: a scene, its `-D` overrides and what to print it as.
 struct Case {
     label: &'static str,
+    /// Relative to the workspace root.
     scene: &'static str,
     defines: &'static [&'static str],
     /// The equivalent POV-Ray scene, for a side-by-side figure when `povray` is installed.
@@ -41,6 +43,13 @@ const RENDERS: &[Case] = &[
         scene: "scenes/bench/grid.scene",
         defines: &["N=1000"],
         pov: Some("scenes/bench/pov/grid.pov"),
+    },
+    Case {
+        label: "mesh 1,000,000 triangles",
+        // Written by `mesh::write` before the renders.
+        scene: "target/bench/mesh1m.scene",
+        defines: &[],
+        pov: None,
     },
 ];
 
@@ -76,6 +85,7 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     let mut width = 640;
     let mut height = 480;
     let mut only_programs = false;
+    let mut only_mesh = false;
     let mut iter = args.iter();
     while let Some(arg) = iter.next() {
         match arg.as_str() {
@@ -88,7 +98,10 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
                 height = h.parse().context("bad height")?;
             }
             "--programs" => only_programs = true,
-            other => bail!("unknown bench option `{other}` (known: --size WxH, --programs)"),
+            "--mesh" => only_mesh = true,
+            other => {
+                bail!("unknown bench option `{other}` (known: --size WxH, --programs, --mesh)")
+            }
         }
     }
     run_cargo(&["build", "--release", "--locked", "--bin", "whitted"])?;
@@ -100,6 +113,13 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     if only_programs {
         return programs::run(&exe, &out_dir, RUNS);
     }
+    let started = Instant::now();
+    mesh::write(&out_dir)?;
+    println!(
+        "(the 1,000,000-triangle mesh is in {}, written in {:.1}s)",
+        out_dir.display(),
+        started.elapsed().as_secs_f64()
+    );
 
     println!(
         "\nrenders ({width}x{height}, max depth 5, 1 spp; release build; best of {RUNS} runs)"
@@ -108,7 +128,10 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         "{:<26} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>10} {:>9}",
         "scene", "threads", "objects", "compile", "bvh", "render", "wall", "rays", "Mrays/s/core"
     );
-    for case in RENDERS {
+    let renders = RENDERS
+        .iter()
+        .filter(|case| !only_mesh || case.scene.ends_with("mesh1m.scene"));
+    for case in renders {
         for threads in [1, cores] {
             let output = out_dir.join(format!("{}.png", case.scene.replace(['/', '.'], "_")));
             let mut command = Command::new(&exe);
@@ -177,6 +200,9 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
             );
             debug_assert!(stats.width == width && stats.height == height && stats.max_depth == 5);
         }
+    }
+    if only_mesh {
+        return Ok(());
     }
 
     // One render per process pays for cold caches, first-touch page faults on the image and

@@ -32,6 +32,8 @@ pub fn limits() -> Limits {
         max_source_bytes: 1 << 20,
         max_lights: 64,
         max_materials: 20_000,
+        max_mesh_triangles: 10_000,
+        max_scene_triangles: 100_000,
     }
 }
 

@@ -89,7 +89,7 @@ fn opaque_solid(context: &Context<'_>, hit: &HitInfo) -> bool {
         return false;
     };
     let solid = match &object.kind {
-        ObjectKind::Shape { shape } => shape.is_solid(),
+        ObjectKind::Shape { shape } => context.scene.is_solid_shape(shape),
         ObjectKind::Csg { .. } => true,
         ObjectKind::Group { .. } => false,
     };

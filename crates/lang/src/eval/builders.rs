@@ -82,6 +82,9 @@ pub(super) struct ShapeFields {
     pub major: f64,
     pub minor: f64,
     pub open: bool,
+    /// A mesh's geometry, registered when its `file` is read.
+    pub mesh: Option<whitted_ir::Handle<whitted_ir::Mesh>>,
+    pub smooth: bool,
 }
 
 impl ShapeFields {
@@ -103,6 +106,8 @@ impl ShapeFields {
             major: 1.0,
             minor: 0.25,
             open: false,
+            mesh: None,
+            smooth: true,
         }
     }
 }

@@ -105,6 +105,8 @@ pub(crate) struct Evaluator<'a> {
     /// Arrays and strings.
     store: arrays::Store,
     default_material: Option<Handle<Material>>,
+    /// Meshes by their normalised path, so that a file named many times is one mesh.
+    mesh_files: std::collections::HashMap<std::path::PathBuf, Handle<whitted_ir::Mesh>>,
 
     sinks: Vec<Sink>,
     targets: Vec<Target>,
@@ -173,6 +175,7 @@ impl<'a> Evaluator<'a> {
             patterns: Vec::new(),
             store: arrays::Store::default(),
             default_material: None,
+            mesh_files: std::collections::HashMap::new(),
             sinks: vec![Sink::Collect(Vec::new())],
             targets: Vec::new(),
             spare_children: Vec::new(),

@@ -7,7 +7,8 @@
 //! which reports them at the object's header.
 
 use whitted_ir::{
-    Diagnostic, Light, LightKind, Object, ObjectKind, Quadric, QuadricForm, Shape, Span,
+    Diagnostic, Handle, Light, LightKind, Mesh, Object, ObjectKind, Quadric, QuadricForm, Shape,
+    Span,
 };
 
 use super::builders::*;
@@ -91,12 +92,40 @@ impl<'a> Evaluator<'a> {
         Ok(())
     }
 
+    /// The mesh of the file at `path` (relative to the folder of the file that names it),
+    /// registered on first use so that every instance shares it. Its geometry is read
+    /// after evaluation (`crate::mesh`), through the loader, at `span`.
+    pub(super) fn mesh_file(&mut self, path: &str, span: Span) -> Eval<Handle<Mesh>> {
+        let folder = self
+            .scene
+            .sources
+            .get(span.file)
+            .map(|source| std::path::PathBuf::from(&source.path))
+            .and_then(|p| p.parent().map(std::path::Path::to_path_buf))
+            .unwrap_or_default();
+        let target = crate::compile::normalize(&folder.join(path));
+        if let Some(&handle) = self.mesh_files.get(&target) {
+            return Ok(handle);
+        }
+        let mesh = Mesh {
+            file: target.to_string_lossy().into_owned(),
+            positions: Vec::new(),
+            normals: Vec::new(),
+            triangles: Vec::new(),
+            solid: false,
+        };
+        let handle = self.scene.meshes.append(mesh, span);
+        self.mesh_files.insert(target, handle);
+        Ok(handle)
+    }
+
     fn shape(&mut self, tag: ObjectTag, builder: &ObjectBuilder, header: Span) -> Eval<Shape> {
         let f = &builder.fields;
         let required = match tag {
             ObjectTag::Triangle => {
                 Some((Prop::Vertices, "vertices <0, 0, 0>, <1, 0, 0>, <0, 1, 0>"))
             }
+            ObjectTag::Mesh => Some((Prop::File, "file \"models/gem.obj\"")),
             ObjectTag::Quadric => Some((
                 Prop::Coefficients,
                 "coefficients <1, 1, 1>, <0, 0, 0>, <0, 0, 0>, -1",
@@ -159,6 +188,14 @@ impl<'a> Evaluator<'a> {
                 center: f.center,
                 normal: f.normal,
                 radius: f.radius,
+            },
+            ObjectTag::Mesh => match f.mesh {
+                Some(mesh) => Shape::Mesh {
+                    mesh,
+                    smooth: f.smooth,
+                },
+                // `file` was given (checked above) but failed, and said so.
+                None => return Err(Abort::Reported),
             },
             ObjectTag::Triangle => Shape::Triangle {
                 a: f.vertices[0],

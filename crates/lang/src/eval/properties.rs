@@ -289,6 +289,8 @@ impl<'a> Evaluator<'a> {
             Vertices([DVec3; 3]),
             Coefficients([f64; 10]),
             Open,
+            Mesh(whitted_ir::Handle<whitted_ir::Mesh>),
+            Smooth(bool),
         }
         let tag = match self.targets.last() {
             Some(Target::Object(b)) => b.tag,
@@ -351,6 +353,40 @@ impl<'a> Evaluator<'a> {
                 Set::Coefficients(coefficients)
             }
             Prop::Open => Set::Open,
+            Prop::File => {
+                let Value::Str(id) = value else {
+                    return self.fail(
+                        Diagnostic::error(
+                            format!("`file` must be a string, not {}", value.type_name()),
+                            value_span,
+                        )
+                        .with_label(format!("{} here", value.type_name()))
+                        .with_hint("write the path in quotes: `file \"models/gem.obj\"`"),
+                    );
+                };
+                let path = self
+                    .store
+                    .strings
+                    .get(id as usize)
+                    .cloned()
+                    .unwrap_or_default();
+                Set::Mesh(self.mesh_file(&path, value_span)?)
+            }
+            Prop::Smooth => match value {
+                Value::Bool(b) => Set::Smooth(b),
+                other => {
+                    return self.fail(
+                        Diagnostic::error(
+                            format!(
+                                "`smooth` must be `true` or `false`, not {}",
+                                other.type_name()
+                            ),
+                            value_span,
+                        )
+                        .with_label(format!("{} here", other.type_name())),
+                    )
+                }
+            },
             _ => return Ok(()),
         };
         let Some(Target::Object(b)) = self.targets.last_mut() else {
@@ -374,6 +410,8 @@ impl<'a> Evaluator<'a> {
             (_, Set::Vertices(v)) => f.vertices = v,
             (_, Set::Coefficients(c)) => f.coefficients = c,
             (_, Set::Open) => f.open = true,
+            (_, Set::Mesh(handle)) => f.mesh = Some(handle),
+            (_, Set::Smooth(b)) => f.smooth = b,
             _ => {}
         }
         Ok(())

@@ -42,7 +42,15 @@ fn every_scene_example_compiles() {
     let mut compiled = 0;
     for (info, body, line) in fenced_blocks(&markdown) {
         let mut words = info.split_whitespace();
-        if words.next() != Some("scene") {
+        let kind = words.next();
+        // ```obj NAME: a mesh file that later examples read; not a scene.
+        if kind == Some("obj") {
+            if let Some(name) = words.next() {
+                loader.files.insert(PathBuf::from(name), body.clone());
+            }
+            continue;
+        }
+        if kind != Some("scene") {
             continue;
         }
         // ```scene NAME: a file that later examples import.

@@ -366,6 +366,8 @@ fn limits_are_errors_that_name_the_limit() {
         max_source_bytes: 200,
         max_lights: 3,
         max_materials: 4,
+        max_mesh_triangles: 100,
+        max_scene_triangles: 1_000,
     };
     let options = CompileOptions {
         limits,

@@ -164,6 +164,8 @@ fn options() -> CompileOptions {
             max_source_bytes: 1 << 20,
             max_lights: 100,
             max_materials: 1_000,
+            max_mesh_triangles: 10_000,
+            max_scene_triangles: 100_000,
         },
     }
 }

@@ -10,6 +10,7 @@ mod exporter_scale;
 mod fuzz;
 mod limits;
 mod material_colors;
+mod meshes;
 mod overrides;
 mod provenance;
 mod scenes;
