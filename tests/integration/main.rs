@@ -9,6 +9,7 @@ mod debug_cli;
 mod debug_tmux;
 mod explain;
 mod extremes;
+mod front_end_oracles;
 mod guards;
 mod json_schema;
 mod mit6837;

@@ -188,8 +188,8 @@ pub(crate) struct Converter<'a, 'l> {
     pub warnings: Vec<Diagnostic>,
     /// Nested groups and transforms, bounded by the nesting limit.
     pub depth: usize,
-    /// Mesh files read so far (by path), each parsed once however often it is used.
-    pub meshes: Vec<(PathBuf, crate::mesh::ObjMesh)>,
+    /// Mesh files read so far (by path), each parsed and held once however often it is used.
+    pub meshes: Vec<(PathBuf, Handle<whitted_ir::Mesh>)>,
     background: Option<Color>,
     ambient: Option<Color>,
     /// The top-level blocks read so far, each at most once.

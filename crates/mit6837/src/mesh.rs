@@ -2,12 +2,12 @@
 //! [`crate::MeshLoader`] (its `v` and `f` lines; everything else is skipped), added to the
 //! source map so that each triangle points at its `f` line, and lowered to the IR.
 //!
-//! The IR has no meshes yet, so [`lower_to_triangles`] makes a group of `triangle` shapes:
-//! thin surfaces, which do not refract as one solid. It is the one place that decides how a
-//! mesh becomes IR, so that it can switch to the IR's meshes when they exist.
+//! Each file becomes one mesh of the IR (`Scene::meshes`), read and parsed once however
+//! often the scene uses it; every `TriangleMesh` is an object instancing it, so a closed,
+//! consistently oriented mesh is a solid (a glass gem refracts as one) as in the language.
 
 use whitted_ir::{
-    limits, DMat4, DVec3, Diagnostic, FileId, Handle, Material, Object, ObjectKind, Shape,
+    limits, DMat4, DVec3, Diagnostic, FileId, Handle, Material, Mesh, Object, ObjectKind, Shape,
     SourceFile, Span,
 };
 
@@ -36,10 +36,14 @@ impl<'a> Converter<'a, '_> {
     ) -> Read<Handle<Object>> {
         let path = self.folder.join(name.text);
         let display = path.to_string_lossy().into_owned();
-        // A mesh used twice is read, parsed and shown in the source map once.
-        let known = self.meshes.iter().position(|(p, _)| *p == path);
-        let index = match known {
-            Some(index) => index,
+        // A mesh used twice is read, parsed and shown in the source map once, and held once.
+        let known = self
+            .meshes
+            .iter()
+            .find(|(p, _)| *p == path)
+            .map(|&(_, h)| h);
+        let mesh = match known {
+            Some(mesh) => mesh,
             None => {
                 let bytes = match self.loader.load(&path) {
                     Ok(bytes) => bytes,
@@ -59,42 +63,58 @@ impl<'a> Converter<'a, '_> {
                     .scene
                     .sources
                     .add(SourceFile::new(display.clone(), text.as_str()));
-                let mesh = parse_obj(&text, file, self.scene.objects.len())?;
-                self.meshes.push((path, mesh));
-                self.meshes.len() - 1
+                let parsed = parse_obj(&text, file)?;
+                let (mesh, degenerate) = to_ir_mesh(&parsed, display.clone());
+                if mesh.triangles.is_empty() {
+                    return Err(Box::new(
+                        Diagnostic::error(
+                            format!("the mesh {display} has no triangles"),
+                            self.reader.span(name),
+                        )
+                        .with_label("this file")
+                        .with_hint("a mesh needs `f` lines naming three or more `v` lines"),
+                    ));
+                }
+                if let Some((count, first)) = degenerate {
+                    self.warnings.push(
+                        Diagnostic::warning(
+                            format!(
+                                "{count} degenerate face{} of {display} (corners in a line) left out",
+                                if count == 1 { "" } else { "s" }
+                            ),
+                            first,
+                        )
+                        .with_label("the first of them"),
+                    );
+                }
+                let handle = self.scene.meshes.append(mesh, self.reader.span(name));
+                self.meshes.push((path, handle));
+                handle
             }
         };
-        let mesh = std::mem::replace(
-            &mut self.meshes[index].1,
-            ObjMesh {
-                positions: Vec::new(),
-                faces: Vec::new(),
+        let handle = self.append(
+            Object {
+                name: None,
+                kind: ObjectKind::Shape {
+                    shape: Shape::Mesh {
+                        mesh,
+                        // The course's meshes are faceted: its files have no normals.
+                        smooth: false,
+                    },
+                },
+                world_from_object,
+                material,
             },
-        );
-        let lowered = lower_to_triangles(self, &mesh, span, world_from_object, material);
-        self.meshes[index].1 = mesh;
-        let (handle, degenerate) = lowered?;
-        // Said once per file, not once per use.
-        if let (Some((count, first)), None) = (degenerate, known) {
-            self.warnings.push(
-                Diagnostic::warning(
-                    format!(
-                        "{count} degenerate face{} of {display} (corners in a line) left out",
-                        if count == 1 { "" } else { "s" }
-                    ),
-                    first,
-                )
-                .with_label("the first of them"),
-            );
-        }
+            span,
+        )?;
         Ok(handle)
     }
 }
 
 /// Parses the `v x y z` and `f a b c ...` lines of an `.obj` text (1-based indices, negative
 /// ones counting back from the last vertex, `a/t/n` forms taking `a`; polygons are split into
-/// a fan of triangles). `objects` is how many objects the scene already has, for the limit.
-pub(crate) fn parse_obj(text: &str, file: FileId, objects: usize) -> Read<ObjMesh> {
+/// a fan of triangles), up to the mesh triangle limit.
+pub(crate) fn parse_obj(text: &str, file: FileId) -> Read<ObjMesh> {
     let mut mesh = ObjMesh {
         positions: Vec::new(),
         faces: Vec::new(),
@@ -169,9 +189,9 @@ pub(crate) fn parse_obj(text: &str, file: FileId, objects: usize) -> Read<ObjMes
                     ));
                 }
                 for i in 1..corners.len() - 1 {
-                    if objects + mesh.faces.len() >= limits::MAX_OBJECTS {
+                    if mesh.faces.len() >= limits::MAX_MESH_TRIANGLES {
                         return Err(Box::new(Diagnostic::error(
-                            format!("this face is past {}", limits::describe("objects")),
+                            format!("this face is past {}", limits::describe("mesh triangles")),
                             line_span,
                         )));
                     }
@@ -186,18 +206,12 @@ pub(crate) fn parse_obj(text: &str, file: FileId, objects: usize) -> Read<ObjMes
     Ok(mesh)
 }
 
-/// The mesh as IR: a group of `triangle` shapes, each with its `f` line's span, under the
-/// `TriangleMesh`'s transform and material. Degenerate faces (corners in a line, which
-/// validation refuses) are left out; returns how many, and where the first is.
-pub(crate) fn lower_to_triangles(
-    converter: &mut Converter<'_, '_>,
-    mesh: &ObjMesh,
-    span: Span,
-    world_from_object: DMat4,
-    material: Handle<Material>,
-) -> Read<(Handle<Object>, Degenerate)> {
-    let mut children = Vec::with_capacity(mesh.faces.len());
+/// The mesh as the IR holds it: positions and triangles (degenerate faces, which have no
+/// normal, left out; returns how many, and where the first is). `file` names it in messages
+/// and in `whitted ir`.
+pub(crate) fn to_ir_mesh(mesh: &ObjMesh, file: String) -> (Mesh, Degenerate) {
     let mut degenerate: Degenerate = None;
+    let mut triangles = Vec::with_capacity(mesh.faces.len());
     for &([i, j, k], face_span) in &mesh.faces {
         let (a, b, c) = (mesh.positions[i], mesh.positions[j], mesh.positions[k]);
         // The validator's own threshold for a degenerate triangle.
@@ -206,26 +220,17 @@ pub(crate) fn lower_to_triangles(
             entry.0 += 1;
             continue;
         }
-        children.push(converter.append(
-            Object {
-                name: None,
-                kind: ObjectKind::Shape {
-                    shape: Shape::Triangle { a, b, c },
-                },
-                world_from_object,
-                material,
-            },
-            face_span,
-        )?);
+        // Indices are below the vertex count, which the source size limit keeps far below
+        // u32::MAX (a `v` line is at least 7 bytes).
+        triangles.push([i as u32, j as u32, k as u32]);
     }
-    let group = converter.append(
-        Object {
-            name: None,
-            kind: ObjectKind::Group { children },
-            world_from_object,
-            material,
-        },
-        span,
-    )?;
-    Ok((group, degenerate))
+    let positions = mesh
+        .positions
+        .iter()
+        .map(|p| p.as_vec3().to_array())
+        .collect();
+    (
+        Mesh::new(file, positions, Vec::new(), triangles),
+        degenerate,
+    )
 }

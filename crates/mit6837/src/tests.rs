@@ -286,7 +286,7 @@ fn transforms_compose_as_the_course_multiplied_them() {
 }
 
 #[test]
-fn a_mesh_becomes_triangles_pointing_at_their_face_lines() {
+fn a_mesh_becomes_one_ir_mesh_instanced_by_its_triangle_mesh() {
     let mut files = Files::default();
     files.0.insert(
         PathBuf::from("course/models/quad.obj"),
@@ -307,31 +307,52 @@ fn a_mesh_becomes_triangles_pointing_at_their_face_lines() {
         warnings,
         "course/models/quad.obj:9:1: 1 degenerate face of course/models/quad.obj (corners in a line) left out\n"
     );
-    let triangles: Vec<_> = scene
+    let instances: Vec<_> = scene
         .objects
         .iter_with_spans()
         .filter_map(|(_, o, span)| match o.kind {
             ObjectKind::Shape {
-                shape: Shape::Triangle { a, b, c },
-            } => Some(((a, b, c), o.world_from_object, scene.sources.location(span))),
+                shape: Shape::Mesh { mesh, smooth },
+            } => Some((
+                mesh,
+                smooth,
+                o.world_from_object,
+                scene.sources.location(span),
+            )),
             _ => None,
         })
         .collect();
+    assert_eq!(instances.len(), 1, "{instances:?}");
+    let (mesh, smooth, world_from_object, location) = instances[0].clone();
+    assert!(!smooth, "the course's meshes are faceted");
+    assert_eq!(world_from_object, DMat4::from_translation(DVec3::Z));
+    assert_eq!(location, "course/scene.txt:4:29");
     // The quad as a fan of two, then `f -4 -2 -1` (counted back from the fourth vertex:
-    // vertices 1, 3 and 4) as the fan's second triangle again, from line 8.
-    assert_eq!(triangles.len(), 3, "{triangles:?}");
-    assert_eq!(
-        triangles[0].0,
-        (DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0))
+    // vertices 1, 3 and 4) as the fan's second triangle again; the degenerate face left out.
+    let mesh = &scene.meshes[mesh];
+    assert_eq!(mesh.triangles, vec![[0, 1, 2], [0, 2, 3], [0, 2, 3]]);
+    assert_eq!(mesh.positions[2], [1.0, 1.0, 0.0]);
+    assert!(mesh.normals.is_empty());
+    // An open square (and a face repeated) is not a solid.
+    assert!(!mesh.solid);
+}
+
+#[test]
+fn a_closed_mesh_is_a_solid() {
+    let mut files = Files::default();
+    files.0.insert(
+        PathBuf::from("course/tetra.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n".to_string(),
     );
-    assert_eq!(
-        triangles[1].0,
-        (DVec3::ZERO, DVec3::new(1.0, 1.0, 0.0), DVec3::Y)
-    );
-    assert_eq!(triangles[2].0, triangles[1].0);
-    assert_eq!(triangles[0].1, DMat4::from_translation(DVec3::Z));
-    assert_eq!(triangles[0].2, "course/models/quad.obj:7:1");
-    assert_eq!(triangles[2].2, "course/models/quad.obj:8:1");
+    let text = "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 5 }\n\
+        Materials { numMaterials 1 Material { diffuseColor 1 1 1 transparentColor 0.9 0.9 0.9 indexOfRefraction 1.5 } }\n\
+        Group { numObjects 1 MaterialIndex 0 TriangleMesh { obj_file tetra.obj } }\n";
+    let conversion = read_with(text, &mut files, &CourseOptions::default());
+    let Some(scene) = conversion.scene else {
+        panic!("{}", messages(&conversion));
+    };
+    let meshes: Vec<_> = scene.meshes.iter().map(|(_, m)| m.solid).collect();
+    assert_eq!(meshes, vec![true]);
 }
 
 #[test]
@@ -355,8 +376,9 @@ fn a_mesh_used_twice_is_one_source_file_and_one_warning() {
     let Some(scene) = conversion.scene else {
         panic!("not converted");
     };
-    // Two groups of one triangle each, and the root group.
-    assert_eq!(scene.objects.len(), 5);
+    // One mesh, held once; two objects instancing it, and the root group.
+    assert_eq!(scene.meshes.len(), 1);
+    assert_eq!(scene.objects.len(), 3);
 }
 
 #[test]
