@@ -151,3 +151,34 @@ fn trace_json_gives_the_hit_object_its_stack_and_matches_the_schema() {
     assert_eq!(object["made_by"][1]["var"], Value::Null);
     assert_eq!(object["made_by"][0]["args"], Value::Null);
 }
+
+/// `whitted explain` names the bead it explains by where it came from: a `made by` line in
+/// the text, and `made_by` on the path's step in the JSON.
+#[test]
+fn explain_shows_the_stack_of_the_object_it_names() {
+    let text = run(&["explain", SCENE, "--pixel", PIXEL]);
+    assert!(
+        text.contains(&format!("made by:\n  bead 7: {STACK}\n")),
+        "{text}"
+    );
+    let json: Value = serde_json::from_str(&run(&["explain", SCENE, "--pixel", PIXEL, "--json"]))
+        .expect("explain --json is JSON");
+    let schema: Value = serde_json::from_str(
+        &std::fs::read_to_string(workspace().join("docs/explain.schema.json"))
+            .expect("the explain schema"),
+    )
+    .expect("the explain schema is JSON");
+    let errors = validate(&schema, &json);
+    assert!(errors.is_empty(), "{errors:?}");
+    let first_step = &json["contributions"][0]["path"][0];
+    assert_eq!(first_step["object"], json!("bead 7"));
+    assert_eq!(
+        first_step["made_by"],
+        json!([
+            "i = 7 at scenes/provenance/lib.scene:6:5",
+            "import at scenes/provenance/main.scene:5:1",
+            "ring(12, 2) at scenes/provenance/main.scene:12:5",
+            "k = 1 at scenes/provenance/main.scene:11:1"
+        ])
+    );
+}

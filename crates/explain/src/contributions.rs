@@ -150,6 +150,13 @@ fn visit(
         object: node.hit.as_ref().map(|h| h.object.label.clone()),
         location: node.hit.as_ref().map(|h| h.object.location.clone()),
         repeat: 1,
+        made_by: node.hit.as_ref().map_or_else(Vec::new, |h| {
+            h.object
+                .made_by
+                .iter()
+                .map(|step| format!("{} at {}", step.text, step.location))
+                .collect()
+        }),
     });
     let weight = DVec3::from(node.weight.map(f64::from)) * scale;
     let mut add = |term: Term, light: Option<(u32, &str)>, color: [f32; 3]| {
@@ -247,6 +254,7 @@ mod tests {
             object: object.map(str::to_string),
             location: object.map(|o| format!("{o}.scene:1:1")),
             repeat: 1,
+            made_by: Vec::new(),
         }
     }
 

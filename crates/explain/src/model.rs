@@ -89,6 +89,11 @@ pub struct Step {
     pub location: Option<String>,
     /// How many times this same step repeats in a row (1 usually; bounces inside a solid).
     pub repeat: u32,
+    /// The object's instantiation stack, innermost first, each step as `i = 7 at
+    /// file:line:col` (docs/ray-tree.md): which loop iteration, call or import made it.
+    /// Left out of the JSON when empty (an object written at the top level of the root file).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub made_by: Vec<String>,
 }
 
 /// A likely cause of the pixel's colour, located in the scene, with a fix.

@@ -64,6 +64,7 @@ pub fn format_text(explanation: &Explanation) -> String {
             let _ = writeln!(out, "  {share}  {}  {line}", rgb(c.color));
         }
     }
+    push_made_by(&mut out, explanation);
     out.push('\n');
     if explanation.findings.is_empty() {
         out.push_str("no findings\n");
@@ -79,4 +80,23 @@ pub fn format_text(explanation: &Explanation) -> String {
         }
     }
     out
+}
+
+/// Where the objects on the lines above came from, when a loop, a call or an import made
+/// them (`sphere #14` alone does not say which of a loop's spheres it is): each object once.
+fn push_made_by(out: &mut String, explanation: &Explanation) {
+    let mut seen: Vec<(&str, &str)> = Vec::new();
+    for step in explanation.contributions.iter().flat_map(|c| &c.path) {
+        let (Some(object), Some(location)) = (&step.object, &step.location) else {
+            continue;
+        };
+        if step.made_by.is_empty() || seen.contains(&(object.as_str(), location.as_str())) {
+            continue;
+        }
+        if seen.is_empty() {
+            out.push_str("made by:\n");
+        }
+        seen.push((object, location));
+        let _ = writeln!(out, "  {object}: {}", step.made_by.join(", "));
+    }
 }
