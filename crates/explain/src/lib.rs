@@ -10,12 +10,15 @@
 //! [`Explanation::document`] are for the binary to show.
 
 pub mod contributions;
+pub mod diff;
 pub mod findings;
 mod inside;
 mod json;
 mod locate;
 mod model;
 pub mod probe;
+pub mod query;
+pub mod regions;
 mod text;
 
 pub use json::{ExplanationDocument, EXPLAIN_JSON_VERSION};
