@@ -23,7 +23,7 @@ mod text;
 
 pub use json::{ExplanationDocument, EXPLAIN_JSON_VERSION};
 pub use model::{Contribution, Explanation, Finding, FindingKind, Step, Term};
-pub use text::format_text;
+pub use text::{format_summary, format_text};
 
 use std::sync::atomic::AtomicBool;
 

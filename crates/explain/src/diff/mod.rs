@@ -415,16 +415,16 @@ impl Walk<'_> {
                             ha.object.label, hb.resolved_material.label
                         )
                     };
-                    push(
-                        out,
-                        DivergenceKind::Material,
-                        what,
-                        [va, vb],
-                        [
-                            Some(ha.resolved_material.location.clone()),
-                            Some(hb.resolved_material.location.clone()),
-                        ],
-                    );
+                    // Point at the value itself where the material writes it.
+                    let location = [(0, ha), (1, hb)].map(|(side, h)| {
+                        let handle =
+                            Handle::<Material>::from_index(h.resolved_material.handle as usize);
+                        Some(
+                            property_location(self.scenes[side], handle, &field)
+                                .unwrap_or_else(|| h.resolved_material.location.clone()),
+                        )
+                    });
+                    push(out, DivergenceKind::Material, what, [va, vb], location);
                     return;
                 }
                 if differs(ha.t, hb.t) {
@@ -592,6 +592,31 @@ impl Walk<'_> {
         }
         rows.into_iter().find(|(_, x, y)| x != y)
     }
+}
+
+/// `file:line:col` of the word `field` inside a material's definition, when it is written
+/// there (an inherited value is written in the parent: the material's own line is used).
+fn property_location(scene: &Scene, material: Handle<Material>, field: &str) -> Option<String> {
+    let span = scene.materials.span(material);
+    let file = scene.sources.get(span.file)?;
+    // The span may cover only the material's header: look on to the end of its block.
+    let rest = file.text.get(span.start as usize..)?;
+    let text = &rest[..rest.find('}').map_or(rest.len(), |end| end + 1)];
+    let word = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    let mut from = 0;
+    while let Some(at) = text[from..].find(field) {
+        let start = from + at;
+        let end = start + field.len();
+        let before = text[..start].chars().next_back().is_some_and(word);
+        let after = text[end..].chars().next().is_some_and(word);
+        if !before && !after {
+            let offset = span.start as usize + start;
+            let at = whitted_ir::Span::new(span.file, offset, offset + field.len());
+            return Some(scene.sources.location(at));
+        }
+        from = end;
+    }
+    None
 }
 
 fn hit_label(hit: &HitInfo) -> String {

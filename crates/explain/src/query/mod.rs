@@ -320,7 +320,17 @@ pub fn describe_witness(query: &Query, scene: &Scene, witness: &Witness) -> Stri
         Some(handle) => {
             let handle = Handle::<Object>::from_index(handle as usize);
             let location = scene.sources.location(scene.objects.span(handle));
-            format!(" at {} ({location})", scene.object_label(handle))
+            let relation = match query.atoms().get(witness.atom) {
+                Some(
+                    Test::ShadowBlocked
+                    | Test::ShadowBlockedBy(_)
+                    | Test::ShadowBlockedByTransparent,
+                ) => "blocked by",
+                Some(Test::MaxDepth | Test::WeightCutoff) => "not traced from",
+                Some(Test::Tir) => "inside",
+                _ => "hitting",
+            };
+            format!(" {relation} {} ({location})", scene.object_label(handle))
         }
         None => String::new(),
     };
