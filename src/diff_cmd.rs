@@ -77,6 +77,10 @@ fn pixel_diff(
     if let Some(path) = other {
         scene_b.scene = path.to_path_buf();
     }
+    // An --against-set replaces the same setting's --set, which would otherwise be given twice.
+    scene_b
+        .set
+        .retain(|(name, _)| against_set.iter().all(|(other, _)| other != name));
     scene_b.set.extend(against_set.iter().cloned());
     let loaded_a = load_scene(scene_a, true)?;
     let loaded_b = load_scene(&scene_b, true)?;

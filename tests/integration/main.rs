@@ -7,6 +7,7 @@ mod cli;
 mod conventions;
 mod debug_cli;
 mod debug_tmux;
+mod diff;
 mod explain;
 mod extremes;
 mod guards;
