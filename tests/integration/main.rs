@@ -13,6 +13,7 @@ mod extremes;
 mod guards;
 mod json_schema;
 mod mit6837;
+mod query;
 mod ray_trees;
 mod reshade;
 mod tidy;
