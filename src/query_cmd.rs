@@ -52,6 +52,14 @@ pub fn query(args: &QueryArgs) -> Result<(), Failure> {
     let loaded = load_scene(&args.scene, true)?;
     let options = render_options(&loaded.scene.settings, &args.overrides);
     check_image_size(options.width, options.height)?;
+    if let Some(mask) = &args.mask {
+        if crate::render_cmd::same_file(mask, &args.scene.scene) {
+            return Err(Failure::Usage(format!(
+                "--mask {} would overwrite the scene",
+                mask.display()
+            )));
+        }
+    }
     let query = Query::compile(&args.expr, &loaded.scene)
         .map_err(|error| Failure::Usage(format!("in the query: {}", error.render(&args.expr))))?;
     let threads = match args.threads {
