@@ -225,3 +225,52 @@ pub(crate) fn first_witness(witnesses: &[Option<Witness>], bits: u64) -> Option<
         .filter_map(|(_, w)| *w)
         .min_by_key(|w| w.order)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use whitted_ir::Scene;
+
+    fn start(kind: RayKind, depth: u32) -> RayStart {
+        RayStart {
+            kind,
+            depth,
+            origin: Vec3A::ZERO,
+            direction: Vec3A::Z,
+            weight: Vec3A::ONE,
+            coefficient: Vec3A::ONE,
+            interface: None,
+        }
+    }
+
+    // No scene makes a NaN colour (tests/integration/extremes.rs sees to that), so the
+    // hooks are fed one by hand.
+    #[test]
+    fn a_ray_returning_nan_is_seen_with_its_depth() {
+        let query = Query::compile("nan and depth >= 1", &Scene::default()).unwrap();
+        let mut watch = Watch {
+            query: &query,
+            observed: Observed::default(),
+            witnesses: vec![None; query.atoms.len()],
+            stack: Vec::new(),
+            sample: 3,
+            events: 0,
+        };
+        watch.ray_started(&start(RayKind::Camera, 0));
+        watch.ray_started(&start(RayKind::Reflected, 1));
+        watch.ray_finished(Vec3A::new(0.0, f32::NAN, 0.0), Termination::Miss);
+        watch.ray_finished(Vec3A::ONE, Termination::NotEnded);
+        assert!(query.holds(&watch.observed));
+        let witness = first_witness(&watch.witnesses, watch.observed.bits).unwrap();
+        assert_eq!(
+            (witness.sample, witness.kind, witness.depth),
+            (3, RayKind::Reflected, 1)
+        );
+        assert!(watch.stack.is_empty());
+        let clean = Observed {
+            bits: 0,
+            deepest: 1,
+        };
+        assert!(!query.holds(&clean));
+    }
+}
