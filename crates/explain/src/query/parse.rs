@@ -115,16 +115,8 @@ enum Token {
     End,
 }
 
-struct Lexer<'a> {
-    text: &'a str,
-    tokens: Vec<(Token, Range<usize>)>,
-}
-
 fn lex(text: &str) -> Result<Vec<(Token, Range<usize>)>, QueryError> {
-    let mut lexer = Lexer {
-        text,
-        tokens: Vec::new(),
-    };
+    let mut tokens = Vec::new();
     let bytes = text.as_bytes();
     let mut i = 0;
     while i < bytes.len() {
@@ -197,20 +189,17 @@ fn lex(text: &str) -> Result<Vec<(Token, Range<usize>)>, QueryError> {
                 ));
             }
             _ => {
-                let len = lexer.text[start..].chars().next().map_or(1, char::len_utf8);
+                let len = text[start..].chars().next().map_or(1, char::len_utf8);
                 return Err(QueryError::new(
-                    format!(
-                        "unexpected `{}` in the query",
-                        &lexer.text[start..start + len]
-                    ),
+                    format!("unexpected `{}` in the query", &text[start..start + len]),
                     start..start + len,
                 ));
             }
         };
-        lexer.tokens.push((token, start..i));
+        tokens.push((token, start..i));
     }
-    lexer.tokens.push((Token::End, text.len()..text.len()));
-    Ok(lexer.tokens)
+    tokens.push((Token::End, text.len()..text.len()));
+    Ok(tokens)
 }
 
 /// The most nested parentheses and `not`s a query may have (the reader recurses on them).
@@ -487,6 +476,21 @@ mod tests {
         assert_eq!(parse("hit(glass)").unwrap_err().span, 4..9);
         assert_eq!(parse("").unwrap_err().span, 0..0);
         assert!(parse(&"not ".repeat(100)).is_err());
+        // Every cut of a query, and text that is not ASCII, is an error or a query, never a
+        // panic, and the caret stays on the text.
+        let full = "not (tir or shadow_blocked_by(\"ß glass\")) and depth >= 12 or é";
+        for (cut, _) in full.char_indices() {
+            if let Err(error) = parse(&full[..cut]) {
+                assert!(error.span.end <= cut, "{cut}: {error:?}");
+                let _ = error.render(&full[..cut]);
+            }
+        }
+        let error = parse("tír").unwrap_err();
+        assert!(
+            error.render("tír").ends_with("\n   ^"),
+            "{}",
+            error.render("tír")
+        );
         assert!(parse(&format!("{}tir{}", "(".repeat(100), ")".repeat(100))).is_err());
     }
 }
