@@ -27,6 +27,14 @@ fn json(args: &[&str]) -> Value {
     serde_json::from_slice(&output.stdout).expect("--json prints JSON")
 }
 
+/// `--json` output checked against its documented schema.
+fn checked(schema: &str, document: &Value) {
+    let text = std::fs::read_to_string(schema).unwrap();
+    let schema: Value = serde_json::from_str(&text).unwrap();
+    let errors = crate::json_schema::validate(&schema, document);
+    assert!(errors.is_empty(), "{errors:#?}");
+}
+
 fn color(v: &Value) -> [f64; 3] {
     std::array::from_fn(|i| v[i].as_f64().expect("a number"))
 }
@@ -36,7 +44,14 @@ fn two_scenes_differing_in_an_ior_diverge_at_that_ior() {
     let (a, b) = ("tests/diff/glass-a.scene", "tests/diff/glass-b.scene");
     // The middle of the image sees the ball.
     let diff = json(&["diff", a, b, "--pixel", "20,13", "--json"]);
-    assert_eq!(diff["version"], 1);
+    checked("docs/diff.schema.json", &diff);
+    let mut broken = diff.clone();
+    broken["divergences"][0]["kind"] = "ior".into();
+    assert!(!crate::json_schema::validate(
+        &serde_json::from_str(&std::fs::read_to_string("docs/diff.schema.json").unwrap()).unwrap(),
+        &broken
+    )
+    .is_empty());
     assert_eq!(diff["settings"], serde_json::json!([]));
     let first = &diff["divergences"][0];
     assert_eq!(first["kind"], "material", "{diff:#}");

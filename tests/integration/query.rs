@@ -170,7 +170,13 @@ fn known_pixels_are_in_or_out_and_the_mask_is_the_list() {
         String::from_utf8_lossy(&output.stderr)
     );
     let document: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
-    assert_eq!(document["version"], 1);
+    let schema: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string("docs/query.schema.json").unwrap()).unwrap();
+    let errors = crate::json_schema::validate(&schema, &document);
+    assert!(errors.is_empty(), "{errors:#?}");
+    let mut broken = document.clone();
+    broken["pixels"][0]["witness"]["ray"] = "sideways".into();
+    assert!(!crate::json_schema::validate(&schema, &broken).is_empty());
     assert_eq!(document["image_size"], serde_json::json!([64, 32]));
     let listed: Vec<[u64; 2]> = document["pixels"]
         .as_array()
