@@ -33,8 +33,10 @@ struct QueryDocument {
 struct PixelDocument {
     pixel: [u32; 2],
     /// The ray that first showed a predicate outside any `not` (null when the pixel
-    /// matches through `not` alone).
+    /// matches through `depth` or `not` alone).
     witness: Option<WitnessDocument>,
+    /// The depth of its deepest camera, reflected or transmitted ray.
+    deepest: u32,
 }
 
 #[derive(Serialize)]
@@ -97,6 +99,7 @@ pub fn query(args: &QueryArgs) -> Result<(), Failure> {
             .iter()
             .map(|m| PixelDocument {
                 pixel: m.pixel,
+                deepest: m.deepest,
                 witness: m.witness.map(|w| {
                     let handle = w.object.map(|h| Handle::<Object>::from_index(h as usize));
                     WitnessDocument {
@@ -135,7 +138,8 @@ pub fn query(args: &QueryArgs) -> Result<(), Failure> {
         let [x, y] = m.pixel;
         let why = match &m.witness {
             Some(w) => describe_witness(&query, scene, w),
-            None => "matches by what its rays do not show (`not`)".to_string(),
+            // Only `depth` and predicates under `not` decided it: no one ray shows it.
+            None => format!("deepest ray at depth {}", m.deepest),
         };
         out.push_str(&format!("  ({x}, {y})  {why}\n"));
     }

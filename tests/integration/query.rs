@@ -106,6 +106,12 @@ fn the_query_matches_exactly_the_pixels_whose_recorded_trees_match() {
                 count += usize::from(expected);
             }
             assert_eq!(result.matches.len(), count);
+            for m in &result.matches {
+                let [x, y] = m.pixel;
+                let tree = &trees[(y * width + x) as usize];
+                let deepest = tree.samples.iter().map(|s| s.root.deepest()).max();
+                assert_eq!(Some(m.deepest), deepest, "{path}: `{text}` at ({x}, {y})");
+            }
             // A matching pixel names the ray that shows it, unless it matches through `not`.
             for m in &result.matches {
                 if !text.starts_with("not") && !text.starts_with("depth") {

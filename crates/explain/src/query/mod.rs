@@ -249,11 +249,13 @@ fn named(scene: &Scene, name: &str, at: &std::ops::Range<usize>) -> Result<Vec<u
 }
 
 /// One pixel that matches, with the ray that shows why (when a predicate outside any `not`
-/// holds; `None` when the pixel matches through `not` alone).
+/// holds; `None` when the pixel matches through `depth` or `not` alone).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Match {
     pub pixel: [u32; 2],
     pub witness: Option<Witness>,
+    /// The deepest camera, reflected or transmitted ray (what `depth` compares).
+    pub deepest: u32,
 }
 
 /// The answer over a whole image.
@@ -273,7 +275,7 @@ pub struct QueryResult {
 pub fn run(prepared: &PreparedScene, options: &RenderOptions, query: &Query) -> QueryResult {
     let (width, height) = (options.width, options.height);
     let positive = query.positive();
-    let rows: Vec<Vec<(bool, Option<Witness>)>> = (0..height)
+    let rows: Vec<Vec<(bool, Option<Witness>, u32)>> = (0..height)
         .into_par_iter()
         .map(|y| {
             (0..width)
@@ -284,7 +286,7 @@ pub fn run(prepared: &PreparedScene, options: &RenderOptions, query: &Query) -> 
                     let witness = matched
                         .then(|| watch::first_witness(&witnesses, observed.bits & positive))
                         .flatten();
-                    (matched, witness)
+                    (matched, witness, observed.deepest)
                 })
                 .collect()
         })
@@ -292,12 +294,13 @@ pub fn run(prepared: &PreparedScene, options: &RenderOptions, query: &Query) -> 
     let mut mask = Vec::with_capacity((width * height) as usize);
     let mut matches = Vec::new();
     for (y, row) in rows.into_iter().enumerate() {
-        for (x, (matched, witness)) in row.into_iter().enumerate() {
+        for (x, (matched, witness, deepest)) in row.into_iter().enumerate() {
             mask.push(matched);
             if matched {
                 matches.push(Match {
                     pixel: [x as u32, y as u32],
                     witness,
+                    deepest,
                 });
             }
         }
