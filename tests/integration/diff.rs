@@ -224,8 +224,12 @@ fn against_image_finds_the_regions_planted_in_a_render() {
         student_path.to_str().unwrap(),
         "--json",
     ]);
+    checked("docs/diff-image.schema.json", &report);
     let regions = report["regions"].as_array().unwrap();
     assert_eq!(regions.len(), 2, "{report:#}");
+    for region in regions {
+        checked("docs/explain.schema.json", &region["explanation"]);
+    }
     assert_eq!(regions[0]["min"], serde_json::json!([17, 10]));
     assert_eq!(regions[0]["max"], serde_json::json!([22, 15]));
     assert_eq!(regions[0]["pixels"], 36);
