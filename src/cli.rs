@@ -28,6 +28,12 @@ pub enum Command {
     Trace(TraceArgs),
     /// Explain one pixel: the light paths that make its colour, and what may be wrong.
     Explain(ExplainArgs),
+    /// Compare one pixel's ray trees under two scenes or settings, or an image with
+    /// whitted's render (docs/diff.md).
+    Diff(DiffArgs),
+    /// Find the pixels whose rays match a predicate, e.g. 'tir and not hit("floor")'
+    /// (docs/query.md).
+    Query(QueryArgs),
     /// Explore a scene in the terminal: pick a pixel, walk its ray tree, see the source.
     Debug(DebugArgs),
     /// Run the MIT 6.837 course's command line, flags as it wrote them (see -help).
@@ -132,6 +138,68 @@ pub struct TraceArgs {
     /// Print the versioned JSON document (docs/ray-tree.md) instead of text.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub overrides: RenderOverrides,
+    /// Compare the pixel's ray tree with its tree in this scene (as `whitted diff`).
+    #[arg(long, value_name = "SCENE_B")]
+    pub against: Option<PathBuf>,
+    /// Compare the pixel's ray tree with its tree under this setting (repeatable; as
+    /// `whitted diff --against-set`).
+    #[arg(long = "against-set", value_name = "NAME=VALUE", value_parser = parse_setting)]
+    pub against_set: Vec<(String, String)>,
+}
+
+#[derive(Args)]
+pub struct DiffArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// The scene to compare with (compiled with the same -D and --set).
+    #[arg(value_name = "SCENE_B")]
+    pub other: Option<PathBuf>,
+    /// The pixel whose ray trees to compare: X,Y counted from the top-left corner (0,0).
+    #[arg(long, value_name = "X,Y", value_parser = parse_pixel, allow_hyphen_values = true)]
+    pub pixel: Option<[u32; 2]>,
+    /// Compare with the same scene (or SCENE_B) under this setting too: --against-set
+    /// max_depth=8 (repeatable).
+    #[arg(long = "against-set", value_name = "NAME=VALUE", value_parser = parse_setting)]
+    pub against_set: Vec<(String, String)>,
+    /// Compare whitted's render with this image (same size, 8-bit sRGB PNG as `render`
+    /// writes): list the regions that differ and explain a pixel of each.
+    #[arg(long = "against-image", value_name = "REF.png")]
+    pub against_image: Option<PathBuf>,
+    /// With --against-image: the largest difference (in 8-bit steps, any channel) that
+    /// still counts as equal.
+    #[arg(long, default_value_t = 8)]
+    pub tolerance: u8,
+    /// With --against-image: explain at most this many regions (the largest).
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub regions: u32,
+    /// Print a versioned JSON document instead of text.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub overrides: RenderOverrides,
+}
+
+#[derive(Args)]
+pub struct QueryArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// The predicate (docs/query.md), e.g. 'shadow_blocked_by("glass") or depth >= 5'.
+    #[arg(value_name = "EXPR")]
+    pub expr: String,
+    /// Write the matching pixels as a white-on-black mask image (.png).
+    #[arg(long, value_name = "OUT", value_parser = parse_output)]
+    pub mask: Option<PathBuf>,
+    /// List at most this many matching pixels (the count covers all of them).
+    #[arg(long, default_value_t = 20)]
+    pub limit: usize,
+    /// Print a versioned JSON document instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Worker threads (default: one per core). The answer is identical for any count.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
     #[command(flatten)]
     pub overrides: RenderOverrides,
 }

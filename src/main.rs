@@ -8,11 +8,13 @@
 mod allocator;
 mod cli;
 mod debug_cmd;
+mod diff_cmd;
 mod explain_cmd;
 mod front_end;
 mod image_output;
 mod interrupt;
 mod mit6837_cmd;
+mod query_cmd;
 mod render_cmd;
 mod scene_input;
 mod stats_image;
@@ -50,7 +52,12 @@ fn main() -> ExitCode {
         Command::Check(args) => scene_input::check(&args),
         Command::Ir(args) => scene_input::ir(&args),
         Command::Render(args) => render_cmd::render(&args),
+        Command::Trace(args) if args.against.is_some() || !args.against_set.is_empty() => {
+            diff_cmd::trace_against(&args)
+        }
         Command::Trace(args) => trace_cmd::trace(&args),
+        Command::Diff(args) => diff_cmd::diff(&args),
+        Command::Query(args) => query_cmd::query(&args),
         Command::Explain(args) => explain_cmd::explain_pixel(&args),
         Command::Debug(args) => debug_cmd::debug(&args),
         Command::Mit6837(args) => mit6837_cmd::mit6837(&args.args),

@@ -10,17 +10,20 @@
 //! [`Explanation::document`] are for the binary to show.
 
 pub mod contributions;
+pub mod diff;
 pub mod findings;
 mod inside;
 mod json;
 mod locate;
 mod model;
 pub mod probe;
+pub mod query;
+pub mod regions;
 mod text;
 
 pub use json::{ExplanationDocument, EXPLAIN_JSON_VERSION};
 pub use model::{Contribution, Explanation, Finding, FindingKind, Step, Term};
-pub use text::format_text;
+pub use text::{format_summary, format_text};
 
 use std::sync::atomic::AtomicBool;
 

@@ -100,3 +100,28 @@ fn push_made_by(out: &mut String, explanation: &Explanation) {
         let _ = writeln!(out, "  {object}: {}", step.made_by.join(", "));
     }
 }
+
+/// A short form for lists of pixels (the image comparison): the main path with its share,
+/// then each finding on one line with its location and fix.
+pub fn format_summary(explanation: &Explanation) -> String {
+    let mut out = String::new();
+    if let Some(c) = explanation.contributions.first() {
+        let share = c
+            .share
+            .map_or(String::new(), |s| format!("{:.0}% ", s * 100.0));
+        let path = describe_path(&c.path);
+        let line = if path.is_empty() {
+            what(c)
+        } else {
+            format!("{path}: {}", what(c))
+        };
+        let _ = writeln!(out, "main light: {share}{line}");
+    } else {
+        out.push_str("main light: none (no recorded path brings light)\n");
+    }
+    for f in &explanation.findings {
+        let _ = writeln!(out, "{} at {}: {}", f.kind.name(), f.location, f.message);
+        let _ = writeln!(out, "  fix: {}", f.fix);
+    }
+    out
+}

@@ -59,7 +59,7 @@ pub fn find(context: &Context<'_>) -> Vec<Finding> {
 }
 
 /// The text of the line a `path:line:col` location points at, when it is in the sources.
-fn source_line(scene: &Scene, location: &str) -> Option<String> {
+pub(crate) fn source_line(scene: &Scene, location: &str) -> Option<String> {
     let mut parts = location.rsplitn(3, ':');
     let _column = parts.next()?;
     let line: u32 = parts.next()?.parse().ok()?;
