@@ -21,7 +21,7 @@ pub enum Command {
     /// Render a scene to an image (.png, .exr, .hdr, .ppm or .tga).
     Render(RenderArgs),
     /// Compile and validate a scene; print its diagnostics.
-    Check(SceneArgs),
+    Check(CheckArgs),
     /// Print the compiled IR of a scene, as text or JSON.
     Ir(IrArgs),
     /// Record every ray behind one pixel and print its ray tree, as text or JSON.
@@ -58,6 +58,16 @@ pub struct SceneArgs {
     /// scene's own).
     #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_setting)]
     pub set: Vec<(String, String)>,
+}
+
+#[derive(Args)]
+pub struct CheckArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Skip the lints: report only the compiler's errors and warnings (docs/explain.md,
+    /// "Lints").
+    #[arg(long)]
+    pub no_lint: bool,
 }
 
 #[derive(Args)]

@@ -8,7 +8,7 @@ use whitted_ir::{Severity, ValidScene};
 use whitted_lang::render_diagnostics;
 use whitted_mit6837::CourseOptions;
 
-use crate::cli::{IrArgs, SceneArgs};
+use crate::cli::{CheckArgs, IrArgs, SceneArgs};
 use crate::Failure;
 
 /// Reads one scene file's bytes (the language decodes them and locates bad UTF-8), refusing
@@ -146,9 +146,13 @@ pub fn load_scene_with(
     }
 }
 
-/// `whitted check`: compile, validate, summarise.
-pub fn check(args: &SceneArgs) -> Result<(), Failure> {
-    let loaded = load_scene(args, false)?;
+/// `whitted check`: compile, validate, lint (unless `--no-lint`), summarise.
+pub fn check(check_args: &CheckArgs) -> Result<(), Failure> {
+    let args = &check_args.scene;
+    let mut loaded = load_scene(args, false)?;
+    if !check_args.no_lint {
+        loaded.warnings += print_lints(&loaded.scene);
+    }
     let scene = &loaded.scene;
     let summary = format!(
         "{}: ok ({} objects, {} light{}, {} materials{})\n",
@@ -164,6 +168,20 @@ pub fn check(args: &SceneArgs) -> Result<(), Failure> {
         }
     );
     write_stdout(&summary)
+}
+
+/// Lints a compiled scene (docs/explain.md, "Lints"), prints its warnings like the
+/// compiler's and returns how many there were.
+pub fn print_lints(scene: &ValidScene) -> usize {
+    let prepared = whitted_tracer::PreparedScene::new(scene);
+    let lints = whitted_explain::lint::lint(&prepared, scene);
+    if lints.is_empty() {
+        return 0;
+    }
+    let diagnostics: Vec<_> = lints.into_iter().map(|l| l.diagnostic).collect();
+    let text = render_diagnostics(&scene.sources, &diagnostics, stderr_wants_color());
+    let _ = std::io::stderr().write_all(text.as_bytes());
+    diagnostics.len()
 }
 
 /// `whitted ir`: the compiled IR as text or JSON on stdout.

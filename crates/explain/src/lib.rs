@@ -13,6 +13,7 @@ pub mod contributions;
 pub mod findings;
 mod inside;
 mod json;
+pub mod lint;
 mod locate;
 mod model;
 pub mod probe;
