@@ -89,6 +89,9 @@ pub fn stderr_wants_color() -> bool {
 pub struct Loaded {
     pub scene: ValidScene,
     pub warnings: usize,
+    /// Where the compiler's own warnings point, so that a lint does not say the same
+    /// thing twice (the language warns about `reflective + transmissive > 1` itself).
+    pub warned_at: Vec<whitted_ir::Span>,
 }
 
 /// Compiles `args.scene` (with either front end, a 6.837 scene with the course's defaults),
@@ -128,7 +131,16 @@ pub fn load_scene_with(
         .filter(|d| d.severity == Severity::Warning)
         .count();
     match compilation.scene {
-        Some(scene) => Ok(Loaded { scene, warnings }),
+        Some(scene) => Ok(Loaded {
+            scene,
+            warnings,
+            warned_at: compilation
+                .diagnostics
+                .iter()
+                .filter(|d| d.severity == Severity::Warning)
+                .filter_map(|d| d.span)
+                .collect(),
+        }),
         None => {
             let errors = compilation
                 .diagnostics
@@ -151,7 +163,7 @@ pub fn check(check_args: &CheckArgs) -> Result<(), Failure> {
     let args = &check_args.scene;
     let mut loaded = load_scene(args, false)?;
     if !check_args.no_lint {
-        loaded.warnings += print_lints(&loaded.scene);
+        loaded.warnings += print_lints(&loaded.scene, &loaded.warned_at);
     }
     let scene = &loaded.scene;
     let summary = format!(
@@ -171,14 +183,19 @@ pub fn check(check_args: &CheckArgs) -> Result<(), Failure> {
 }
 
 /// Lints a compiled scene (docs/explain.md, "Lints"), prints its warnings like the
-/// compiler's and returns how many there were.
-pub fn print_lints(scene: &ValidScene) -> usize {
+/// compiler's and returns how many there were. A lint at a place the compiler already
+/// warned about (`warned_at`) is left out.
+pub fn print_lints(scene: &ValidScene, warned_at: &[whitted_ir::Span]) -> usize {
     let prepared = whitted_tracer::PreparedScene::new(scene);
     let lints = whitted_explain::lint::lint(&prepared, scene);
-    if lints.is_empty() {
+    let diagnostics: Vec<_> = lints
+        .into_iter()
+        .map(|l| l.diagnostic)
+        .filter(|d| d.span.is_none_or(|span| !warned_at.contains(&span)))
+        .collect();
+    if diagnostics.is_empty() {
         return 0;
     }
-    let diagnostics: Vec<_> = lints.into_iter().map(|l| l.diagnostic).collect();
     let text = render_diagnostics(&scene.sources, &diagnostics, stderr_wants_color());
     let _ = std::io::stderr().write_all(text.as_bytes());
     diagnostics.len()

@@ -11,6 +11,7 @@ mod explain;
 mod extremes;
 mod guards;
 mod json_schema;
+mod lint;
 mod mit6837;
 mod ray_trees;
 mod reshade;

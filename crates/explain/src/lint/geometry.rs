@@ -22,6 +22,32 @@ pub(super) fn light_label(scene: &Scene, handle: Handle<Light>) -> String {
     }
 }
 
+/// An object as the warnings name it: `sphere "ball"`, or `sphere #3` when unnamed.
+pub(super) fn object_name(scene: &Scene, handle: Handle<Object>) -> String {
+    let Some(object) = scene.objects.get(handle) else {
+        return format!("object {handle}");
+    };
+    match &object.name {
+        Some(name) => {
+            let kind = match &object.kind {
+                ObjectKind::Shape { shape } => shape.kind_name(),
+                ObjectKind::Csg { op, .. } => op.name(),
+                ObjectKind::Group { .. } => "group",
+            };
+            format!("{kind} \"{name}\"")
+        }
+        None => scene.object_label(handle),
+    }
+}
+
+/// A material as the warnings name it.
+fn material_name(scene: &Scene, handle: Handle<whitted_ir::Material>) -> String {
+    match &scene.materials[handle].name {
+        Some(name) => format!("material `{name}`"),
+        None => format!("the material {handle}"),
+    }
+}
+
 /// The objects that render as objects: the roots, with groups opened (CSG solids stay
 /// whole: their children's surfaces are internal).
 pub(super) fn renderables(scene: &Scene) -> Vec<Handle<Object>> {
@@ -65,7 +91,7 @@ pub(super) fn lights_inside_solids(scene: &Scene, lints: &mut Vec<Lint>) {
             if lets_light_through && scene.settings.shadows == ShadowMode::Filtered {
                 continue;
             }
-            let name = scene.object_label(object_handle);
+            let name = object_name(scene, object_handle);
             let light_name = light_label(scene, light_handle);
             let plane = matches!(
                 object.kind,
@@ -110,10 +136,13 @@ pub(super) fn lights_inside_solids(scene: &Scene, lints: &mut Vec<Lint>) {
 /// A material whose reflected and transmitted rays together weigh more than 1 on a
 /// channel. Without Fresnel the rays weigh `kr` and `kt`; with Fresnel `kr + kt·R` and
 /// `kt·(1 − R)`, which still sum to `kr + kt`. So the rule is `kr + kt > 1` in every
-/// mode: such a surface returns more light than reaches it, and between two of them
-/// brightness grows with every bounce until `max_depth` stops it. The diffuse and specular
-/// terms are not counted: Whitted's model adds them on top of `kr` and `kt` by design
-/// (a diffuse 0.8 mirror of `kr` 0.5 is the textbook's own kind of material).
+/// mode: such a surface would return more light than reaches it, so the tracer scales
+/// both down to sum to 1 (`conserve_energy` in the tracer) and the material is not what
+/// its numbers say. The diffuse and specular terms are not counted: Whitted's model adds
+/// them on top of `kr` and `kt` by design (a diffuse 0.8 mirror of `kr` 0.5 is the
+/// textbook's own kind of material). The scene language warns about the same rule when it
+/// evaluates the material; the binary shows one of the two, so this lint is what a 6.837
+/// scene (or any other front end) gets.
 pub(super) fn material_gain(scene: &Scene, lints: &mut Vec<Lint>) {
     for (handle, material, span) in scene.materials.iter_with_spans() {
         let sum = [
@@ -125,11 +154,11 @@ pub(super) fn material_gain(scene: &Scene, lints: &mut Vec<Lint>) {
         if worst <= 1.0 + 1e-9 {
             continue;
         }
-        let name = scene.material_label(handle);
+        let name = material_name(scene, handle);
         let diagnostic = Diagnostic::warning(
             format!(
                 "{name} reflects and transmits more light than it receives: reflective + \
-                 transmissive is {} (more than 1)",
+                 transmissive is {} (more than 1), so the tracer scales both down to sum to 1",
                 color_sum(material.reflective, material.transmissive)
             ),
             span,
@@ -196,11 +225,11 @@ pub(super) fn facing_away_from_lights(scene: &Scene, lints: &mut Vec<Lint>) {
         let Some(sides) = sides(scene, normal, origin) else {
             continue;
         };
-        let name = scene.object_label(handle);
+        let name = object_name(scene, handle);
         let (message, fix) = if !scene.settings.shade_back && !sides.camera_in_front {
             (
                 format!(
-                    "the camera sees the back of the {what} {name}, and `shade_back off` leaves \
+                    "the camera sees the back of {name}, and `shade_back off` leaves \
                      back faces unlit: it renders with ambient light only"
                 ),
                 match what {
@@ -228,7 +257,7 @@ pub(super) fn facing_away_from_lights(scene: &Scene, lints: &mut Vec<Lint>) {
             };
             (
                 format!(
-                    "every light is behind the {what} {name}: the camera sees its {side}, which \
+                    "every light is behind {name}: the camera sees its {side}, which \
                      no light faces, so it renders with ambient light only"
                 ),
                 format!("move a light to the camera's side of {name}"),

@@ -14,7 +14,7 @@ use whitted_tracer::{
 };
 
 use super::bounds::{world_bounds, Bounds};
-use super::geometry::{renderables, short};
+use super::geometry::{object_name, renderables, short};
 use super::{Lint, LintKind};
 use crate::inside::contains;
 use crate::locate::setting_span;
@@ -259,7 +259,7 @@ pub(super) fn coincident_surfaces(scene: &Scene, samples: &Samples, lints: &mut 
             }
             reported.push(pair);
             let (this_name, other_name) =
-                (scene.object_label(hit.object), scene.object_label(other));
+                (object_name(scene, hit.object), object_name(scene, other));
             let at = hit.point;
             let diagnostic = Diagnostic::warning(
                 format!(
@@ -307,7 +307,7 @@ pub(super) fn max_depth_too_low(
         return;
     }
     let (x, y) = cut.pixel;
-    let name = scene.object_label(cut.object);
+    let name = object_name(scene, cut.object);
     let current = options.max_depth;
     let needed = match depth_needed(prepared, &options, x, y, SIGNIFICANT) {
         DepthSearch::Found { max_depth, .. } => format!(
@@ -325,7 +325,7 @@ pub(super) fn max_depth_too_low(
     };
     let mut diagnostic = Diagnostic::warning(
         format!(
-            "max_depth {current} is too low for the glass {name}: at pixel ({x}, {y}) the depth \
+            "max_depth {current} is too low for {name}: at pixel ({x}, {y}) the depth \
              limit cuts a ray through it that carries {:.0}% of the pixel, so it renders too \
              dark",
             f64::from(cut.weight) * 100.0
@@ -333,7 +333,7 @@ pub(super) fn max_depth_too_low(
         scene.objects.span(cut.object),
     )
     .with_label(format!(
-        "light is still inside {name} after {current} bounces"
+        "light is still inside {name} when max_depth {current} stops it"
     ))
     .with_hint(needed);
     if let Some(span) = setting_span(scene, "max_depth") {

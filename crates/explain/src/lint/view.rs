@@ -7,6 +7,7 @@ use glam::DVec3;
 use whitted_ir::{Diagnostic, Handle, Object, ObjectKind, Projection, Scene};
 
 use super::bounds::world_bounds;
+use super::geometry::object_name;
 use super::sampled::Samples;
 use super::{Lint, LintKind};
 
@@ -44,10 +45,7 @@ pub(super) fn unseen_objects(scene: &Scene, samples: &Samples, lints: &mut Vec<L
     // A group is one thing to its author (a cue whose end leaves the picture is fine):
     // it is unseen only when none of its objects is seen.
     for &handle in &scene.roots {
-        if descendants(scene, handle)
-            .iter()
-            .any(|d| samples.met.get(d.index()).copied().unwrap_or(true))
-        {
+        if met(scene, samples, handle) {
             continue;
         }
         let Some(bounds) = world_bounds(scene, handle) else {
@@ -60,7 +58,7 @@ pub(super) fn unseen_objects(scene: &Scene, samples: &Samples, lints: &mut Vec<L
         let Some(outside) = outside(&local, camera.projection, aspect) else {
             continue;
         };
-        let name = scene.object_label(handle);
+        let name = object_name(scene, handle);
         let diagnostic = Diagnostic::warning(
             format!(
                 "the camera cannot see {name}: it is {}, and no sampled reflection, refraction \
@@ -81,14 +79,23 @@ pub(super) fn unseen_objects(scene: &Scene, samples: &Samples, lints: &mut Vec<L
 /// The objects a sampled ray can report for `root`: itself, or a group's members.
 fn descendants(scene: &Scene, root: Handle<Object>) -> Vec<Handle<Object>> {
     let mut out = vec![root];
-    let mut stack = vec![root];
-    while let Some(handle) = stack.pop() {
+    let mut next = 0;
+    while let Some(&handle) = out.get(next) {
+        next += 1;
         if let Some(ObjectKind::Group { children }) = scene.objects.get(handle).map(|o| &o.kind) {
             out.extend(children);
-            stack.extend(children);
         }
     }
     out
+}
+
+/// Whether a sampled ray met `root` or, for a group, any of its members.
+fn met(scene: &Scene, samples: &Samples, root: Handle<Object>) -> bool {
+    let met_one = |h: Handle<Object>| samples.met.get(h.index()).copied().unwrap_or(true);
+    match scene.objects.get(root).map(|o| &o.kind) {
+        Some(ObjectKind::Group { .. }) => descendants(scene, root).into_iter().any(met_one),
+        _ => met_one(root),
+    }
 }
 
 /// Which side of the view every corner (in camera space: x right, y up, z forward) is on.
