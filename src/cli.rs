@@ -108,6 +108,9 @@ pub struct RenderArgs {
     /// Print nothing but errors (no progress bar, no warnings).
     #[arg(long, short = 'q')]
     pub quiet: bool,
+    /// Skip the lints `whitted check` also prints (docs/explain.md, "Lints").
+    #[arg(long)]
+    pub no_lint: bool,
 }
 
 /// The scene settings that `render` and `trace` may override, so that a trace can follow a

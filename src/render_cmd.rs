@@ -218,6 +218,9 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     };
     estimate.check()?;
     let prepared = PreparedScene::new(&loaded.scene);
+    if !args.quiet && !args.no_lint {
+        crate::scene_input::print_lints(&loaded, &prepared);
+    }
 
     let threads = match args.threads {
         Some(n) => n as usize,

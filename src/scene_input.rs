@@ -163,7 +163,8 @@ pub fn check(check_args: &CheckArgs) -> Result<(), Failure> {
     let args = &check_args.scene;
     let mut loaded = load_scene(args, false)?;
     if !check_args.no_lint {
-        loaded.warnings += print_lints(&loaded.scene, &loaded.warned_at);
+        let prepared = whitted_tracer::PreparedScene::new(&loaded.scene);
+        loaded.warnings += print_lints(&loaded, &prepared);
     }
     let scene = &loaded.scene;
     let summary = format!(
@@ -184,14 +185,14 @@ pub fn check(check_args: &CheckArgs) -> Result<(), Failure> {
 
 /// Lints a compiled scene (docs/explain.md, "Lints"), prints its warnings like the
 /// compiler's and returns how many there were. A lint at a place the compiler already
-/// warned about (`warned_at`) is left out.
-pub fn print_lints(scene: &ValidScene, warned_at: &[whitted_ir::Span]) -> usize {
-    let prepared = whitted_tracer::PreparedScene::new(scene);
-    let lints = whitted_explain::lint::lint(&prepared, scene);
+/// warned about is left out. `prepared` must be made from `loaded.scene`.
+pub fn print_lints(loaded: &Loaded, prepared: &whitted_tracer::PreparedScene) -> usize {
+    let scene = &loaded.scene;
+    let lints = whitted_explain::lint::lint(prepared, scene);
     let diagnostics: Vec<_> = lints
         .into_iter()
         .map(|l| l.diagnostic)
-        .filter(|d| d.span.is_none_or(|span| !warned_at.contains(&span)))
+        .filter(|d| d.span.is_none_or(|span| !loaded.warned_at.contains(&span)))
         .collect();
     if diagnostics.is_empty() {
         return 0;

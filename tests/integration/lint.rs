@@ -203,3 +203,24 @@ fn a_lint_the_language_already_gave_is_not_repeated() {
     );
     assert!(!stderr.contains("material_gain"), "{stderr}");
 }
+
+#[test]
+fn render_prints_the_lints_too_unless_quiet_or_no_lint() {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let out = dir.path().join("unseen.png");
+    let out = out.to_str().expect("a UTF-8 path");
+    let render = |extra: &[&str]| {
+        let output = Command::new(env!("CARGO_BIN_EXE_whitted"))
+            .current_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")))
+            .env("NO_COLOR", "1")
+            .args(["render", "tests/lint/unseen.scene", "-o", out])
+            .args(extra)
+            .output()
+            .expect("the whitted binary runs");
+        assert!(output.status.success());
+        String::from_utf8_lossy(&output.stderr).into_owned()
+    };
+    assert!(render(&[]).contains("warning: unseen_object"));
+    assert!(!render(&["--no-lint"]).contains("unseen_object"));
+    assert!(!render(&["--quiet"]).contains("unseen_object"));
+}
