@@ -224,3 +224,17 @@ fn render_prints_the_lints_too_unless_quiet_or_no_lint() {
     assert!(!render(&["--no-lint"]).contains("unseen_object"));
     assert!(!render(&["--quiet"]).contains("unseen_object"));
 }
+
+/// docs/explain.md's lint example is what `whitted check` prints.
+#[test]
+fn the_docs_example_is_what_check_prints() {
+    let docs = std::fs::read_to_string("docs/explain.md").expect("docs/explain.md");
+    let example = docs
+        .split("## Lints")
+        .nth(1)
+        .and_then(|rest| rest.split("```").nth(1))
+        .map(|block| block.trim_start_matches('\n'))
+        .unwrap_or_default();
+    let output = check(&["tests/lint/light-inside-solid.scene"]);
+    assert_eq!(String::from_utf8_lossy(&output.stderr), example);
+}
