@@ -82,6 +82,22 @@ pub fn world_bounds(scene: &Scene, handle: Handle<Object>) -> Option<Bounds> {
 }
 
 fn shape_bounds(shape: &Shape, world_from_object: &DMat4) -> Option<Bounds> {
+    if let Shape::Sphere { center, radius } = *shape {
+        // A transformed sphere's exact box, from one transformed point: along world axis
+        // i it reaches `radius × |row i of the linear part|` from its centre (the common
+        // case of a scene of a million spheres, eight times cheaper than eight corners).
+        let centre = world_from_object.transform_point3(center);
+        let linear = world_from_object.transpose();
+        let reach = DVec3::new(
+            linear.x_axis.truncate().length(),
+            linear.y_axis.truncate().length(),
+            linear.z_axis.truncate().length(),
+        ) * radius;
+        return Some(Bounds {
+            min: centre - reach,
+            max: centre + reach,
+        });
+    }
     let local = match *shape {
         Shape::Sphere { center, radius } => Bounds {
             min: center - radius,
@@ -142,6 +158,18 @@ mod tests {
         let b = shape_bounds(&sphere, &moved).unwrap();
         assert_eq!(b.min, DVec3::new(8.0, -2.0, -2.0));
         assert_eq!(b.max, DVec3::new(12.0, 2.0, 2.0));
+        // A sphere squashed along y and turned 90 degrees about z lies flat along x.
+        let squashed = DMat4::from_rotation_z(std::f64::consts::FRAC_PI_2)
+            * DMat4::from_scale(DVec3::new(1.0, 3.0, 1.0));
+        let b = shape_bounds(&sphere, &squashed).unwrap();
+        assert!(
+            (b.max - DVec3::new(6.0, 2.0, 2.0)).abs().max_element() < 1e-9,
+            "{b:?}"
+        );
+        assert!(
+            (b.min + DVec3::new(6.0, 2.0, 2.0)).abs().max_element() < 1e-9,
+            "{b:?}"
+        );
         let plane = Shape::Plane {
             normal: DVec3::Y,
             offset: 0.0,

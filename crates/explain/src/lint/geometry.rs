@@ -7,11 +7,13 @@ use whitted_ir::{
     Color, Diagnostic, Handle, Light, LightKind, Object, ObjectKind, Scene, ShadowMode, Shape,
 };
 
+use super::bounds::world_bounds;
 use super::{Lint, LintKind};
 use crate::inside::contains;
 
 /// The most light-in-object tests [`lights_inside_solids`] makes (lights × objects): past
-/// it, the remaining lights are not tested (a million objects and 50 lights still fit).
+/// it, the objects after the first `MAX_CONTAINMENT_TESTS / lights` are not tested (a
+/// million objects and 50 lights still fit).
 pub const MAX_CONTAINMENT_TESTS: usize = 50_000_000;
 
 /// A light's display name.
@@ -71,21 +73,43 @@ pub(super) fn lights_inside_solids(scene: &Scene, lints: &mut Vec<Lint>) {
     if scene.settings.shadows == ShadowMode::None {
         return;
     }
+    let lights: Vec<(Handle<Light>, DVec3)> = scene
+        .lights
+        .iter()
+        .filter_map(|(handle, light)| match light.kind {
+            LightKind::Point { position, .. } | LightKind::Spot { position, .. } => {
+                Some((handle, position))
+            }
+            LightKind::Directional { .. } => None,
+        })
+        .collect();
+    if lights.is_empty() {
+        return;
+    }
     let objects = renderables(scene);
-    let mut tests = 0usize;
-    for (light_handle, light, light_span) in scene.lights.iter_with_spans() {
-        let position = match light.kind {
+    let budget = MAX_CONTAINMENT_TESTS / lights.len();
+    // Objects outer, lights inner: each object's bounds are made once and rule out most
+    // lights without inverting its transform.
+    let mut inside: Vec<(Handle<Light>, Handle<Object>)> = Vec::new();
+    for &object_handle in objects.iter().take(budget) {
+        let bounds = world_bounds(scene, object_handle);
+        for &(light_handle, position) in &lights {
+            if bounds.is_some_and(|b| !b.contains(position, 0.0)) {
+                continue;
+            }
+            if contains(scene, object_handle, position) == Some(true) {
+                inside.push((light_handle, object_handle));
+            }
+        }
+    }
+    inside.sort();
+    for (light_handle, object_handle) in inside {
+        let light_span = scene.lights.span(light_handle);
+        let position = match scene.lights[light_handle].kind {
             LightKind::Point { position, .. } | LightKind::Spot { position, .. } => position,
             LightKind::Directional { .. } => continue,
         };
-        tests += objects.len();
-        if tests > MAX_CONTAINMENT_TESTS {
-            return;
-        }
-        for &object_handle in &objects {
-            if contains(scene, object_handle, position) != Some(true) {
-                continue;
-            }
+        {
             let object = &scene.objects[object_handle];
             let lets_light_through = !scene.materials[object.material].transmissive.is_black();
             if lets_light_through && scene.settings.shadows == ShadowMode::Filtered {
