@@ -113,3 +113,37 @@ fn cap_per_kind(lints: &mut Vec<Lint>) {
         });
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use whitted_ir::{FileId, Span};
+
+    fn warning(kind: LintKind, n: usize) -> Lint {
+        Lint::new(
+            kind,
+            Diagnostic::warning(format!("number {n}"), Span::new(FileId(0), n, n + 1)),
+        )
+    }
+
+    #[test]
+    fn at_most_five_of_a_kind_and_the_last_says_how_many_more() {
+        let mut lints: Vec<Lint> = (0..8)
+            .map(|n| warning(LintKind::UnseenObject, n))
+            .chain([warning(LintKind::LightInsideSolid, 9)])
+            .collect();
+        cap_per_kind(&mut lints);
+        let unseen: Vec<&Lint> = lints
+            .iter()
+            .filter(|l| l.kind == LintKind::UnseenObject)
+            .collect();
+        assert_eq!(unseen.len(), MAX_PER_KIND);
+        assert_eq!(unseen[4].diagnostic.message, "unseen_object: number 4");
+        assert_eq!(
+            unseen[4].diagnostic.hints,
+            ["3 more unseen_object warnings are not shown"]
+        );
+        assert!(unseen[..4].iter().all(|l| l.diagnostic.hints.is_empty()));
+        assert_eq!(lints.len(), MAX_PER_KIND + 1);
+    }
+}
