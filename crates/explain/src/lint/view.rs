@@ -103,22 +103,23 @@ fn outside(corners: &[DVec3; 8], projection: Projection, aspect: f64) -> Option<
     if corners.iter().all(|c| c.z <= 0.0) {
         return Some(Outside::Behind);
     }
-    let (half_width, half_height): (Box<dyn Fn(f64) -> f64>, Box<dyn Fn(f64) -> f64>) =
+    // The view's half width and half height at depth z: growing with z in perspective,
+    // fixed in orthographic projection.
+    let half_size = |z: f64| -> (f64, f64) {
         match projection {
             Projection::Perspective {
                 vertical_fov_degrees,
             } => {
                 let tan = (vertical_fov_degrees.to_radians() / 2.0).tan();
-                (
-                    Box::new(move |z| z * tan * aspect),
-                    Box::new(move |z| z * tan),
-                )
+                (z * tan * aspect, z * tan)
             }
             Projection::Orthographic { view_height } => {
-                let h = view_height / 2.0;
-                (Box::new(move |_| h * aspect), Box::new(move |_| h))
+                (view_height / 2.0 * aspect, view_height / 2.0)
             }
-        };
+        }
+    };
+    let half_width = |z: f64| half_size(z).0;
+    let half_height = |z: f64| half_size(z).1;
     let all = |f: &dyn Fn(&DVec3) -> bool| corners.iter().all(f);
     if all(&|c| c.x > half_width(c.z)) {
         Some(Outside::Right)
