@@ -238,3 +238,24 @@ fn the_docs_example_is_what_check_prints() {
     let output = check(&["tests/lint/light-inside-solid.scene"]);
     assert_eq!(String::from_utf8_lossy(&output.stderr), example);
 }
+
+/// Light trapped in glass by total internal reflection: the cut ray is a reflected one,
+/// inside the cube, and the warning still names the cube and the depth that lets it out.
+#[test]
+fn max_depth_too_low_follows_light_reflected_inside_glass() {
+    let output = check(&["scenes/tir.scene", "--set", "max_depth=3"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr
+            .contains("warning: max_depth_too_low: max_depth 3 is too low for box \"glass cube\""),
+        "{stderr}"
+    );
+    assert!(stderr.contains("scenes/tir.scene:16:1"), "{stderr}");
+    assert!(stderr.contains("<--set max_depth=3>:1:1"), "{stderr}");
+    assert!(
+        stderr.contains(
+            "Help: raise max_depth to 5 (`max_depth 5` in the settings, or --set max_depth=5)"
+        ),
+        "{stderr}"
+    );
+}

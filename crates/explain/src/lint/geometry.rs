@@ -125,7 +125,7 @@ pub(super) fn lights_inside_solids(scene: &Scene, lints: &mut Vec<Lint>) {
             );
             let (inside, fix) = if plane {
                 (
-                    format!("below the plane {name} (on the side its normal points away from)"),
+                    format!("below {name} (on the side its normal points away from)"),
                     format!(
                         "move {light_name} to the side of {name} its normal points to, or turn \
                          the plane around (negate its normal)"
