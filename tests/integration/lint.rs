@@ -259,3 +259,20 @@ fn max_depth_too_low_follows_light_reflected_inside_glass() {
         "{stderr}"
     );
 }
+
+/// Thousands of spheres in one place (a fuzz input): five warnings, the last saying how many
+/// pairs were left out, found within the lint's bounded number of shape tests.
+#[test]
+fn many_coincident_objects_make_five_warnings_and_a_count() {
+    let (lints, _) = lints_of("tests/fuzz-regressions/105-coincident-objects-few.scene");
+    let coincident: Vec<&Lint> = lints
+        .iter()
+        .filter(|l| l.kind == LintKind::CoincidentSurfaces)
+        .collect();
+    assert_eq!(coincident.len(), 5, "{lints:#?}");
+    let last = coincident[4].diagnostic.hints.last().expect("a hint");
+    assert!(
+        last.ends_with("more coincident_surfaces warnings are not shown"),
+        "{last}"
+    );
+}

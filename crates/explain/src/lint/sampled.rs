@@ -15,7 +15,7 @@ use whitted_tracer::{
 
 use super::bounds::{world_bounds, Bounds};
 use super::geometry::{object_name, renderables, short};
-use super::{Lint, LintKind};
+use super::{Lint, LintKind, MAX_PER_KIND};
 use crate::inside::contains;
 use crate::locate::setting_span;
 use crate::probe::{depth_needed, DepthSearch};
@@ -29,6 +29,10 @@ pub const RAYS_PER_PIXEL: u64 = 4096;
 /// The most (hit, object) pairs the coincidence test looks at: with a million objects only
 /// the first few hits are tested, so the lint stays linear in the scene's size.
 pub const MAX_SURFACE_TESTS: usize = 20_000_000;
+/// The most exact shape tests (two insideness tests each, which invert a transform) the
+/// coincidence lint makes, once the bounds let an object through: thousands of objects in
+/// one place would otherwise cost a test per object per hit.
+pub const MAX_SHAPE_TESTS: usize = 200_000;
 /// A ray counts when its path weight (largest channel) is at least this: it makes at
 /// least a twentieth of its pixel (as explain's findings).
 pub const SIGNIFICANT: f32 = 0.05;
@@ -227,8 +231,11 @@ pub(super) fn coincident_surfaces(scene: &Scene, samples: &Samples, lints: &mut 
     let objects = renderables(scene);
     let bounds: Vec<Option<Bounds>> = objects.iter().map(|&o| world_bounds(scene, o)).collect();
     let hits_to_test = (MAX_SURFACE_TESTS / objects.len().max(1)).min(samples.hits.len());
-    let mut reported: Vec<(Handle<Object>, Handle<Object>)> = Vec::new();
-    for hit in &samples.hits[..hits_to_test] {
+    // Pairs already found; a set, because thousands of spheres in one place make millions.
+    let mut reported: std::collections::HashSet<(Handle<Object>, Handle<Object>)> =
+        std::collections::HashSet::new();
+    let mut shape_tests = 0usize;
+    'hits: for hit in &samples.hits[..hits_to_test] {
         if hit.priority > 0 {
             continue;
         }
@@ -245,6 +252,10 @@ pub(super) fn coincident_surfaces(scene: &Scene, samples: &Samples, lints: &mut 
             {
                 continue;
             }
+            shape_tests += 1;
+            if shape_tests > MAX_SHAPE_TESTS {
+                break 'hits;
+            }
             let (Some(inside_below), Some(inside_above)) =
                 (contains(scene, other, below), contains(scene, other, above))
             else {
@@ -254,10 +265,9 @@ pub(super) fn coincident_surfaces(scene: &Scene, samples: &Samples, lints: &mut 
                 continue;
             }
             let pair = (hit.object.min(other), hit.object.max(other));
-            if reported.contains(&pair) {
+            if !reported.insert(pair) || reported.len() > MAX_PER_KIND {
                 continue;
             }
-            reported.push(pair);
             let (this_name, other_name) =
                 (object_name(scene, hit.object), object_name(scene, other));
             let at = hit.point;
@@ -284,6 +294,19 @@ pub(super) fn coincident_surfaces(scene: &Scene, samples: &Samples, lints: &mut 
                  both materials a `priority`"
             ));
             lints.push(Lint::new(LintKind::CoincidentSurfaces, diagnostic));
+        }
+    }
+    // Only the first pairs became warnings; the last one says how many more there were.
+    if reported.len() > MAX_PER_KIND {
+        if let Some(last) = lints
+            .iter_mut()
+            .rev()
+            .find(|l| l.kind == LintKind::CoincidentSurfaces)
+        {
+            last.diagnostic.hints.push(format!(
+                "{} more coincident_surfaces warnings are not shown",
+                reported.len() - MAX_PER_KIND
+            ));
         }
     }
 }
