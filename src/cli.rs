@@ -20,7 +20,7 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene to an image (.png, .exr, .hdr, .ppm or .tga).
     Render(RenderArgs),
-    /// Compile and validate a scene; print its diagnostics.
+    /// Compile, validate and lint a scene; print its diagnostics and warnings.
     Check(CheckArgs),
     /// Print the compiled IR of a scene, as text or JSON.
     Ir(IrArgs),
