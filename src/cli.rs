@@ -20,8 +20,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene to an image (.png, .exr, .hdr, .ppm or .tga).
     Render(RenderArgs),
-    /// Compile and validate a scene; print its diagnostics.
-    Check(SceneArgs),
+    /// Compile, validate and lint a scene; print its diagnostics and warnings.
+    Check(CheckArgs),
     /// Print the compiled IR of a scene, as text or JSON.
     Ir(IrArgs),
     /// Record every ray behind one pixel and print its ray tree, as text or JSON.
@@ -67,6 +67,20 @@ pub struct SceneArgs {
 }
 
 #[derive(Args)]
+pub struct CheckArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Skip the lints: report only the compiler's errors and warnings (docs/explain.md,
+    /// "Lints").
+    #[arg(long, conflicts_with = "lint")]
+    pub no_lint: bool,
+    /// Lint even a scene of more than 50,000 objects, which is skipped otherwise (the lints
+    /// then cost more than the check).
+    #[arg(long)]
+    pub lint: bool,
+}
+
+#[derive(Args)]
 pub struct IrArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
@@ -104,6 +118,9 @@ pub struct RenderArgs {
     /// Print nothing but errors (no progress bar, no warnings).
     #[arg(long, short = 'q')]
     pub quiet: bool,
+    /// Skip the lints `whitted check` also prints (docs/explain.md, "Lints").
+    #[arg(long)]
+    pub no_lint: bool,
 }
 
 /// The scene settings that `render` and `trace` may override, so that a trace can follow a

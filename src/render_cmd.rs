@@ -218,6 +218,11 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     };
     estimate.check()?;
     let prepared = PreparedScene::new(&loaded.scene);
+    // A scene too big to lint by default is rendered without its lints (`check --lint`
+    // has them): they would add about a second per million objects to the render.
+    if !args.quiet && !args.no_lint && whitted_explain::lint::lints_by_default(&loaded.scene) {
+        crate::scene_input::print_lints(&loaded, &prepared);
+    }
 
     let threads = match args.threads {
         Some(n) => n as usize,

@@ -8,7 +8,7 @@ use whitted_ir::{Severity, ValidScene};
 use whitted_lang::render_diagnostics;
 use whitted_mit6837::CourseOptions;
 
-use crate::cli::{IrArgs, SceneArgs};
+use crate::cli::{CheckArgs, IrArgs, SceneArgs};
 use crate::Failure;
 
 /// Reads one scene file's bytes (the language decodes them and locates bad UTF-8), refusing
@@ -89,6 +89,9 @@ pub fn stderr_wants_color() -> bool {
 pub struct Loaded {
     pub scene: ValidScene,
     pub warnings: usize,
+    /// Where the compiler's own warnings point, so that a lint does not say the same
+    /// thing twice (the language warns about `reflective + transmissive > 1` itself).
+    pub warned_at: Vec<whitted_ir::Span>,
 }
 
 /// Compiles `args.scene` (with either front end, a 6.837 scene with the course's defaults),
@@ -128,7 +131,16 @@ pub fn load_scene_with(
         .filter(|d| d.severity == Severity::Warning)
         .count();
     match compilation.scene {
-        Some(scene) => Ok(Loaded { scene, warnings }),
+        Some(scene) => Ok(Loaded {
+            scene,
+            warnings,
+            warned_at: compilation
+                .diagnostics
+                .iter()
+                .filter(|d| d.severity == Severity::Warning)
+                .filter_map(|d| d.span)
+                .collect(),
+        }),
         None => {
             let errors = compilation
                 .diagnostics
@@ -146,9 +158,22 @@ pub fn load_scene_with(
     }
 }
 
-/// `whitted check`: compile, validate, summarise.
-pub fn check(args: &SceneArgs) -> Result<(), Failure> {
-    let loaded = load_scene(args, false)?;
+/// `whitted check`: compile, validate, lint (unless `--no-lint`), summarise.
+pub fn check(check_args: &CheckArgs) -> Result<(), Failure> {
+    let args = &check_args.scene;
+    let mut loaded = load_scene(args, false)?;
+    let big = !whitted_explain::lint::lints_by_default(&loaded.scene);
+    if big && !check_args.lint && !check_args.no_lint {
+        let _ = writeln!(
+            std::io::stderr(),
+            "note: not linted: {} objects is more than {} (`--lint` lints it anyway)",
+            loaded.scene.objects.len(),
+            whitted_explain::lint::MAX_OBJECTS
+        );
+    } else if !check_args.no_lint {
+        let prepared = whitted_tracer::PreparedScene::new(&loaded.scene);
+        loaded.warnings += print_lints(&loaded, &prepared);
+    }
     let scene = &loaded.scene;
     let summary = format!(
         "{}: ok ({} objects, {} light{}, {} materials{})\n",
@@ -164,6 +189,25 @@ pub fn check(args: &SceneArgs) -> Result<(), Failure> {
         }
     );
     write_stdout(&summary)
+}
+
+/// Lints a compiled scene (docs/explain.md, "Lints"), prints its warnings like the
+/// compiler's and returns how many there were. A lint at a place the compiler already
+/// warned about is left out. `prepared` must be made from `loaded.scene`.
+pub fn print_lints(loaded: &Loaded, prepared: &whitted_tracer::PreparedScene) -> usize {
+    let scene = &loaded.scene;
+    let lints = whitted_explain::lint::lint(prepared, scene);
+    let diagnostics: Vec<_> = lints
+        .into_iter()
+        .map(|l| l.diagnostic)
+        .filter(|d| d.span.is_none_or(|span| !loaded.warned_at.contains(&span)))
+        .collect();
+    if diagnostics.is_empty() {
+        return 0;
+    }
+    let text = render_diagnostics(&scene.sources, &diagnostics, stderr_wants_color());
+    let _ = std::io::stderr().write_all(text.as_bytes());
+    diagnostics.len()
 }
 
 /// `whitted ir`: the compiled IR as text or JSON on stdout.

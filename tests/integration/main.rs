@@ -13,6 +13,7 @@ mod extremes;
 mod front_end_oracles;
 mod guards;
 mod json_schema;
+mod lint;
 mod mit6837;
 mod provenance;
 mod query;

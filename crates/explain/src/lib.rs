@@ -14,6 +14,7 @@ pub mod diff;
 pub mod findings;
 mod inside;
 mod json;
+pub mod lint;
 mod locate;
 mod model;
 pub mod probe;

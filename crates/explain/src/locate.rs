@@ -2,13 +2,22 @@
 //! looked up as a word in the scene's sources (outside `//` comments). The last one wins,
 //! as it does when the scene is compiled: `--set` pseudo-files come after the scene's own.
 
-use whitted_ir::Scene;
+use whitted_ir::{Scene, Span};
 
 /// `file:line:col` of the last place `name` is written in the scene's sources, if any.
 pub fn setting_location(scene: &Scene, name: &str) -> Option<String> {
+    setting_span(scene, name).map(|span| scene.sources.location(span))
+}
+
+/// The span of the last place `name` is written in the scene's sources, if any (the
+/// linter's warnings underline it).
+pub fn setting_span(scene: &Scene, name: &str) -> Option<Span> {
     let mut found = None;
-    for (_, file) in scene.sources.files() {
-        for (index, line) in file.text.lines().enumerate() {
+    for (id, file) in scene.sources.files() {
+        let mut line_start = 0;
+        for line in file.text.split_inclusive('\n') {
+            let this_line = line_start;
+            line_start += line.len();
             let code = line.split("//").next().unwrap_or("");
             let mut from = 0;
             while let Some(at) = code[from..].find(name) {
@@ -18,8 +27,7 @@ pub fn setting_location(scene: &Scene, name: &str) -> Option<String> {
                 let before = code[..start].chars().next_back().is_some_and(word_char);
                 let after = code[end..].chars().next().is_some_and(word_char);
                 if !before && !after {
-                    let column = code[..start].chars().count() + 1;
-                    found = Some(format!("{}:{}:{column}", file.path, index + 1));
+                    found = Some(Span::new(id, this_line + start, this_line + end));
                 }
                 from = end;
             }
