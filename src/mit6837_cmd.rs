@@ -233,15 +233,7 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
                 path.display()
             )));
         }
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            if !dir.is_dir() {
-                return Err(Failure::Message(format!(
-                    "cannot write {}: the directory {} does not exist",
-                    path.display(),
-                    dir.display()
-                )));
-            }
-        }
+        crate::render_cmd::check_output_folder(path)?;
     }
     if std::fs::metadata(&run.input).is_ok() && !crate::front_end::is_course_scene(&run.input) {
         return Err(Failure::Message(format!(

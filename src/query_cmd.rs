@@ -64,14 +64,7 @@ pub fn query(args: &QueryArgs) -> Result<(), Failure> {
     }
     let query = Query::compile(&args.expr, &loaded.scene)
         .map_err(|error| Failure::Usage(format!("in the query: {}", error.render(&args.expr))))?;
-    let threads = match args.threads {
-        Some(n) => n as usize,
-        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
-    };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Failure::Message(format!("cannot start {threads} worker threads: {e}")))?;
+    let pool = crate::render_cmd::thread_pool(args.threads)?;
     let started = Instant::now();
     let prepared = PreparedScene::new(&loaded.scene);
     let result = pool.install(|| run(&prepared, &options, &query));
@@ -153,7 +146,8 @@ pub fn query(args: &QueryArgs) -> Result<(), Failure> {
     // Timing goes to stderr so that the listing stays the same from run to run.
     let _ = writeln!(
         std::io::stderr(),
-        "queried in {seconds:.2} s on {threads} threads"
+        "queried in {seconds:.2} s on {} threads",
+        pool.current_num_threads()
     );
     Ok(())
 }

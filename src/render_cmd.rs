@@ -142,6 +142,30 @@ fn refuse_outputs_over_sources(
     Ok(())
 }
 
+/// The rayon pool for `threads` workers (`None`: one per core), for `render` and `query`.
+pub fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool, Failure> {
+    let threads = match threads {
+        Some(n) => n as usize,
+        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Failure::Message(format!("cannot start {threads} worker threads: {e}")))
+}
+
+/// Refuses an output whose folder does not exist, before a long render rather than after.
+pub fn check_output_folder(path: &Path) -> Result<(), Failure> {
+    match path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        Some(dir) if !dir.is_dir() => Err(Failure::Message(format!(
+            "cannot write {}: the directory {} does not exist",
+            path.display(),
+            dir.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
 /// Whether two paths name the same file: the same device and inode when both exist (this
 /// sees through links and `..`), otherwise the same canonical folder and file name.
 pub fn same_file(a: &Path, b: &Path) -> bool {
@@ -177,15 +201,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     let format = ImageFormat::from_path(&output).unwrap_or(ImageFormat::Png);
     // Fail before a long render, not after it, when the output cannot be written there.
     for path in std::iter::once(&output).chain(&args.stats_image) {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            if !dir.is_dir() {
-                return Err(Failure::Message(format!(
-                    "cannot write {}: the directory {} does not exist",
-                    path.display(),
-                    dir.display()
-                )));
-            }
-        }
+        check_output_folder(path)?;
     }
 
     if let Some(stats_image) = &args.stats_image {
@@ -224,14 +240,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         crate::scene_input::print_lints(&loaded, &prepared);
     }
 
-    let threads = match args.threads {
-        Some(n) => n as usize,
-        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
-    };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Failure::Message(format!("cannot start {threads} worker threads: {e}")))?;
+    let pool = thread_pool(args.threads)?;
 
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let bar = show_progress.then(|| {
@@ -291,7 +300,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         scene: &args.scene.scene,
         output: &output,
         options: &options,
-        threads,
+        threads: pool.current_num_threads(),
         objects: loaded.scene.objects.len(),
         compile_seconds,
         build_seconds: prepared.build_seconds(),

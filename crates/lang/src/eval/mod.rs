@@ -20,6 +20,7 @@ mod properties;
 mod provenance;
 mod strings;
 
+use std::borrow::Borrow;
 use std::collections::HashSet;
 
 use whitted_ir::{Diagnostic, Handle, Material, Object, Scene, Severity, Span};
@@ -298,7 +299,26 @@ impl<'a> Evaluator<'a> {
 
     fn run_file(&mut self, index: FileIndex) -> Eval<()> {
         let program = self.program;
-        let Some(file) = program.files.get(index) else {
+        match program.files.get(index) {
+            Some(file) => self.run_file_items(index, &file.items),
+            None => Ok(()),
+        }
+    }
+
+    /// Runs the root file like [`Self::run_file`], dropping each item once it has run.
+    fn run_root(&mut self, items: Vec<Item>) -> Eval<()> {
+        self.run_file_items(0, items)
+    }
+
+    /// Runs file `index`'s items, once, in a frame of the file's size. The items are the
+    /// program's (borrowed) or, for the root file, owned, so that each is dropped as soon as
+    /// it has run.
+    fn run_file_items<I: Borrow<Item>>(
+        &mut self,
+        index: FileIndex,
+        items: impl IntoIterator<Item = I>,
+    ) -> Eval<()> {
+        let Some(file) = self.program.files.get(index) else {
             return Ok(());
         };
         if self.files_run[index] {
@@ -309,36 +329,15 @@ impl<'a> Evaluator<'a> {
         self.base = self.stack.len();
         self.stack
             .resize(self.base + file.frame_size as usize, Value::Poisoned);
-        let result = self.items(&file.items);
+        let result = self.items(items);
         self.stack.truncate(self.base);
         self.base = saved_base;
         result.map(|_| ())
     }
 
-    /// Runs the root file like [`Self::run_file`], dropping each item once it has run.
-    fn run_root(&mut self, items: Vec<Item>) -> Eval<()> {
-        if self.files_run.is_empty() || self.files_run[0] {
-            return Ok(());
-        }
-        self.files_run[0] = true;
-        let frame_size = self.program.files[0].frame_size as usize;
-        self.base = self.stack.len();
-        self.stack.resize(self.base + frame_size, Value::Poisoned);
+    fn items<I: Borrow<Item>>(&mut self, items: impl IntoIterator<Item = I>) -> Eval<Flow> {
         for item in items {
-            match self.item(&item) {
-                Ok(Flow::Normal) | Err(Abort::Reported) => {}
-                // The resolver allows `return` only inside a function.
-                Ok(Flow::Return(_)) => break,
-                Err(Abort::Fatal) => return Err(Abort::Fatal),
-            }
-        }
-        self.stack.truncate(self.base);
-        Ok(())
-    }
-
-    fn items(&mut self, items: &[Item]) -> Eval<Flow> {
-        for item in items {
-            match self.item(item) {
+            match self.item(item.borrow()) {
                 Ok(Flow::Normal) | Err(Abort::Reported) => {}
                 Ok(flow @ Flow::Return(_)) => return Ok(flow),
                 Err(Abort::Fatal) => return Err(Abort::Fatal),
