@@ -74,6 +74,8 @@ pub struct Picked {
     /// From the key or click that picked it to the frame showing it on the terminal,
     /// measured by the event loop (`None` until that frame is drawn, and in tests).
     pub on_screen_after: Option<Duration>,
+    /// Why the pixel has its colour, from this tree (`x` shows it).
+    pub explanation: Option<whitted_explain::Explanation>,
 }
 
 /// Which definition the source pane shows for the selected ray.
@@ -159,6 +161,12 @@ pub struct App {
     pub traced_request_at: Option<Instant>,
     /// The node budget of recorded trees: `limits::MAX_RAY_TREE_NODES`.
     pub node_budget: usize,
+    /// `x`: the inspector's area shows the explanation, and which entry is selected.
+    pub explain_open: bool,
+    pub explain_selected: usize,
+    /// A line the source pane shows instead of the selected ray's definition (a finding's,
+    /// after Enter in the explanation) and what to call it; cleared when the ray changes.
+    pub source_focus: Option<(whitted_ir::Span, String)>,
 }
 
 impl App {
@@ -195,6 +203,9 @@ impl App {
             trace_requests: 0,
             traced_request_at: None,
             node_budget: whitted_ir::limits::MAX_RAY_TREE_NODES,
+            explain_open: false,
+            explain_selected: 0,
+            source_focus: None,
         }
     }
 
@@ -291,9 +302,11 @@ impl App {
                     Some(previous) if tracing.retrace => TreeView::new_like(tree, &previous.tree),
                     _ => {
                         self.inspector_scroll = 0;
+                        self.explain_selected = 0;
                         TreeView::new(tree)
                     }
                 };
+                self.source_focus = None;
                 view.keep_selection_in_view(self.tree_rows());
                 if view.tree().unrecorded > 0 {
                     self.set_message(
@@ -309,6 +322,7 @@ impl App {
                     tree: view,
                     trace_time,
                     on_screen_after: None,
+                    explanation: traced.explanation,
                 });
                 self.traces += 1;
                 self.traced_request_at = Some(tracing.requested_at);

@@ -10,6 +10,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use whitted_tracer::ray_tree::{trace_pixel_request, RayTree, SampleChoice, TraceRequest};
+use whitted_explain::{explain_tree, Explanation};
 use whitted_tracer::RenderOptions;
 
 use crate::app::LoadedScene;
@@ -33,6 +34,10 @@ pub struct Traced {
     pub generation: u64,
     pub pixel: (u32, u32),
     pub result: Result<(RayTree, Duration), TraceFailure>,
+    /// The explanation of the recorded tree (`x`), worked out here on the worker since its
+    /// findings may trace the pixel again with other settings; `None` when there is no tree
+    /// or it panicked.
+    pub explanation: Option<Explanation>,
 }
 
 /// Why a trace gave no tree.
@@ -74,11 +79,30 @@ impl TraceJob {
                 take_worker_panic().unwrap_or_else(|| panic_text(&*payload)),
             )),
         };
+        let explanation = match &result {
+            Ok((tree, _)) if !self.cancel.load(Ordering::Relaxed) => self.explain(tree),
+            _ => None,
+        };
         Traced {
             generation: self.generation,
             pixel: self.pixel,
             result,
+            explanation,
         }
+    }
+
+    /// Explains the recorded tree itself (no second trace of it): the pane shows exactly
+    /// the rays of the tree beside it.
+    fn explain(&self, tree: &RayTree) -> Option<Explanation> {
+        catch_unwind(AssertUnwindSafe(|| {
+            explain_tree(
+                &self.loaded.prepared,
+                &self.loaded.scene,
+                &self.options,
+                tree,
+            )
+        }))
+        .ok()
     }
 
     /// Runs the trace on a new thread and sends its answer as [`Event::Traced`].

@@ -19,7 +19,6 @@ use crate::tree_view::{NodeId, TreeView};
 
 use super::format::{self, number, swatch, vector};
 use super::pane_block;
-use super::tree_pane::contribution;
 
 const LABEL_WIDTH: usize = 13;
 
@@ -170,7 +169,7 @@ impl Lines {
         }
         self.color(
             "contributes",
-            contribution(tree, id, node),
+            tree.contribution(id),
             "weight × returned",
         );
         self.text("ended", termination(node));
