@@ -91,9 +91,13 @@ pub enum Action {
     /// `x`: the inspector's area shows the pixel's explanation, or the inspector again.
     ToggleExplain,
     /// `]` / `[`: the next / previous ray in the order the tracer ran them.
-    Step { forward: bool },
+    Step {
+        forward: bool,
+    },
     /// `}` / `{`: the next / previous ray where something notable happened.
-    RunToEvent { forward: bool },
+    RunToEvent {
+        forward: bool,
+    },
     /// Enter in the explanation: goes to the selected entry's ray or source line.
     ExplainGo,
 }

@@ -90,9 +90,11 @@ fn follow_path(view: &TreeView, root: NodeId, contribution: &Contribution) -> Op
         for _ in 0..step.repeat.max(1) {
             let next = match at {
                 None => Some(root).filter(|_| step.ray == RayKind::Camera),
-                Some(id) => view.children(id).iter().copied().find(|&child| {
-                    view.node(child).is_some_and(|n| n.kind == step.ray)
-                }),
+                Some(id) => view
+                    .children(id)
+                    .iter()
+                    .copied()
+                    .find(|&child| view.node(child).is_some_and(|n| n.kind == step.ray)),
             }?;
             let node = view.node(next)?;
             let object = node.hit.as_ref().map(|h| h.object.label.as_str());
@@ -176,7 +178,10 @@ mod tests {
     #[test]
     fn a_finding_jumps_to_its_line() {
         let mut sources = SourceMap::new();
-        let file = sources.add(SourceFile::new("a.scene", "one\nsettings { max_depth 5 }\n"));
+        let file = sources.add(SourceFile::new(
+            "a.scene",
+            "one\nsettings { max_depth 5 }\n",
+        ));
         let span = location_span(&sources, "a.scene:2:12").unwrap();
         assert_eq!(span, Span::new(file, 15, 28));
         assert_eq!(&sources.get(file).unwrap().text[15..28], "max_depth 5 }");

@@ -63,7 +63,9 @@ mod tests {
     fn the_heaviest_child_is_the_one_bringing_most_light_not_the_heaviest_weight() {
         let view = small_tree();
         assert_eq!(view.children(0), &[1, 2, 3]);
-        let sums: Vec<f32> = (1..=3).map(|id| view.contribution(id).iter().sum()).collect();
+        let sums: Vec<f32> = (1..=3)
+            .map(|id| view.contribution(id).iter().sum())
+            .collect();
         for (sum, hand) in sums.iter().zip([0.27f32, 0.3, 0.25]) {
             assert!((sum - hand).abs() < 1e-6, "{sums:?}");
         }

@@ -258,6 +258,11 @@ mod tests {
         assert_ne!(app.picked.as_ref().unwrap().tree.selected(), 0);
         update(&mut app, Action::RunToEvent { forward: false });
         update(&mut app, Action::RunToEvent { forward: false });
-        assert!(app.message.as_ref().unwrap().text.contains("no event before"));
+        assert!(app
+            .message
+            .as_ref()
+            .unwrap()
+            .text
+            .contains("no event before"));
     }
 }

@@ -225,7 +225,10 @@ mod tests {
         // After the shadow ray comes the reflected ray, then its whole subtree, then the
         // transmitted ray.
         step(&mut view, true);
-        assert_eq!(view.selected_node().map(|n| n.kind), Some(RayKind::Reflected));
+        assert_eq!(
+            view.selected_node().map(|n| n.kind),
+            Some(RayKind::Reflected)
+        );
         let reflected = view.selected();
         let transmitted = view.subtree_end(reflected) + 1;
         assert_eq!(view.parent(transmitted), Some(0));
@@ -277,8 +280,15 @@ mod tests {
         let mut options = f.options.clone();
         options.max_depth = max_depth;
         options.min_weight = min_weight;
-        let tree = trace_pixel(&f.prepared, &f.scene, &options, pixel.0, pixel.1, SampleChoice::All)
-            .expect("inside the image");
+        let tree = trace_pixel(
+            &f.prepared,
+            &f.scene,
+            &options,
+            pixel.0,
+            pixel.1,
+            SampleChoice::All,
+        )
+        .expect("inside the image");
         TreeView::new(tree)
     }
 
@@ -305,13 +315,19 @@ mod tests {
         let expected: Vec<NodeId> = (0..view.len())
             .filter(|&id| !events(&view, id).is_empty())
             .collect();
-        assert_eq!(found.iter().map(|(id, _)| *id).collect::<Vec<_>>(), expected);
+        assert_eq!(
+            found.iter().map(|(id, _)| *id).collect::<Vec<_>>(),
+            expected
+        );
         // Each is what the tracer recorded.
         for (id, events) in &found {
             let node = view.node(*id).unwrap();
             for event in events {
                 let recorded = match event {
-                    RayEvent::MaxDepth => node.skipped.iter().any(|s| s.reason == Termination::MaxDepth),
+                    RayEvent::MaxDepth => node
+                        .skipped
+                        .iter()
+                        .any(|s| s.reason == Termination::MaxDepth),
                     RayEvent::ShadowBlocked => node
                         .shadow
                         .as_ref()
@@ -330,10 +346,17 @@ mod tests {
         assert_eq!(id, expected[expected.len() - 2]);
         view.select(expected[0]);
         assert_eq!(run_to_event(&mut view, false), None);
-        assert_eq!(view.selected(), expected[0], "no event before: the selection stays");
+        assert_eq!(
+            view.selected(),
+            expected[0],
+            "no event before: the selection stays"
+        );
         // The default scene's glass pixel: light under 1% is cut by the weight limit.
         let mut view = TreeView::new(glass_pixel_tree());
-        let kinds: Vec<RayEvent> = walk_events(&mut view).into_iter().flat_map(|(_, e)| e).collect();
+        let kinds: Vec<RayEvent> = walk_events(&mut view)
+            .into_iter()
+            .flat_map(|(_, e)| e)
+            .collect();
         assert!(kinds.contains(&RayEvent::WeightCutoff), "{kinds:?}");
     }
 
@@ -391,7 +414,9 @@ mod tests {
         reflected.hit = Some(acne);
         let view = TreeView::new(tree);
         let reflected = (0..view.len())
-            .find(|&id| view.node(id).unwrap().kind == RayKind::Reflected && view.parent(id) == Some(0))
+            .find(|&id| {
+                view.node(id).unwrap().kind == RayKind::Reflected && view.parent(id) == Some(0)
+            })
             .unwrap();
         assert!(events(&view, reflected).contains(&RayEvent::SelfHit));
         // The untouched tree has none.

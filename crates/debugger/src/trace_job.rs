@@ -9,8 +9,8 @@ use std::sync::mpsc::Sender;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use whitted_tracer::ray_tree::{trace_pixel_request, RayTree, SampleChoice, TraceRequest};
 use whitted_explain::{explain_tree, Explanation};
+use whitted_tracer::ray_tree::{trace_pixel_request, RayTree, SampleChoice, TraceRequest};
 use whitted_tracer::RenderOptions;
 
 use crate::app::LoadedScene;

@@ -481,7 +481,10 @@ mod tests {
             .unwrap();
         let subtree: Vec<NodeId> = (reflected..=view.subtree_end(reflected)).collect();
         for &id in &subtree {
-            assert!(!view.is_shown(id), "ray {id} of the light reflection is shown");
+            assert!(
+                !view.is_shown(id),
+                "ray {id} of the light reflection is shown"
+            );
             assert!(!view.visible().contains(&id));
         }
         assert!(view.hidden_count() >= subtree.len());

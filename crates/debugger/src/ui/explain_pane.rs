@@ -27,11 +27,15 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
             None => "Pick a pixel (Enter) to see why it has its colour.",
             Some(_) => "This tree has no explanation.",
         };
-        Paragraph::new(vec![Line::from(note), Line::from(""), Line::from("x: inspector")])
-            .style(Style::new().fg(Color::Gray))
-            .wrap(Wrap { trim: true })
-            .block(pane_block(Line::from(" Explanation "), focused))
-            .render(pane, buf);
+        Paragraph::new(vec![
+            Line::from(note),
+            Line::from(""),
+            Line::from("x: inspector"),
+        ])
+        .style(Style::new().fg(Color::Gray))
+        .wrap(Wrap { trim: true })
+        .block(pane_block(Line::from(" Explanation "), focused))
+        .render(pane, buf);
         return;
     };
     let [x, y] = explanation.pixel;
@@ -45,8 +49,13 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let area = block.inner(pane);
     block.render(pane, buf);
 
-    let rows = rows(explanation, usize::from(area.width), app.color_depth);
     let selected = app.explain_selected;
+    let rows = rows(
+        explanation,
+        selected,
+        usize::from(area.width),
+        app.color_depth,
+    );
     let first = rows.iter().position(|r| r.entry == Some(selected));
     let last = rows.iter().rposition(|r| r.entry == Some(selected));
     let height = usize::from(area.height);
@@ -56,7 +65,11 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         (Some(first), Some(last)) => (last + 1).saturating_sub(height).min(first),
         _ => 0,
     };
-    let scroll = if first.is_some_and(|f| f <= 1) { 0 } else { scroll };
+    let scroll = if first.is_some_and(|f| f <= 1) {
+        0
+    } else {
+        scroll
+    };
     for (row, line) in rows.into_iter().skip(scroll).take(height).enumerate() {
         let row_area = Rect::new(area.x, area.y + row as u16, area.width, 1);
         if line.entry == Some(selected) {
@@ -79,13 +92,16 @@ struct Row {
 
 /// Every row, in `width` columns: a heading, one row per contribution, a heading, then
 /// each finding as its kind and location over its message, wrapped.
-fn rows(explanation: &Explanation, width: usize, depth: ColorDepth) -> Vec<Row> {
+fn rows(explanation: &Explanation, selected: usize, width: usize, depth: ColorDepth) -> Vec<Row> {
+    // The selected entry's first row starts with a marker (the highlight aside), so that
+    // it reads without colour too.
+    let marker = |index: usize| if index == selected { "▸" } else { " " };
     let heading = Style::new().fg(Color::Cyan).add_modifier(Modifier::BOLD);
     let mut rows = vec![Row {
         entry: None,
         line: Line::from(vec![
             Span::styled("Contributions", heading),
-            Span::raw(" · sum "),
+            Span::raw(" "),
             swatch(explanation.color, depth),
             Span::raw(format!(" {}", format::rgb(explanation.color))),
         ]),
@@ -93,7 +109,10 @@ fn rows(explanation: &Explanation, width: usize, depth: ColorDepth) -> Vec<Row> 
     if explanation.contributions.is_empty() {
         rows.push(Row {
             entry: None,
-            line: Line::styled(" no recorded path brings light", Style::new().fg(Color::Gray)),
+            line: Line::styled(
+                " no recorded path brings light",
+                Style::new().fg(Color::Gray),
+            ),
         });
     }
     let mut findings_heading = false;
@@ -113,7 +132,7 @@ fn rows(explanation: &Explanation, width: usize, depth: ColorDepth) -> Vec<Row> 
                 rows.push(Row {
                     entry: Some(index),
                     line: Line::from(vec![
-                        Span::raw(format!(" {share} ")),
+                        Span::raw(format!("{}{share} ", marker(index))),
                         swatch(c.color, depth),
                         Span::raw(" "),
                         Span::raw(format::truncate(&words, width.saturating_sub(used))),
@@ -132,15 +151,10 @@ fn rows(explanation: &Explanation, width: usize, depth: ColorDepth) -> Vec<Row> 
                 rows.push(Row {
                     entry: Some(index),
                     line: Line::from(vec![
+                        Span::raw(marker(index)),
+                        Span::styled(f.kind.name(), Style::new().fg(Color::Yellow)),
                         Span::styled(
-                            format!(" {}", f.kind.name()),
-                            Style::new().fg(Color::Yellow),
-                        ),
-                        Span::styled(
-                            format::truncate(
-                                &place,
-                                width.saturating_sub(f.kind.name().len() + 1),
-                            ),
+                            format::truncate(&place, width.saturating_sub(f.kind.name().len() + 1)),
                             Style::new().fg(Color::Gray),
                         ),
                     ]),

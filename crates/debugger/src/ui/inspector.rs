@@ -167,11 +167,7 @@ impl Lines {
             }
             self.why_this_colour(node);
         }
-        self.color(
-            "contributes",
-            tree.contribution(id),
-            "weight × returned",
-        );
+        self.color("contributes", tree.contribution(id), "weight × returned");
         self.text("ended", termination(node));
         for skipped in &node.skipped {
             self.text(
