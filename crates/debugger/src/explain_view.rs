@@ -160,6 +160,10 @@ mod tests {
             let node = view.node(id).unwrap();
             // The ray (or, for a light's term, its parent) is as deep as the path is long.
             let steps: u32 = contribution.path.iter().map(|s| s.repeat).sum();
+            // A light's term is that light's shadow ray, whenever one was cast.
+            if matches!(contribution.term, Term::Diffuse | Term::Specular) {
+                assert_eq!(node.kind, RayKind::Shadow, "{contribution:?}");
+            }
             let surface = if node.kind == RayKind::Shadow {
                 assert_eq!(
                     node.shadow.as_ref().map(|s| s.light.label.as_str()),
