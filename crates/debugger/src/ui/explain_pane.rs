@@ -121,7 +121,7 @@ fn rows(explanation: &Explanation, selected: usize, width: usize, depth: ColorDe
             Entry::Contribution(c) => {
                 let share = c
                     .share
-                    .map_or("     ".to_string(), |s| format!("{:4.1}%", s * 100.0));
+                    .map_or("      ".to_string(), |s| format!("{:5.1}%", s * 100.0));
                 let path = describe_path(&c.path);
                 let words = if path.is_empty() {
                     describe_term(c)
