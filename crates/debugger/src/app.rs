@@ -17,7 +17,7 @@ use crate::framebuffer::Framebuffer;
 use crate::heat_map::{HeatMap, HeatMapKind};
 use crate::image_view::{ColorDepth, Viewport};
 use crate::layout::{self, Panes};
-use crate::trace_job::{TraceFailure, TraceJob, Traced};
+use crate::trace_job::{Explained, TraceFailure, TraceJob, Traced};
 use crate::tree_view::TreeView;
 
 /// A scene ready to render and trace: the IR (names, spans, sources) and its prepared form.
@@ -74,8 +74,28 @@ pub struct Picked {
     /// From the key or click that picked it to the frame showing it on the terminal,
     /// measured by the event loop (`None` until that frame is drawn, and in tests).
     pub on_screen_after: Option<Duration>,
+    /// The trace request that recorded the tree: its explanation arrives with this number.
+    pub generation: u64,
     /// Why the pixel has its colour, from this tree (`x` shows it).
-    pub explanation: Option<whitted_explain::Explanation>,
+    pub explanation: ExplanationState,
+}
+
+/// The picked tree's explanation: worked out on the trace worker after the tree arrives.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExplanationState {
+    Working,
+    Ready(whitted_explain::Explanation),
+    /// The explain library panicked (a bug): its message.
+    Failed(String),
+}
+
+impl ExplanationState {
+    pub fn ready(&self) -> Option<&whitted_explain::Explanation> {
+        match self {
+            ExplanationState::Ready(explanation) => Some(explanation),
+            _ => None,
+        }
+    }
 }
 
 /// Which definition the source pane shows for the selected ray.
@@ -322,7 +342,8 @@ impl App {
                     tree: view,
                     trace_time,
                     on_screen_after: None,
-                    explanation: traced.explanation,
+                    generation: traced.generation,
+                    explanation: ExplanationState::Working,
                 });
                 self.traces += 1;
                 self.traced_request_at = Some(tracing.requested_at);
@@ -342,6 +363,20 @@ impl App {
                 true,
             ),
         }
+    }
+
+    /// The explanation of a traced tree: kept when that tree is still the one shown.
+    pub fn apply_explained(&mut self, explained: Explained) {
+        let Some(picked) = &mut self.picked else {
+            return;
+        };
+        if picked.generation != explained.generation {
+            return;
+        }
+        picked.explanation = match explained.result {
+            Ok(explanation) => ExplanationState::Ready(explanation),
+            Err(message) => ExplanationState::Failed(message),
+        };
     }
 
     /// Called by the event loop when it starts a render with this generation number.

@@ -91,11 +91,8 @@ pub fn run_to_event(app: &mut App, forward: bool) {
 pub fn toggle_explain(app: &mut App) {
     app.explain_open = !app.explain_open;
     if app.explain_open {
-        let explained = app.picked.as_ref().map(|p| p.explanation.is_some());
-        match explained {
-            None => app.set_message("pick a pixel (Enter) to explain it", false),
-            Some(false) => app.set_message("this tree has no explanation", true),
-            Some(true) => {}
+        if app.picked.is_none() {
+            app.set_message("pick a pixel (Enter) to explain it", false);
         }
     }
 }
@@ -105,7 +102,7 @@ pub fn move_explain_selection(app: &mut App, lines: i32) {
     let count = app
         .picked
         .as_ref()
-        .and_then(|p| p.explanation.as_ref())
+        .and_then(|p| p.explanation.ready())
         .map_or(0, |e| explain_view::entries(e).len());
     app.explain_selected = if lines == i32::MIN || count == 0 {
         0
@@ -125,7 +122,7 @@ pub fn go(app: &mut App) {
         let Some(picked) = &app.picked else {
             return;
         };
-        let Some(explanation) = &picked.explanation else {
+        let Some(explanation) = picked.explanation.ready() else {
             return;
         };
         let entries = explain_view::entries(explanation);
@@ -170,7 +167,7 @@ mod tests {
     fn the_trace_worker_explains_the_tree_it_recorded() {
         let app = picked_app();
         let picked = app.picked.as_ref().unwrap();
-        let explanation = picked.explanation.as_ref().expect("an explanation");
+        let explanation = picked.explanation.ready().expect("an explanation");
         assert_eq!(explanation.pixel, picked.tree.tree().pixel);
         assert_eq!(explanation.color, picked.tree.tree().color);
         // The same as the explain command's, which traces the pixel itself.
@@ -187,12 +184,52 @@ mod tests {
     }
 
     #[test]
+    fn an_explanation_is_kept_only_for_the_tree_it_explains() {
+        let mut app = picked_app();
+        let job_of = |app: &mut App| {
+            app.trace_cursor();
+            app.trace_job().unwrap()
+        };
+        // A late explanation of an earlier trace is dropped.
+        let old = job_of(&mut app);
+        let old_tree = old.run().result.unwrap().0;
+        app.trace_cursor();
+        finish_trace(&mut app);
+        let current = app.picked.as_ref().unwrap().generation;
+        assert_ne!(old.generation, current);
+        let before = app.picked.as_ref().unwrap().explanation.clone();
+        let mut late = old.explain(&old_tree);
+        if let Ok(explanation) = &mut late.result {
+            explanation.findings.clear();
+        }
+        app.apply_explained(late);
+        assert_eq!(app.picked.as_ref().unwrap().explanation, before);
+        // Until its explanation arrives a new tree says it is being worked out.
+        let job = job_of(&mut app);
+        let traced = job.run();
+        app.apply_trace(traced);
+        assert_eq!(
+            app.picked.as_ref().unwrap().explanation,
+            crate::app::ExplanationState::Working
+        );
+        app.apply_explained(crate::trace_job::Explained {
+            generation: job.generation,
+            result: Err("boom".into()),
+        });
+        assert_eq!(
+            app.picked.as_ref().unwrap().explanation,
+            crate::app::ExplanationState::Failed("boom".into())
+        );
+    }
+
+    #[test]
     fn enter_on_a_contribution_selects_its_ray_and_on_a_finding_shows_its_line() {
         let mut app = picked_app();
         update(&mut app, Action::ToggleExplain);
         assert!(app.explain_open);
         app.focus = Focus::Inspector;
-        let explanation = app.picked.as_ref().unwrap().explanation.clone().unwrap();
+        let picked = app.picked.as_ref().unwrap();
+        let explanation = picked.explanation.ready().unwrap().clone();
         // The second contribution (the first is usually the camera ray's own light).
         let second = &explanation.contributions[1];
         update(&mut app, Action::InspectorScroll(1));

@@ -48,12 +48,15 @@ impl TreeView {
     /// tree); further samples start closed. The first camera ray is selected.
     pub fn new(tree: RayTree) -> TreeView {
         let mut entries = Vec::new();
+        // Each node's largest path-weight channel, read while the node is at hand.
+        let mut weights = Vec::new();
         for (sample_index, sample) in tree.samples.iter().enumerate() {
             // An explicit stack: a deep tree must not overflow the call stack.
             let mut stack: Vec<(&RayNode, Vec<usize>, Option<NodeId>)> =
                 vec![(&sample.root, Vec::new(), None)];
             while let Some((node, path, parent)) = stack.pop() {
                 let id = entries.len();
+                weights.push(node.weight.iter().fold(0.0f32, |m, &w| m.max(w)));
                 entries.push(Entry {
                     sample: sample_index,
                     path: path.clone(),
@@ -71,7 +74,7 @@ impl TreeView {
             }
         }
         let open = entries.iter().map(|e| e.sample == 0).collect();
-        let heavy = heavy_nodes(&tree, &entries);
+        let heavy = heavy_nodes(&entries, &weights, tree.samples_per_pixel);
         TreeView {
             tree,
             entries,
@@ -377,15 +380,12 @@ impl TreeView {
 /// For each node (entries in pre-order), whether it or a ray below it counts for at least
 /// [`LIGHT_SHARE`] of the pixel. Camera rays always count, so that every sample has a row.
 /// Computed bottom-up: in pre-order a node's children come after it.
-fn heavy_nodes(tree: &RayTree, entries: &[Entry]) -> Vec<bool> {
-    let samples = tree.samples_per_pixel.max(1) as f32;
+fn heavy_nodes(entries: &[Entry], weights: &[f32], samples_per_pixel: u32) -> Vec<bool> {
+    let samples = samples_per_pixel.max(1) as f32;
     let mut heavy = vec![false; entries.len()];
     for id in (0..entries.len()).rev() {
         let entry = &entries[id];
-        let own = entry.parent.is_none()
-            || node_at(tree, entry).is_some_and(|node| {
-                node.weight.iter().fold(0.0f32, |m, &w| m.max(w)) / samples >= LIGHT_SHARE
-            });
+        let own = entry.parent.is_none() || weights[id] / samples >= LIGHT_SHARE;
         heavy[id] = own || entry.children.iter().any(|&c| heavy[c]);
     }
     heavy

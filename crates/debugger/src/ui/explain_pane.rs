@@ -12,7 +12,7 @@ use whitted_explain::contributions::describe_path;
 use whitted_explain::{describe_term, Explanation};
 
 use crate::action::Focus;
-use crate::app::App;
+use crate::app::{App, ExplanationState};
 use crate::explain_view::{entries, Entry};
 use crate::image_view::ColorDepth;
 
@@ -21,11 +21,14 @@ use super::pane_block;
 
 pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let focused = app.focus == Focus::Inspector;
-    let explanation = app.picked.as_ref().map(|p| p.explanation.as_ref());
-    let Some(Some(explanation)) = explanation else {
-        let note = match explanation {
-            None => "Pick a pixel (Enter) to see why it has its colour.",
-            Some(_) => "This tree has no explanation.",
+    let state = app.picked.as_ref().map(|p| &p.explanation);
+    let Some(ExplanationState::Ready(explanation)) = state else {
+        let note = match state {
+            None => "Pick a pixel (Enter) to see why it has its colour.".to_string(),
+            Some(ExplanationState::Failed(message)) => {
+                format!("The explanation failed (a bug in whitted): {message}")
+            }
+            Some(_) => "Working out why the pixel has its colour…".to_string(),
         };
         Paragraph::new(vec![
             Line::from(note),
