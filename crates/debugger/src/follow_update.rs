@@ -90,10 +90,8 @@ pub fn run_to_event(app: &mut App, forward: bool) {
 
 pub fn toggle_explain(app: &mut App) {
     app.explain_open = !app.explain_open;
-    if app.explain_open {
-        if app.picked.is_none() {
-            app.set_message("pick a pixel (Enter) to explain it", false);
-        }
+    if app.explain_open && app.picked.is_none() {
+        app.set_message("pick a pixel (Enter) to explain it", false);
     }
 }
 
