@@ -260,6 +260,40 @@ mod tests {
     }
 
     #[test]
+    fn the_running_colour_ends_at_the_pixel_with_several_samples_and_in_a_cut_tree() {
+        let f = fixture();
+        let mut options = f.options.clone();
+        options.samples_per_pixel = 4;
+        let tree = trace_pixel(&f.prepared, &f.scene, &options, 400, 270, SampleChoice::All)
+            .expect("inside the image");
+        assert_eq!(tree.samples.len(), 4);
+        let view = TreeView::new(tree);
+        assert_eq!(running_color(&view, view.len() - 1), view.tree().color);
+        // Half way, less than the whole pixel.
+        let half = running_color(&view, view.len() / 2);
+        assert!(half.iter().sum::<f32>() < view.tree().color.iter().sum::<f32>());
+
+        // A tree cut by its node budget: the cut subtrees count with their recorded colour.
+        let request = whitted_tracer::ray_tree::TraceRequest {
+            x: 400,
+            y: 270,
+            which: SampleChoice::All,
+            node_budget: 5,
+            cancel: None,
+        };
+        let tree = whitted_tracer::ray_tree::trace_pixel_request(
+            &f.prepared,
+            &f.scene,
+            &f.options,
+            &request,
+        )
+        .expect("inside the image");
+        assert!(tree.unrecorded > 0);
+        let view = TreeView::new(tree);
+        assert_eq!(running_color(&view, view.len() - 1), view.tree().color);
+    }
+
+    #[test]
     fn the_running_colour_counts_a_light_when_its_shadow_ray_is_visited() {
         let view = TreeView::new(glass_pixel_tree());
         let root = view.node(0).unwrap();
