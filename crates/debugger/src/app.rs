@@ -374,7 +374,12 @@ impl App {
             return;
         }
         picked.explanation = match explained.result {
-            Ok(explanation) => ExplanationState::Ready(explanation),
+            Ok(explanation) => {
+                // A re-traced pixel's explanation may have fewer entries than the last one.
+                let entries = explanation.contributions.len() + explanation.findings.len();
+                self.explain_selected = self.explain_selected.min(entries.saturating_sub(1));
+                ExplanationState::Ready(explanation)
+            }
             Err(message) => ExplanationState::Failed(message),
         };
     }
