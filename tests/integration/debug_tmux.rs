@@ -344,6 +344,52 @@ fn light_rays_collapse_stepping_reaches_the_pixel_and_the_explanation_jumps_at_8
 }
 
 #[test]
+fn stepping_through_the_glass_cube_stops_at_total_internal_reflection() {
+    let scene = repository().join("scenes/tir.scene");
+    let command = format!(
+        "'{}' debug '{}' --pixel 240,170",
+        whitted(),
+        scene.display()
+    );
+    let tmux = Tmux::start("tir", &repository(), &command, 120, 40);
+    tmux.wait_for("the tree of the cube", |s| {
+        s.contains("Ray tree of (240, 170)") && s.contains("rendered in")
+    });
+    // Every ray in trace order: the running colour, absorption in the glass included, ends
+    // at the pixel's.
+    for _ in 0..15 {
+        tmux.keys(&["]"]);
+    }
+    let screen = tmux.wait_for("the last ray", |s| s.contains("step 16/16"));
+    let pixel = line_with(&screen, "rendered in");
+    let running = line_with(&screen, "step 16/16");
+    let numbers = |line: &str| {
+        let after = line.split("██").nth(1).unwrap_or("").trim().to_string();
+        after
+            .split_whitespace()
+            .take(3)
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let status = pixel
+        .split('│')
+        .find(|part| part.contains("(240, 170)"))
+        .unwrap_or("");
+    assert_eq!(numbers(running).split(' ').count(), 3, "{screen}");
+    assert_eq!(numbers(running), numbers(status), "{screen}");
+    for _ in 0..4 {
+        tmux.keys(&["{"]);
+    }
+    tmux.wait_for("a total internal reflection", |s| {
+        s.contains("total internal reflection: reflected ray")
+    });
+    tmux.keys(&["q"]);
+    tmux.wait_for("the shell after quitting", |s| {
+        s.contains("debugger exited with 0")
+    });
+}
+
+#[test]
 fn editing_the_scene_reloads_it_and_errors_keep_the_last_good_image() {
     let dir = tempfile::tempdir().expect("a temporary directory");
     let scene = dir.path().join("scene.scene");
