@@ -52,8 +52,8 @@ pub fn running_color(view: &TreeView, upto: NodeId) -> [f32; 3] {
         pixel.add(partial(view, &sample.root, root, upto).to_array());
         root = view.subtree_end(root) + 1;
     }
-    // Samples that were traced but not recorded (a tree of one sample) are not in `samples`;
-    // the debugger records every sample, so their count matches.
+    // The debugger records every sample (`SampleChoice::All`), so this is the mean over
+    // the pixel's samples, as `render` takes it.
     pixel.mean()
 }
 
