@@ -251,8 +251,9 @@ fn resizing_to_a_tiny_terminal_says_so_and_back_redraws() {
         scene.display()
     );
     let tmux = Tmux::start("resize", &repository(), &command, 80, 24);
+    // At 80 columns the tree's title leaves out the pixel (the status line has it).
     let screen = tmux.wait_for("the tree of --pixel", |s| {
-        s.contains("Ray tree of (400, 270)") && s.contains("rendered in")
+        s.contains("Ray tree · 9 of 13 rays") && s.contains("rendered in")
     });
     assert!(screen.contains("Inspector · camera ray"), "{screen}");
     tmux.run(&["resize-window", "-t", &tmux.session, "-x", "40", "-y", "10"]);
@@ -276,6 +277,116 @@ fn resizing_to_a_tiny_terminal_says_so_and_back_redraws() {
         s.contains("debugger exited with 0")
     });
     assert_eq!(tmux.pane_flag("alternate_on"), "0");
+}
+
+#[test]
+fn light_rays_collapse_stepping_reaches_the_pixel_and_the_explanation_jumps_at_80x24() {
+    let scene = repository().join("scenes/whitted.scene");
+    let command = format!(
+        "'{}' debug '{}' --pixel 400,270",
+        whitted(),
+        scene.display()
+    );
+    let tmux = Tmux::start("follow", &repository(), &command, 80, 24);
+    tmux.wait_for("the collapsed tree", |s| {
+        s.contains("9 of 13 rays, a: all") && s.contains("rendered in")
+    });
+    tmux.keys(&["a"]);
+    tmux.wait_for("every ray", |s| s.contains("13 rays, a: collapse"));
+    tmux.keys(&["a"]);
+    tmux.wait_for("the light rays collapsed again", |s| {
+        s.contains("9 of 13 rays")
+    });
+    // Stepping through all 13 rays in trace order ends at the pixel's colour (the status
+    // line's numbers for the cursor pixel).
+    tmux.keys(&["]"]);
+    tmux.wait_for("the first step", |s| s.contains("step 2/13"));
+    for _ in 0..11 {
+        tmux.keys(&["]"]);
+    }
+    let screen = tmux.wait_for("the last step", |s| s.contains("step 13/13"));
+    assert!(
+        line_with(&screen, "step 13/13").contains("0.189 0.292 0.693"),
+        "{screen}"
+    );
+    assert!(
+        line_with(&screen, "rendered in").contains("0.189 0.292 0.693"),
+        "{screen}"
+    );
+    tmux.keys(&["["]);
+    tmux.wait_for("a step back", |s| s.contains("step 12/13"));
+    tmux.keys(&["{"]);
+    tmux.wait_for("the previous event", |s| s.contains("in trace order"));
+
+    // The explanation in the inspector's place; Enter on the second contribution selects
+    // its ray, a light's term its shadow ray.
+    tmux.keys(&["x"]);
+    tmux.wait_for("the explanation", |s| {
+        s.contains("Explanation · Enter: go to") && s.contains("Findings")
+    });
+    tmux.keys(&["Tab", "Tab", "Down", "Down", "Enter"]);
+    let screen = tmux.wait_for("the ray of the third contribution", |s| {
+        line_with(s, "▸").contains("7.8% ██ diffuse from sun")
+    });
+    assert!(screen.contains("Ray tree"), "{screen}");
+    tmux.keys(&["x"]);
+    let screen = tmux.wait_for("the inspector again", |s| {
+        s.contains("Inspector · shadow ray")
+    });
+    assert!(
+        screen.contains("Inspector · shadow ray, depth 1"),
+        "{screen}"
+    );
+    tmux.keys(&["q"]);
+    tmux.wait_for("the shell after quitting", |s| {
+        s.contains("debugger exited with 0")
+    });
+}
+
+#[test]
+fn stepping_through_the_glass_cube_stops_at_total_internal_reflection() {
+    let scene = repository().join("scenes/tir.scene");
+    let command = format!(
+        "'{}' debug '{}' --pixel 240,170",
+        whitted(),
+        scene.display()
+    );
+    let tmux = Tmux::start("tir", &repository(), &command, 120, 40);
+    tmux.wait_for("the tree of the cube", |s| {
+        s.contains("Ray tree of (240, 170)") && s.contains("rendered in")
+    });
+    // Every ray in trace order: the running colour, absorption in the glass included, ends
+    // at the pixel's.
+    for _ in 0..15 {
+        tmux.keys(&["]"]);
+    }
+    let screen = tmux.wait_for("the last ray", |s| s.contains("step 16/16"));
+    let pixel = line_with(&screen, "rendered in");
+    let running = line_with(&screen, "step 16/16");
+    let numbers = |line: &str| {
+        let after = line.split("██").nth(1).unwrap_or("").trim().to_string();
+        after
+            .split_whitespace()
+            .take(3)
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let status = pixel
+        .split('│')
+        .find(|part| part.contains("(240, 170)"))
+        .unwrap_or("");
+    assert_eq!(numbers(running).split(' ').count(), 3, "{screen}");
+    assert_eq!(numbers(running), numbers(status), "{screen}");
+    for _ in 0..4 {
+        tmux.keys(&["{"]);
+    }
+    tmux.wait_for("a total internal reflection", |s| {
+        s.contains("total internal reflection: reflected ray")
+    });
+    tmux.keys(&["q"]);
+    tmux.wait_for("the shell after quitting", |s| {
+        s.contains("debugger exited with 0")
+    });
 }
 
 #[test]

@@ -8,9 +8,9 @@ use anyhow::{bail, Context};
 use crate::{cargo, run_cargo, workspace_root};
 
 /// Which crates each workspace crate must never depend on (DESIGN.md, "Dependency directions").
-/// `ir <- lang`, `ir <- mit6837`, `ir <- tracer <- debugger`; the tracer never sees syntax,
-/// the debugger never parses, and the two front ends know nothing of each other or of what
-/// comes after the IR.
+/// `ir <- lang`, `ir <- mit6837`, `ir <- tracer <- debugger`, `tracer <- explain <- debugger`;
+/// the tracer never sees syntax, the debugger never parses, and the two front ends know
+/// nothing of each other or of what comes after the IR.
 const FORBIDDEN: &[(&str, &[&str])] = &[
     (
         "whitted-ir",
@@ -79,6 +79,8 @@ const REQUIRED: &[(&str, &str)] = &[
     ("whitted-tracer", "whitted-ir"),
     ("whitted-debugger", "whitted-tracer"),
     ("whitted-explain", "whitted-tracer"),
+    // The debugger explains the picked pixel (`x`) with the explain library.
+    ("whitted-debugger", "whitted-explain"),
 ];
 
 pub fn run(args: &[String]) -> anyhow::Result<()> {

@@ -84,6 +84,22 @@ pub enum Action {
     ToggleSourceTarget,
     Reload,
     Export,
+    /// `a`: shows the light rays of the tree, or collapses them again.
+    ToggleShowAll,
+    /// `p`: selects the selected ray's child that brings the most to the pixel.
+    FollowHeaviest,
+    /// `x`: the inspector's area shows the pixel's explanation, or the inspector again.
+    ToggleExplain,
+    /// `]` / `[`: the next / previous ray in the order the tracer ran them.
+    Step {
+        forward: bool,
+    },
+    /// `}` / `{`: the next / previous ray where something notable happened.
+    RunToEvent {
+        forward: bool,
+    },
+    /// Enter in the explanation: goes to the selected entry's ray or source line.
+    ExplainGo,
 }
 
 /// The keys `?` lists: (section, keys, what they do). Every binding in
@@ -95,21 +111,21 @@ pub const KEY_HELP: &[(&str, &str, &str)] = &[
     ("Image", "+ / -, wheel", "zoom in / out at the cursor"),
     ("Image", "Ctrl/Alt+arrows", "pan the view"),
     ("Image", "f", "fit the image to the pane"),
-    ("Image", "o", "overlay: rays per pixel"),
-    ("Image", "d", "overlay: deepest level"),
+    ("Image", "o  d", "overlay: rays / deepest level"),
     ("Image", "s", "mark the selected hit point"),
     ("Ray tree", "↑↓ jk", "previous / next ray"),
     ("Ray tree", "← h", "collapse, or go to the parent"),
     ("Ray tree", "→ l", "expand, or go to the first child"),
     ("Ray tree", "Enter", "expand or collapse"),
     ("Ray tree", "Home End PgUp/Dn", "first / last / page"),
+    ("Ray tree", "a  p", "all rays; follow heaviest child"),
+    ("Ray tree", "] [  } {", "step, run to event: fwd / back"),
     ("Inspector", "↑↓ PgUp/Dn", "scroll"),
+    ("Inspector", "x  Enter", "explain pixel; go to entry"),
     ("Source", "m", "material / object definition"),
     ("Anywhere", "Tab Shift+Tab", "next / previous pane"),
-    ("Anywhere", "r", "reload (automatic on save)"),
-    ("Anywhere", "e", "write the ray tree as JSON"),
-    ("Anywhere", "?", "this help"),
-    ("Anywhere", "q, Esc", "quit (Esc: cancel a trace)"),
+    ("Anywhere", "r  e", "reload; write the tree as JSON"),
+    ("Anywhere", "?  q  Esc", "help; quit (Esc: cancel trace)"),
 ];
 
 /// The action for a key, given which pane has focus and whether the help is open (then any
@@ -145,6 +161,13 @@ pub fn action_for_key(key: KeyEvent, focus: Focus, help_open: bool) -> Option<Ac
         KeyCode::Char('+' | '=') => Some(Action::ZoomIn),
         KeyCode::Char('-' | '_') => Some(Action::ZoomOut),
         KeyCode::Char('f') => Some(Action::Fit),
+        KeyCode::Char('a') => Some(Action::ToggleShowAll),
+        KeyCode::Char('p') => Some(Action::FollowHeaviest),
+        KeyCode::Char('x') => Some(Action::ToggleExplain),
+        KeyCode::Char(']') => Some(Action::Step { forward: true }),
+        KeyCode::Char('[') => Some(Action::Step { forward: false }),
+        KeyCode::Char('}') => Some(Action::RunToEvent { forward: true }),
+        KeyCode::Char('{') => Some(Action::RunToEvent { forward: false }),
         _ => None,
     };
     if global.is_some() {
@@ -208,6 +231,7 @@ fn inspector_key(code: KeyCode) -> Option<Action> {
         KeyCode::PageUp => Action::InspectorScroll(-10),
         KeyCode::PageDown => Action::InspectorScroll(10),
         KeyCode::Home => Action::InspectorScroll(i32::MIN),
+        KeyCode::Enter => Action::ExplainGo,
         _ => return None,
     })
 }
@@ -303,6 +327,31 @@ mod tests {
                 })
             );
         }
+    }
+
+    #[test]
+    fn follow_keys_work_in_every_pane_and_enter_goes_in_the_inspector() {
+        let bindings = [
+            ('a', Action::ToggleShowAll),
+            ('p', Action::FollowHeaviest),
+            ('x', Action::ToggleExplain),
+            (']', Action::Step { forward: true }),
+            ('[', Action::Step { forward: false }),
+            ('}', Action::RunToEvent { forward: true }),
+            ('{', Action::RunToEvent { forward: false }),
+        ];
+        for focus in [Focus::Image, Focus::Tree, Focus::Inspector] {
+            for (c, action) in bindings {
+                assert_eq!(
+                    action_for_key(key(KeyCode::Char(c)), focus, false),
+                    Some(action)
+                );
+            }
+        }
+        assert_eq!(
+            action_for_key(key(KeyCode::Enter), Focus::Inspector, false),
+            Some(Action::ExplainGo)
+        );
     }
 
     #[test]

@@ -17,7 +17,7 @@ use crate::framebuffer::Framebuffer;
 use crate::heat_map::{HeatMap, HeatMapKind};
 use crate::image_view::{ColorDepth, Viewport};
 use crate::layout::{self, Panes};
-use crate::trace_job::{TraceFailure, TraceJob, Traced};
+use crate::trace_job::{Explained, TraceFailure, TraceJob, Traced};
 use crate::tree_view::TreeView;
 
 /// A scene ready to render and trace: the IR (names, spans, sources) and its prepared form.
@@ -74,6 +74,28 @@ pub struct Picked {
     /// From the key or click that picked it to the frame showing it on the terminal,
     /// measured by the event loop (`None` until that frame is drawn, and in tests).
     pub on_screen_after: Option<Duration>,
+    /// The trace request that recorded the tree: its explanation arrives with this number.
+    pub generation: u64,
+    /// Why the pixel has its colour, from this tree (`x` shows it).
+    pub explanation: ExplanationState,
+}
+
+/// The picked tree's explanation: worked out on the trace worker after the tree arrives.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExplanationState {
+    Working,
+    Ready(whitted_explain::Explanation),
+    /// The explain library panicked (a bug): its message.
+    Failed(String),
+}
+
+impl ExplanationState {
+    pub fn ready(&self) -> Option<&whitted_explain::Explanation> {
+        match self {
+            ExplanationState::Ready(explanation) => Some(explanation),
+            _ => None,
+        }
+    }
 }
 
 /// Which definition the source pane shows for the selected ray.
@@ -159,6 +181,12 @@ pub struct App {
     pub traced_request_at: Option<Instant>,
     /// The node budget of recorded trees: `limits::MAX_RAY_TREE_NODES`.
     pub node_budget: usize,
+    /// `x`: the inspector's area shows the explanation, and which entry is selected.
+    pub explain_open: bool,
+    pub explain_selected: usize,
+    /// A line the source pane shows instead of the selected ray's definition (a finding's,
+    /// after Enter in the explanation) and what to call it; cleared when the ray changes.
+    pub source_focus: Option<(whitted_ir::Span, String)>,
 }
 
 impl App {
@@ -195,6 +223,9 @@ impl App {
             trace_requests: 0,
             traced_request_at: None,
             node_budget: whitted_ir::limits::MAX_RAY_TREE_NODES,
+            explain_open: false,
+            explain_selected: 0,
+            source_focus: None,
         }
     }
 
@@ -291,9 +322,11 @@ impl App {
                     Some(previous) if tracing.retrace => TreeView::new_like(tree, &previous.tree),
                     _ => {
                         self.inspector_scroll = 0;
+                        self.explain_selected = 0;
                         TreeView::new(tree)
                     }
                 };
+                self.source_focus = None;
                 view.keep_selection_in_view(self.tree_rows());
                 if view.tree().unrecorded > 0 {
                     self.set_message(
@@ -309,6 +342,8 @@ impl App {
                     tree: view,
                     trace_time,
                     on_screen_after: None,
+                    generation: traced.generation,
+                    explanation: ExplanationState::Working,
                 });
                 self.traces += 1;
                 self.traced_request_at = Some(tracing.requested_at);
@@ -328,6 +363,25 @@ impl App {
                 true,
             ),
         }
+    }
+
+    /// The explanation of a traced tree: kept when that tree is still the one shown.
+    pub fn apply_explained(&mut self, explained: Explained) {
+        let Some(picked) = &mut self.picked else {
+            return;
+        };
+        if picked.generation != explained.generation {
+            return;
+        }
+        picked.explanation = match explained.result {
+            Ok(explanation) => {
+                // A re-traced pixel's explanation may have fewer entries than the last one.
+                let entries = explanation.contributions.len() + explanation.findings.len();
+                self.explain_selected = self.explain_selected.min(entries.saturating_sub(1));
+                ExplanationState::Ready(explanation)
+            }
+            Err(message) => ExplanationState::Failed(message),
+        };
     }
 
     /// Called by the event loop when it starts a render with this generation number.

@@ -32,6 +32,8 @@ pub enum Event {
     Reloaded(Reloaded),
     /// A pixel's ray tree, recorded off the UI thread (or why not).
     Traced(crate::trace_job::Traced),
+    /// The explanation of a traced pixel's tree, worked out after it on the same worker.
+    Explained(crate::trace_job::Explained),
     /// A watched scene file changed on disk.
     FileChanged,
     /// The loop's timer: nothing arrived before the next deadline.

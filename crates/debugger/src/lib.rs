@@ -10,6 +10,9 @@
 pub mod action;
 pub mod app;
 pub mod event;
+pub mod explain_view;
+pub mod follow;
+mod follow_update;
 pub mod framebuffer;
 pub mod heat_map;
 pub mod hit_point;
@@ -20,6 +23,7 @@ mod reload;
 mod render_job;
 mod run;
 mod session;
+pub mod stepping;
 mod terminal;
 pub mod trace_job;
 pub mod tree_view;

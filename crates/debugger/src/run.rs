@@ -273,6 +273,10 @@ fn handle(app: &mut App, event: Event) -> Vec<Effect> {
             app.apply_trace(traced);
             Vec::new()
         }
+        Event::Explained(explained) => {
+            app.apply_explained(explained);
+            Vec::new()
+        }
         Event::RenderDone { generation, result } => {
             app.apply_render_done(generation, result);
             Vec::new()

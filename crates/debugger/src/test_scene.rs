@@ -218,12 +218,16 @@ pub fn glass_pixel_tree() -> RayTree {
     .expect("the pixel is inside the image")
 }
 
-/// Runs the trace the app asked for on this thread and hands it the answer, as the event
-/// loop does with a worker thread.
+/// Runs the trace the app asked for on this thread and hands it the answer, then the
+/// tree's explanation, as the event loop does with a worker thread.
 pub fn finish_trace(app: &mut crate::app::App) {
     if let Some(job) = app.trace_job() {
         let traced = job.run();
+        let tree = traced.result.as_ref().ok().map(|(tree, _)| tree.clone());
         app.apply_trace(traced);
+        if let Some(tree) = tree {
+            app.apply_explained(job.explain(&tree));
+        }
     }
 }
 

@@ -9,6 +9,7 @@ use std::sync::mpsc::Sender;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use whitted_explain::{explain_tree, Explanation};
 use whitted_tracer::ray_tree::{trace_pixel_request, RayTree, SampleChoice, TraceRequest};
 use whitted_tracer::RenderOptions;
 
@@ -33,6 +34,16 @@ pub struct Traced {
     pub generation: u64,
     pub pixel: (u32, u32),
     pub result: Result<(RayTree, Duration), TraceFailure>,
+}
+
+/// The explanation of a recorded tree (`x`), sent after the tree itself: its findings may
+/// trace the pixel again with other settings, and the tree must not wait for that.
+#[derive(Debug)]
+pub struct Explained {
+    /// The trace's generation: the explanation belongs to that trace's tree only.
+    pub generation: u64,
+    /// The explanation, or the panic's message (a bug).
+    pub result: Result<Explanation, String>,
 }
 
 /// Why a trace gave no tree.
@@ -81,12 +92,38 @@ impl TraceJob {
         }
     }
 
-    /// Runs the trace on a new thread and sends its answer as [`Event::Traced`].
+    /// Explains the recorded tree itself (no second trace of it), so that the explanation
+    /// is of exactly the rays shown beside it.
+    pub fn explain(&self, tree: &RayTree) -> Explained {
+        let explained = catch_unwind(AssertUnwindSafe(|| {
+            explain_tree(
+                &self.loaded.prepared,
+                &self.loaded.scene,
+                &self.options,
+                tree,
+            )
+        }));
+        Explained {
+            generation: self.generation,
+            result: explained
+                .map_err(|payload| take_worker_panic().unwrap_or_else(|| panic_text(&*payload))),
+        }
+    }
+
+    /// Runs the trace on a new thread and sends its answer as [`Event::Traced`], then,
+    /// unless it was cancelled meanwhile, the tree's explanation as [`Event::Explained`].
     pub fn spawn(self, events: Sender<Event>) -> std::io::Result<()> {
         std::thread::Builder::new()
             .name(format!("trace {}", self.generation))
             .spawn(move || {
-                let _ = events.send(Event::Traced(self.run()));
+                let traced = self.run();
+                let tree = traced.result.as_ref().ok().map(|(tree, _)| tree.clone());
+                if events.send(Event::Traced(traced)).is_err() {
+                    return;
+                }
+                if let Some(tree) = tree.filter(|_| !self.cancel.load(Ordering::Relaxed)) {
+                    let _ = events.send(Event::Explained(self.explain(&tree)));
+                }
             })?;
         Ok(())
     }

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use crate::action::{Action, Focus};
 use crate::app::{App, Effect, SourceTarget, View};
+use crate::follow_update;
 use crate::image_view::Viewport;
 use crate::layout;
 
@@ -79,6 +80,12 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
             }
         }
         Action::Export => return export(app),
+        Action::ToggleShowAll => follow_update::toggle_show_all(app),
+        Action::FollowHeaviest => follow_update::follow_heaviest(app),
+        Action::ToggleExplain => follow_update::toggle_explain(app),
+        Action::Step { forward } => follow_update::step(app, forward),
+        Action::RunToEvent { forward } => follow_update::run_to_event(app, forward),
+        Action::ExplainGo => follow_update::go(app),
     }
     Vec::new()
 }
@@ -171,6 +178,7 @@ fn click(app: &mut App, column: u16, row: u16) {
                 if id != picked.tree.selected() {
                     picked.tree.select(id);
                     app.inspector_scroll = 0;
+                    app.source_focus = None;
                 }
             }
         }
@@ -213,10 +221,14 @@ fn tree(app: &mut App, navigate: impl FnOnce(&mut crate::tree_view::TreeView)) {
     picked.tree.keep_selection_in_view(rows);
     if picked.tree.selected() != before {
         app.inspector_scroll = 0;
+        app.source_focus = None;
     }
 }
 
 fn scroll_inspector(app: &mut App, lines: i32) {
+    if app.explain_open {
+        return follow_update::move_explain_selection(app, lines);
+    }
     app.inspector_scroll = if lines == i32::MIN {
         0
     } else {

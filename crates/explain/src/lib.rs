@@ -24,12 +24,14 @@ mod text;
 
 pub use json::{ExplanationDocument, EXPLAIN_JSON_VERSION};
 pub use model::{Contribution, Explanation, Finding, FindingKind, Step, Term};
-pub use text::{format_summary, format_text};
+pub use text::{describe_term, format_summary, format_text};
 
 use std::sync::atomic::AtomicBool;
 
 use whitted_ir::Scene;
-use whitted_tracer::ray_tree::{trace_pixel_request, SampleChoice, TraceError, TraceRequest};
+use whitted_tracer::ray_tree::{
+    trace_pixel_request, RayTree, SampleChoice, TraceError, TraceRequest,
+};
 use whitted_tracer::{PreparedScene, RenderOptions};
 
 /// Explains pixel `(x, y)`: records its ray tree (every sample) and analyses it.
@@ -79,16 +81,29 @@ pub fn explain_request(
         cancel: request.cancel,
     };
     let tree = trace_pixel_request(prepared, scene, options, &trace_request)?;
-    let contributions = contributions::decompose(&tree);
+    Ok(explain_tree(prepared, scene, options, &tree))
+}
+
+/// Explains a ray tree already recorded (the debugger's picked pixel), so that the
+/// explanation is of exactly the rays shown beside it. `tree` must have been traced from
+/// `prepared` with `options`, recording every sample (`SampleChoice::All`), for the
+/// contributions to sum to the pixel.
+pub fn explain_tree(
+    prepared: &PreparedScene,
+    scene: &Scene,
+    options: &RenderOptions,
+    tree: &RayTree,
+) -> Explanation {
+    let contributions = contributions::decompose(tree);
     let context = findings::Context {
         prepared,
         scene,
         options,
-        tree: &tree,
+        tree,
         contributions: &contributions,
     };
     let findings = findings::find(&context);
-    Ok(Explanation {
+    Explanation {
         pixel: tree.pixel,
         image_size: tree.image_size,
         color: tree.color,
@@ -98,5 +113,5 @@ pub fn explain_request(
         unrecorded: tree.unrecorded,
         contributions,
         findings,
-    })
+    }
 }

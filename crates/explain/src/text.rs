@@ -10,7 +10,8 @@ fn rgb(c: [f32; 3]) -> String {
     format!("rgb({:.4}, {:.4}, {:.4})", c[0], c[1], c[2])
 }
 
-fn what(contribution: &Contribution) -> String {
+/// What a contribution's light is, in words: `diffuse from sun`, `background`, ...
+pub fn describe_term(contribution: &Contribution) -> String {
     let light = contribution.light.as_deref().unwrap_or("a light");
     match contribution.term {
         Term::Ambient => "ambient".to_string(),
@@ -57,9 +58,9 @@ pub fn format_text(explanation: &Explanation) -> String {
                 .map_or("     ".to_string(), |s| format!("{:5.1}%", s * 100.0));
             let path = describe_path(&c.path);
             let line = if path.is_empty() {
-                what(c)
+                describe_term(c)
             } else {
-                format!("{path}: {}", what(c))
+                format!("{path}: {}", describe_term(c))
             };
             let _ = writeln!(out, "  {share}  {}  {line}", rgb(c.color));
         }
@@ -111,9 +112,9 @@ pub fn format_summary(explanation: &Explanation) -> String {
             .map_or(String::new(), |s| format!("{:.0}% ", s * 100.0));
         let path = describe_path(&c.path);
         let line = if path.is_empty() {
-            what(c)
+            describe_term(c)
         } else {
-            format!("{path}: {}", what(c))
+            format!("{path}: {}", describe_term(c))
         };
         let _ = writeln!(out, "main light: {share}{line}");
     } else {

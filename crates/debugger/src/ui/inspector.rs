@@ -19,7 +19,6 @@ use crate::tree_view::{NodeId, TreeView};
 
 use super::format::{self, number, swatch, vector};
 use super::pane_block;
-use super::tree_pane::contribution;
 
 const LABEL_WIDTH: usize = 13;
 
@@ -168,11 +167,7 @@ impl Lines {
             }
             self.why_this_colour(node);
         }
-        self.color(
-            "contributes",
-            contribution(tree, id, node),
-            "weight × returned",
-        );
+        self.color("contributes", tree.contribution(id), "weight × returned");
         self.text("ended", termination(node));
         for skipped in &node.skipped {
             self.text(

@@ -2,6 +2,7 @@
 //! has its own module; none of them changes state.
 
 mod errors_pane;
+mod explain_pane;
 pub mod format;
 mod help;
 mod image_pane;
@@ -29,7 +30,11 @@ impl Widget for &App {
         };
         image_pane::draw(self, panes.image, buf);
         tree_pane::draw(self, panes.tree, buf);
-        inspector::draw(self, panes.inspector, buf);
+        if self.explain_open {
+            explain_pane::draw(self, panes.inspector, buf);
+        } else {
+            inspector::draw(self, panes.inspector, buf);
+        }
         match &self.errors {
             Some(errors) => errors_pane::draw(errors, panes.source, buf),
             None => source_pane::draw(self, panes.source, buf),

@@ -180,3 +180,59 @@ fn source_pane_shows_the_instantiation_stack_of_a_bead_made_by_a_call_in_a_loop(
     }
     assert_snapshot!(screen.backend());
 }
+
+/// The glass pixel with its explanation in the inspector's place, the second entry selected.
+fn explained_glass_pixel(width: u16, height: u16) -> App {
+    let mut app = rendered_app(width, height);
+    pick_glass_pixel(&mut app);
+    update(&mut app, Action::ToggleExplain);
+    app.focus = Focus::Inspector;
+    update(&mut app, Action::InspectorScroll(1));
+    app
+}
+
+#[test]
+fn explanation_pane_at_120x40() {
+    let app = explained_glass_pixel(120, 40);
+    assert_snapshot!(draw(&app).backend());
+}
+
+#[test]
+fn explanation_pane_at_80x24() {
+    let app = explained_glass_pixel(80, 24);
+    assert_snapshot!(draw(&app).backend());
+}
+
+/// The glass pixel of scenes/whitted.scene with the most rays (16, of them 6 light: a
+/// scan of the image every 10 pixels), stepped three rays on in trace order so that the
+/// running colour shows under the tree.
+fn collapsed_busy_pixel(width: u16, height: u16) -> App {
+    let mut app = rendered_app(width, height);
+    app.cursor = BUSY_PIXEL;
+    update(&mut app, Action::TraceCursor);
+    crate::test_scene::finish_trace(&mut app);
+    if let Some(picked) = &mut app.picked {
+        picked.trace_time = Duration::from_micros(60);
+    }
+    app.focus = Focus::Tree;
+    for _ in 0..3 {
+        update(&mut app, Action::Step { forward: true });
+    }
+    app
+}
+
+const BUSY_PIXEL: (u32, u32) = (370, 250);
+
+#[test]
+fn collapsed_tree_while_stepping_at_120x40() {
+    let app = collapsed_busy_pixel(120, 40);
+    let tree = &app.picked.as_ref().expect("a tree").tree;
+    assert_eq!((tree.hidden_count(), tree.len()), (6, 16));
+    assert_snapshot!(draw(&app).backend());
+}
+
+#[test]
+fn collapsed_tree_while_stepping_at_80x24() {
+    let app = collapsed_busy_pixel(80, 24);
+    assert_snapshot!(draw(&app).backend());
+}

@@ -63,6 +63,15 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
 
 /// The definition to show for the selected ray, or a note saying why there is none.
 fn target(app: &App) -> (Option<Target<'_>>, String) {
+    // A finding's line, after Enter in the explanation.
+    if let Some((span, what)) = &app.source_focus {
+        let target = Target {
+            span: *span,
+            what: what.clone(),
+            made_by: &[],
+        };
+        return (Some(target), String::new());
+    }
     let Some(picked) = &app.picked else {
         return (
             None,

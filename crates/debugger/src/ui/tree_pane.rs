@@ -11,6 +11,8 @@ use whitted_tracer::{RayKind, Termination};
 
 use crate::action::Focus;
 use crate::app::App;
+use crate::image_view::ColorDepth;
+use crate::stepping;
 use crate::tree_view::{NodeId, TreeView};
 
 use super::format::{self, swatch};
@@ -32,9 +34,10 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         return;
     };
     let tree = &picked.tree;
-    let [x, y] = tree.tree().pixel;
-    let title = format!(" Ray tree of ({x}, {y}) · {} rays ", tree.len());
-    let block = pane_block(Line::from(title), focused);
+    let mut block = pane_block(Line::from(title(tree, pane.width)), focused);
+    if tree.is_stepping() {
+        block = block.title_bottom(step_line(tree, app.color_depth));
+    }
     let area = block.inner(pane);
     block.render(pane, buf);
 
@@ -70,7 +73,7 @@ fn row_line(app: &App, tree: &TreeView, id: NodeId, width: usize) -> Line<'stati
         (true, false) => "▶ ",
     };
     let head = format!("{indent}{marker}{:<11} d{} ", node.kind.name(), node.depth);
-    let contribution = contribution(tree, id, node);
+    let contribution = tree.contribution(id);
     let [r, g, b] = contribution;
     let numbers = format!(" {r:.2} {g:.2} {b:.2}");
     let head_width = head.chars().count();
@@ -142,18 +145,45 @@ fn describe(node: &RayNode) -> String {
     text
 }
 
-/// How much of the pixel this ray accounts for: its path weight times the colour it
-/// returned, over the sample count. A shadow ray accounts for its light's diffuse and
-/// specular terms at the hit that cast it.
-pub fn contribution(tree: &TreeView, id: NodeId, node: &RayNode) -> [f32; 3] {
-    let samples = tree.tree().samples_per_pixel.max(1) as f32;
-    let share = if node.kind == RayKind::Shadow {
-        match tree.light_of_shadow(id) {
-            Some(light) => format::mul(node.weight, format::add(light.diffuse, light.specular)),
-            None => [0.0; 3],
-        }
+/// The pane's title: the pixel, and how many rays the collapse hides (`a` shows them),
+/// shortened to fit the pane.
+fn title(tree: &TreeView, width: u16) -> String {
+    let [x, y] = tree.tree().pixel;
+    let all = tree.len();
+    let hidden = tree.hidden_count();
+    let light = tree.light_count();
+    let (long, short) = if hidden > 0 {
+        let shown = all - hidden;
+        (
+            format!(" Ray tree of ({x}, {y}) · {shown} of {all} rays, a shows all "),
+            format!(" Ray tree · {shown} of {all} rays, a: all "),
+        )
+    } else if light > 0 {
+        (
+            format!(" Ray tree of ({x}, {y}) · {all} rays, a hides {light} light "),
+            format!(" Ray tree · {all} rays, a: collapse "),
+        )
     } else {
-        format::mul(node.weight, node.color)
+        (
+            format!(" Ray tree of ({x}, {y}) · {all} rays "),
+            format!(" Ray tree · {all} rays "),
+        )
     };
-    format::scale(share, 1.0 / samples)
+    if long.chars().count() + 2 <= usize::from(width) {
+        long
+    } else {
+        short
+    }
+}
+
+/// While stepping: which ray of how many in the tracer's order, and the pixel's colour
+/// counting the rays so far (it ends at the pixel's colour on the last ray).
+fn step_line(tree: &TreeView, depth: ColorDepth) -> Line<'static> {
+    let id = tree.selected();
+    let running = stepping::running_color(tree, id);
+    Line::from(vec![
+        Span::raw(format!(" step {}/{} ", id + 1, tree.len())),
+        swatch(running, depth),
+        Span::raw(format!(" {} ", format::rgb(running))),
+    ])
 }

@@ -10,6 +10,8 @@ mod lights;
 mod media;
 pub(crate) mod surfaces;
 
+pub use surfaces::is_self_hit;
+
 use whitted_ir::{Handle, Material, Object, Scene};
 use whitted_tracer::ray_tree::{RayNode, RayTree};
 use whitted_tracer::{PreparedScene, RenderOptions};

@@ -2,7 +2,7 @@
 //! surface a hair from where it left (`self_hit`: surface acne), or another surface there
 //! (`coincident_surfaces`: two surfaces in the same place).
 
-use whitted_tracer::ray_tree::{HitInfo, ObjectRef, ShadowOutcome};
+use whitted_tracer::ray_tree::{HitInfo, ObjectRef, RayNode, ShadowOutcome};
 
 use whitted_ir::{Handle, Object, ObjectKind};
 
@@ -124,6 +124,25 @@ fn starts_inside(
             source_line: None,
         },
     );
+}
+
+/// Whether `node` (a secondary or shadow ray cast from `parent`'s hit) met the very surface
+/// it left at once (surface acne): the object it hit, or the shadow ray's blocker, is the
+/// parent's object, closer than [`TINY`]. The debugger's `{`/`}` stop at such rays.
+pub fn is_self_hit(node: &RayNode, parent: &RayNode) -> bool {
+    let Some(from) = &parent.hit else {
+        return false;
+    };
+    let met = match (&node.shadow, &node.hit) {
+        (Some(shadow), _) => shadow
+            .blocker
+            .as_ref()
+            .filter(|_| shadow.result == ShadowOutcome::Blocked)
+            .map(|b| (b.object.handle, b.t)),
+        (None, Some(hit)) => Some((hit.object.handle, hit.t)),
+        (None, None) => None,
+    };
+    met.is_some_and(|(object, t)| object == from.object.handle && tiny(t, from))
 }
 
 fn tiny(t: f32, from: &HitInfo) -> bool {

@@ -1,0 +1,303 @@
+//! How the keys that follow what matters change the [`App`]: `a` (light rays), `p` (the
+//! heaviest child), `[ ] { }` (stepping in the tracer's order), `x` and, in the explanation,
+//! ↑↓ and Enter. Called from [`crate::update::update`]; the tree logic itself is in
+//! `tree_view.rs`, `follow.rs`, `stepping.rs` and `explain_view.rs`.
+
+use crate::action::Focus;
+use crate::app::App;
+use crate::explain_view::{self, Jump};
+use crate::follow;
+use crate::stepping;
+use crate::tree_view::TreeView;
+
+/// Runs `change` on the picked tree, keeps the selection in view, and resets what follows
+/// the selected ray (the inspector's scroll, a finding's line) when it moved. What `change`
+/// returns is handed back; `None` with a message when no pixel is picked.
+fn with_tree<T>(app: &mut App, change: impl FnOnce(&mut TreeView) -> T) -> Option<T> {
+    let rows = app.tree_rows();
+    let Some(picked) = &mut app.picked else {
+        app.set_message("no ray tree yet: move the cursor and press Enter", false);
+        return None;
+    };
+    let before = picked.tree.selected();
+    let answer = change(&mut picked.tree);
+    picked.tree.keep_selection_in_view(rows);
+    if picked.tree.selected() != before {
+        app.inspector_scroll = 0;
+        app.source_focus = None;
+    }
+    Some(answer)
+}
+
+pub fn toggle_show_all(app: &mut App) {
+    let Some(hidden) = with_tree(app, |tree| {
+        tree.toggle_show_all();
+        tree.light_count()
+    }) else {
+        return;
+    };
+    if hidden == 0 {
+        app.set_message("no ray here counts for under 1% of the pixel", false);
+    }
+}
+
+pub fn follow_heaviest(app: &mut App) {
+    if with_tree(app, follow::follow_heaviest) == Some(None) {
+        app.set_message("the selected ray has no children to follow", false);
+    }
+}
+
+pub fn step(app: &mut App, forward: bool) {
+    let moved = with_tree(app, |tree| stepping::step(tree, forward));
+    if moved == Some(false) {
+        let end = if forward { "last" } else { "first" };
+        app.set_message(format!("this is the {end} ray the tracer traced"), false);
+    }
+}
+
+pub fn run_to_event(app: &mut App, forward: bool) {
+    let Some(found) = with_tree(app, |tree| {
+        let found = stepping::run_to_event(tree, forward)?;
+        let node = tree.node(found.0)?;
+        Some((found, node.kind.name(), node.depth, tree.len()))
+    }) else {
+        return;
+    };
+    match found {
+        Some(((id, events), kind, depth, rays)) => {
+            let names: Vec<&str> = events.iter().map(|e| e.name()).collect();
+            app.set_message(
+                format!(
+                    "{}: {kind} ray, depth {depth} (ray {} of {rays} in trace order)",
+                    names.join(", "),
+                    id + 1
+                ),
+                false,
+            );
+        }
+        None => {
+            let way = if forward { "after" } else { "before" };
+            app.set_message(
+                format!(
+                    "no event {way} this ray (total internal reflection, max depth, \
+                     weight cut-off, blocked shadow ray, self-hit)"
+                ),
+                false,
+            );
+        }
+    }
+}
+
+pub fn toggle_explain(app: &mut App) {
+    app.explain_open = !app.explain_open;
+    if app.explain_open && app.picked.is_none() {
+        app.set_message("pick a pixel (Enter) to explain it", false);
+    }
+}
+
+/// ↑↓ in the explanation: moves the selected entry (`i32::MIN`, Home, to the first).
+pub fn move_explain_selection(app: &mut App, lines: i32) {
+    let count = app
+        .picked
+        .as_ref()
+        .and_then(|p| p.explanation.ready())
+        .map_or(0, |e| explain_view::entries(e).len());
+    app.explain_selected = if lines == i32::MIN || count == 0 {
+        0
+    } else {
+        let moved = app.explain_selected as i64 + i64::from(lines);
+        moved.clamp(0, count as i64 - 1) as usize
+    };
+}
+
+/// Enter in the explanation: selects the entry's ray in the tree (and gives the tree the
+/// keyboard), or shows a finding's line in the source pane.
+pub fn go(app: &mut App) {
+    if !app.explain_open {
+        return;
+    }
+    let jump = {
+        let Some(picked) = &app.picked else {
+            return;
+        };
+        let Some(explanation) = picked.explanation.ready() else {
+            return;
+        };
+        let entries = explain_view::entries(explanation);
+        let Some(&entry) = entries.get(app.explain_selected) else {
+            return;
+        };
+        explain_view::jump(entry, &picked.tree, &app.loaded.scene.sources)
+    };
+    match jump {
+        Jump::Ray(id) => {
+            with_tree(app, |tree| tree.select(id));
+            app.focus = Focus::Tree;
+        }
+        Jump::Source { span, what } => app.source_focus = Some((span, what)),
+        Jump::Nowhere(why) => app.set_message(why, false),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::action::Action;
+    use crate::app::LoadedScene;
+    use crate::test_scene::{finish_trace, whitted_scene, GLASS_PIXEL};
+    use crate::update::update;
+    use ratatui::layout::Rect;
+
+    fn picked_app() -> App {
+        let mut app = App::new(
+            "scenes/whitted.scene".into(),
+            LoadedScene::new(whitted_scene()),
+            Rect::new(0, 0, 120, 40),
+            "/tmp/out".into(),
+        );
+        app.cursor = GLASS_PIXEL;
+        update(&mut app, Action::TraceCursor);
+        finish_trace(&mut app);
+        app
+    }
+
+    #[test]
+    fn the_trace_worker_explains_the_tree_it_recorded() {
+        let app = picked_app();
+        let picked = app.picked.as_ref().unwrap();
+        let explanation = picked.explanation.ready().expect("an explanation");
+        assert_eq!(explanation.pixel, picked.tree.tree().pixel);
+        assert_eq!(explanation.color, picked.tree.tree().color);
+        // The same as the explain command's, which traces the pixel itself.
+        let f = crate::test_scene::fixture();
+        let cli = whitted_explain::explain(
+            &f.prepared,
+            &f.scene,
+            &f.options,
+            GLASS_PIXEL.0,
+            GLASS_PIXEL.1,
+        )
+        .unwrap();
+        assert_eq!(&cli, explanation);
+    }
+
+    #[test]
+    fn an_explanation_is_kept_only_for_the_tree_it_explains() {
+        let mut app = picked_app();
+        let job_of = |app: &mut App| {
+            app.trace_cursor();
+            app.trace_job().unwrap()
+        };
+        // A late explanation of an earlier trace is dropped.
+        let old = job_of(&mut app);
+        let old_tree = old.run().result.unwrap().0;
+        app.trace_cursor();
+        finish_trace(&mut app);
+        let current = app.picked.as_ref().unwrap().generation;
+        assert_ne!(old.generation, current);
+        let before = app.picked.as_ref().unwrap().explanation.clone();
+        let mut late = old.explain(&old_tree);
+        if let Ok(explanation) = &mut late.result {
+            explanation.findings.clear();
+        }
+        app.apply_explained(late);
+        assert_eq!(app.picked.as_ref().unwrap().explanation, before);
+        // Until its explanation arrives a new tree says it is being worked out.
+        let job = job_of(&mut app);
+        let traced = job.run();
+        app.apply_trace(traced);
+        assert_eq!(
+            app.picked.as_ref().unwrap().explanation,
+            crate::app::ExplanationState::Working
+        );
+        app.apply_explained(crate::trace_job::Explained {
+            generation: job.generation,
+            result: Err("boom".into()),
+        });
+        assert_eq!(
+            app.picked.as_ref().unwrap().explanation,
+            crate::app::ExplanationState::Failed("boom".into())
+        );
+    }
+
+    #[test]
+    fn enter_on_a_contribution_selects_its_ray_and_on_a_finding_shows_its_line() {
+        let mut app = picked_app();
+        update(&mut app, Action::ToggleExplain);
+        assert!(app.explain_open);
+        app.focus = Focus::Inspector;
+        let picked = app.picked.as_ref().unwrap();
+        let explanation = picked.explanation.ready().unwrap().clone();
+        // The second contribution (the first is usually the camera ray's own light).
+        let second = &explanation.contributions[1];
+        update(&mut app, Action::InspectorScroll(1));
+        assert_eq!(app.explain_selected, 1);
+        update(&mut app, Action::ExplainGo);
+        assert_eq!(app.focus, Focus::Tree);
+        let tree = &app.picked.as_ref().unwrap().tree;
+        assert_eq!(
+            Some(tree.selected()),
+            explain_view::contribution_ray(tree, second)
+        );
+        assert_ne!(tree.selected(), 0);
+
+        let Some(finding) = explanation.findings.first() else {
+            panic!("the glass pixel has findings: {explanation:#?}");
+        };
+        app.focus = Focus::Inspector;
+        update(&mut app, Action::InspectorScroll(i32::MIN));
+        update(
+            &mut app,
+            Action::InspectorScroll(explanation.contributions.len() as i32),
+        );
+        update(&mut app, Action::ExplainGo);
+        let (span, what) = app.source_focus.clone().expect("the finding's line");
+        assert_eq!(app.loaded.scene.sources.location(span), finding.location);
+        assert!(what.contains(finding.kind.name()));
+        // Moving in the tree shows the ray's definition again.
+        update(&mut app, Action::Step { forward: true });
+        assert_eq!(app.source_focus, None);
+        // The selection stops at the last entry.
+        update(&mut app, Action::InspectorScroll(1000));
+        assert_eq!(
+            app.explain_selected,
+            explanation.contributions.len() + explanation.findings.len() - 1
+        );
+    }
+
+    #[test]
+    fn follow_keys_without_a_tree_say_how_to_get_one() {
+        let mut app = App::new(
+            "scenes/whitted.scene".into(),
+            LoadedScene::new(whitted_scene()),
+            Rect::new(0, 0, 120, 40),
+            "/tmp/out".into(),
+        );
+        for action in [
+            Action::ToggleShowAll,
+            Action::FollowHeaviest,
+            Action::Step { forward: true },
+            Action::RunToEvent { forward: false },
+        ] {
+            update(&mut app, action);
+            assert!(app.message.as_ref().unwrap().text.contains("Enter"));
+        }
+    }
+
+    #[test]
+    fn run_to_event_says_what_it_found() {
+        let mut app = picked_app();
+        update(&mut app, Action::RunToEvent { forward: true });
+        let text = &app.message.as_ref().unwrap().text;
+        assert!(text.contains("in trace order"), "{text}");
+        assert_ne!(app.picked.as_ref().unwrap().tree.selected(), 0);
+        update(&mut app, Action::RunToEvent { forward: false });
+        update(&mut app, Action::RunToEvent { forward: false });
+        assert!(app
+            .message
+            .as_ref()
+            .unwrap()
+            .text
+            .contains("no event before"));
+    }
+}
