@@ -84,6 +84,15 @@ pub enum Action {
     ToggleSourceTarget,
     Reload,
     Export,
+    /// Shows the 3D ray view in the image pane, or the image again.
+    ToggleRayView,
+    /// Puts the 3D view's camera back at the scene's camera.
+    ResetRayView,
+    /// The mouse moved with the left button down, to this cell: orbits the 3D view.
+    Drag {
+        column: u16,
+        row: u16,
+    },
 }
 
 /// The keys `?` lists: (section, keys, what they do). Every binding in
@@ -95,9 +104,9 @@ pub const KEY_HELP: &[(&str, &str, &str)] = &[
     ("Image", "+ / -, wheel", "zoom in / out at the cursor"),
     ("Image", "Ctrl/Alt+arrows", "pan the view"),
     ("Image", "f", "fit the image to the pane"),
-    ("Image", "o", "overlay: rays per pixel"),
-    ("Image", "d", "overlay: deepest level"),
+    ("Image", "o / d", "overlay: rays / deepest level"),
     ("Image", "s", "mark the selected hit point"),
+    ("Image", "v", "3D ray view (keys in its title)"),
     ("Ray tree", "↑↓ jk", "previous / next ray"),
     ("Ray tree", "← h", "collapse, or go to the parent"),
     ("Ray tree", "→ l", "expand, or go to the first child"),
@@ -145,6 +154,7 @@ pub fn action_for_key(key: KeyEvent, focus: Focus, help_open: bool) -> Option<Ac
         KeyCode::Char('+' | '=') => Some(Action::ZoomIn),
         KeyCode::Char('-' | '_') => Some(Action::ZoomOut),
         KeyCode::Char('f') => Some(Action::Fit),
+        KeyCode::Char('v') => Some(Action::ToggleRayView),
         _ => None,
     };
     if global.is_some() {
@@ -181,6 +191,7 @@ fn image_key(code: KeyCode, shift: bool) -> Option<Action> {
         KeyCode::Char('K') => (0, -10),
         KeyCode::Char('J') => (0, 10),
         KeyCode::Enter => return Some(Action::TraceCursor),
+        KeyCode::Char('0') => return Some(Action::ResetRayView),
         _ => return None,
     };
     Some(Action::MoveCursor { dx, dy })
@@ -217,6 +228,7 @@ pub fn action_for_mouse(mouse: MouseEvent) -> Option<Action> {
     let (column, row) = (mouse.column, mouse.row);
     match mouse.kind {
         MouseEventKind::Down(MouseButton::Left) => Some(Action::Click { column, row }),
+        MouseEventKind::Drag(MouseButton::Left) => Some(Action::Drag { column, row }),
         MouseEventKind::ScrollUp => Some(Action::Wheel {
             column,
             row,

@@ -17,6 +17,7 @@ use crate::framebuffer::Framebuffer;
 use crate::heat_map::{HeatMap, HeatMapKind};
 use crate::image_view::{ColorDepth, Viewport};
 use crate::layout::{self, Panes};
+use crate::ray_view_state::{BackdropJob, BackdropRendered, RayViewState};
 use crate::trace_job::{TraceFailure, TraceJob, Traced};
 use crate::tree_view::TreeView;
 
@@ -159,6 +160,8 @@ pub struct App {
     pub traced_request_at: Option<Instant>,
     /// The node budget of recorded trees: `limits::MAX_RAY_TREE_NODES`.
     pub node_budget: usize,
+    /// The 3D ray view, when the image pane shows it instead of the image (`v`).
+    pub ray_view: Option<RayViewState>,
 }
 
 impl App {
@@ -195,6 +198,7 @@ impl App {
             trace_requests: 0,
             traced_request_at: None,
             node_budget: whitted_ir::limits::MAX_RAY_TREE_NODES,
+            ray_view: None,
         }
     }
 
@@ -305,6 +309,13 @@ impl App {
                         false,
                     );
                 }
+                // A 3D view not yet moved turns to orbit the new pixel's hit.
+                if self.ray_view.as_ref().is_some_and(|v| v.orbit.is_home()) {
+                    self.ray_view = Some(RayViewState::new(
+                        &self.loaded.scene.camera,
+                        Some(view.tree()),
+                    ));
+                }
                 self.picked = Some(Picked {
                     tree: view,
                     trace_time,
@@ -327,6 +338,31 @@ impl App {
                 format!("the tracer crashed on ({x}, {y}) (a bug in whitted): {message}"),
                 true,
             ),
+        }
+    }
+
+    /// Shows the 3D ray view in the image pane (from the scene's camera, orbiting the picked
+    /// pixel's first hit), or the image again.
+    pub fn toggle_ray_view(&mut self) {
+        self.ray_view = match self.ray_view {
+            Some(_) => None,
+            None => Some(RayViewState::new(
+                &self.loaded.scene.camera,
+                self.picked.as_ref().map(|p| p.tree.tree()),
+            )),
+        };
+    }
+
+    /// The backdrop render the 3D view needs now (after a move, a resize or a reload), if any.
+    pub fn backdrop_job(&mut self) -> Option<BackdropJob> {
+        let area = self.image_area()?;
+        let view = self.ray_view.as_mut()?;
+        view.backdrop_job(&self.loaded, &self.options, area.width, area.height)
+    }
+
+    pub fn apply_backdrop(&mut self, rendered: BackdropRendered) {
+        if let Some(view) = &mut self.ray_view {
+            view.apply_backdrop(rendered);
         }
     }
 

@@ -32,6 +32,8 @@ pub enum Event {
     Reloaded(Reloaded),
     /// A pixel's ray tree, recorded off the UI thread (or why not).
     Traced(crate::trace_job::Traced),
+    /// A backdrop of the 3D ray view, rendered off the UI thread (or cancelled).
+    Backdrop(crate::ray_view_state::BackdropRendered),
     /// A watched scene file changed on disk.
     FileChanged,
     /// The loop's timer: nothing arrived before the next deadline.

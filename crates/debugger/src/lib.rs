@@ -18,6 +18,7 @@ pub mod layout;
 pub mod orbit;
 pub mod projection;
 pub mod ray_view;
+pub mod ray_view_state;
 mod reload;
 mod render_job;
 mod run;
