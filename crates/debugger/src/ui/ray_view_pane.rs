@@ -25,7 +25,7 @@ const SHADOW_BLOCKED: [u8; 3] = [255, 40, 40];
 const SELECTED: [u8; 3] = [255, 0, 255];
 
 /// How bright the backdrop is drawn, so that the rays stand out against it.
-const BACKDROP_BRIGHTNESS: f32 = 0.55;
+const BACKDROP_BRIGHTNESS: f32 = 0.4;
 
 /// Rays that hit nothing (and shadow rays to directional lights) are drawn this many times
 /// the distance from the scene's camera to the point it looks at.
@@ -147,15 +147,20 @@ fn title(app: &App, width: u16) -> Line<'static> {
             format!(" of ({x}, {y})")
         })
         .unwrap_or_default();
-    let keys = if width >= 70 {
-        " · ←↑↓→ drag: orbit · +/-: zoom · 0: reset · v: image "
-    } else if width >= 52 {
-        " · ←↑↓→ orbit · +- zoom · 0 · v image "
-    } else {
-        " ←↑↓→ +- 0 v "
-    };
+    let name = format!(" 3D rays{pixel}");
+    // The longest list of keys that fits beside the name inside the corners.
+    let room = usize::from(width.saturating_sub(2)).saturating_sub(name.chars().count());
+    let keys = [
+        " · ←↑↓→ drag: orbit · +/-: zoom · 0: reset · v: image ",
+        " · ←↑↓→ orbit · +- zoom · 0 reset · v image ",
+        " ←↑↓→ orbit +- zoom 0 reset v image ",
+        " ←↑↓→ +- 0 v ",
+    ]
+    .into_iter()
+    .find(|keys| keys.chars().count() <= room)
+    .unwrap_or("");
     Line::from(vec![
-        Span::raw(format!(" 3D rays{pixel}")),
+        Span::raw(name),
         Span::styled(keys, Style::new().fg(Color::Gray)),
     ])
 }
@@ -167,8 +172,10 @@ fn legend(app: &App, width: u16) -> Line<'static> {
     }
     let names: [&str; 6] = if width >= 66 {
         ["camera", "reflected", "transmitted", "shadow", "blocked", "selected"]
-    } else {
+    } else if width >= 45 {
         ["cam", "refl", "trans", "shadow", "blocked", "sel"]
+    } else {
+        ["cam", "refl", "trans", "lit", "blocked", "sel"]
     };
     let colors = [CAMERA, REFLECTED, TRANSMITTED, SHADOW_LIT, SHADOW_BLOCKED, SELECTED];
     let mut spans = vec![Span::raw(" ")];
