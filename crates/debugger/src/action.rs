@@ -366,4 +366,26 @@ mod tests {
         );
         assert_eq!(action_for_mouse(mouse(MouseEventKind::Moved)), None);
     }
+
+    #[test]
+    fn v_shows_the_3d_view_0_resets_it_and_left_drags_orbit_it() {
+        assert_eq!(
+            action_for_key(key(KeyCode::Char('v')), Focus::Tree, false),
+            Some(Action::ToggleRayView)
+        );
+        assert_eq!(
+            action_for_key(key(KeyCode::Char('0')), Focus::Image, false),
+            Some(Action::ResetRayView)
+        );
+        let drag = MouseEvent {
+            kind: MouseEventKind::Drag(MouseButton::Left),
+            column: 7,
+            row: 2,
+            modifiers: KeyModifiers::NONE,
+        };
+        assert_eq!(
+            action_for_mouse(drag),
+            Some(Action::Drag { column: 7, row: 2 })
+        );
+    }
 }

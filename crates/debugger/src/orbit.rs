@@ -183,7 +183,11 @@ mod tests {
     fn yaw_by_a_full_turn_returns_to_the_start() {
         let mut orbit = OrbitCamera::new(home(), DVec3::new(0.0, 1.0, 0.0));
         orbit.orbit(std::f64::consts::TAU, 0.0);
-        assert!(close(orbit.camera().eye, home().eye), "{:?}", orbit.camera());
+        assert!(
+            close(orbit.camera().eye, home().eye),
+            "{:?}",
+            orbit.camera()
+        );
         assert!(close(orbit.camera().look_at, home().look_at));
         let mut stepped = OrbitCamera::new(home(), DVec3::new(0.0, 1.0, 0.0));
         for _ in 0..36 {
@@ -217,7 +221,10 @@ mod tests {
         orbit.orbit(0.0, 10.0);
         let forward = orbit.forward();
         assert!(forward.y < 0.0 && forward.y > -1.0, "{forward:?}");
-        assert!(orbit.camera().eye.y > 1.0, "the camera rose above the target");
+        assert!(
+            orbit.camera().eye.y > 1.0,
+            "the camera rose above the target"
+        );
         let before = orbit.forward();
         let distance = (orbit.camera().eye - orbit.target()).length();
         orbit.zoom(2.0);

@@ -56,7 +56,10 @@ pub fn segments(tree: &RayTree, miss_length: f64) -> Vec<Segment> {
             let (kind, to, ends_on_surface) = match node.kind {
                 RayKind::Shadow => match &node.shadow {
                     Some(shadow) if shadow.result == ShadowOutcome::Blocked => {
-                        let t = shadow.blocker.as_ref().map_or(miss_length, |b| f64::from(b.t));
+                        let t = shadow
+                            .blocker
+                            .as_ref()
+                            .map_or(miss_length, |b| f64::from(b.t));
                         (SegmentKind::ShadowBlocked, along(t), true)
                     }
                     Some(shadow) => {
@@ -117,10 +120,7 @@ impl ViewProjection {
         let forward = (camera.look_at - camera.eye)
             .try_normalize()
             .unwrap_or(DVec3::Z);
-        let right = forward
-            .cross(camera.up)
-            .try_normalize()
-            .unwrap_or(DVec3::X);
+        let right = forward.cross(camera.up).try_normalize().unwrap_or(DVec3::X);
         let up = right.cross(forward);
         let (half_height, perspective) = match camera.projection {
             Projection::Perspective {

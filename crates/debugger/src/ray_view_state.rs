@@ -264,7 +264,9 @@ mod tests {
         assert!(view.backdrop_job(&loaded, &options, 20, 8).is_none());
         view.orbit.orbit(0.5, 0.0);
         let old = view.backdrop_job(&loaded, &options, 20, 8).expect("moved");
-        let new = view.backdrop_job(&loaded, &options, 21, 8).expect("resized");
+        let new = view
+            .backdrop_job(&loaded, &options, 21, 8)
+            .expect("resized");
         assert!(old.cancel.load(Ordering::Relaxed));
         let stale = old.run();
         assert!(stale.backdrop.is_none(), "a cancelled render stops");

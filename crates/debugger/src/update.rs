@@ -86,7 +86,9 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
             app.toggle_ray_view();
             app.focus = Focus::Image;
         }
-        Action::ResetRayView => app.set_message("0 resets the 3D view's camera (v shows it)", false),
+        Action::ResetRayView => {
+            app.set_message("0 resets the 3D view's camera (v shows it)", false)
+        }
         // Drags only orbit the 3D view.
         Action::Drag { .. } => {}
     }
@@ -123,13 +125,20 @@ fn ray_view_action(app: &mut App, action: Action) -> bool {
         Action::ZoomIn => orbit.zoom(ZOOM_STEP),
         Action::ZoomOut => orbit.zoom(1.0 / ZOOM_STEP),
         Action::Wheel { column, row, lines } if inside(column, row) => {
-            orbit.zoom(if lines < 0 { ZOOM_STEP } else { 1.0 / ZOOM_STEP });
+            orbit.zoom(if lines < 0 {
+                ZOOM_STEP
+            } else {
+                1.0 / ZOOM_STEP
+            });
         }
         Action::Pan { columns, rows } => {
             // As a fraction of the view's height: a row is two of the backdrop's pixels,
             // a column one.
             let half_rows = f64::from(area.map_or(1, |a| a.height.max(1))) * 2.0;
-            orbit.pan(f64::from(columns) / half_rows, -f64::from(rows) * 2.0 / half_rows);
+            orbit.pan(
+                f64::from(columns) / half_rows,
+                -f64::from(rows) * 2.0 / half_rows,
+            );
         }
         Action::ResetRayView => orbit.reset(),
         Action::Click { column, row } if inside(column, row) && !app.help_open => {
@@ -569,5 +578,117 @@ mod tests {
         assert_eq!(app.inspector_scroll, 7);
         update(&mut app, Action::InspectorScroll(i32::MIN));
         assert_eq!(app.inspector_scroll, 0);
+    }
+
+    #[test]
+    fn in_the_3d_view_arrows_orbit_zoom_pans_and_0_resets_to_the_scene_camera() {
+        let mut app = picked_app();
+        let scene_camera = app.loaded.scene.camera.clone();
+        update(&mut app, Action::ToggleRayView);
+        let view = app.ray_view.as_ref().expect("the 3D view is shown");
+        assert_eq!(
+            view.orbit.camera(),
+            &scene_camera,
+            "it starts at the scene's camera"
+        );
+        let hit = app
+            .picked
+            .as_ref()
+            .unwrap()
+            .tree
+            .node(0)
+            .unwrap()
+            .hit
+            .clone()
+            .unwrap();
+        let target = view.orbit.target();
+        assert!(
+            (target.x - f64::from(hit.point[0])).abs() < 1e-6,
+            "it orbits the hit"
+        );
+        let cursor = app.cursor;
+        update(&mut app, Action::MoveCursor { dx: 1, dy: 0 });
+        update(&mut app, Action::ZoomIn);
+        update(
+            &mut app,
+            Action::Pan {
+                columns: 4,
+                rows: 0,
+            },
+        );
+        assert_eq!(app.cursor, cursor, "the cursor stays");
+        let moved = app.ray_view.as_ref().unwrap().orbit.camera().clone();
+        assert_ne!(moved, scene_camera);
+        update(&mut app, Action::ResetRayView);
+        assert_eq!(app.ray_view.as_ref().unwrap().orbit.camera(), &scene_camera);
+        update(&mut app, Action::ToggleRayView);
+        assert!(app.ray_view.is_none());
+        update(&mut app, Action::MoveCursor { dx: 1, dy: 0 });
+        assert_eq!(
+            app.cursor,
+            (cursor.0 + 1, cursor.1),
+            "the image's keys are back"
+        );
+    }
+
+    #[test]
+    fn a_drag_that_starts_in_the_3d_view_orbits_it_and_a_click_there_picks_nothing() {
+        let mut app = picked_app();
+        update(&mut app, Action::ToggleRayView);
+        let image = app.image_area().unwrap();
+        let tree = layout::inner(app.panes().unwrap().tree);
+        let start = app.ray_view.as_ref().unwrap().orbit.camera().clone();
+        // A drag from outside the pane does nothing.
+        update(
+            &mut app,
+            Action::Click {
+                column: tree.x + 1,
+                row: tree.y + 1,
+            },
+        );
+        update(
+            &mut app,
+            Action::Drag {
+                column: image.x + 9,
+                row: image.y + 3,
+            },
+        );
+        assert_eq!(app.ray_view.as_ref().unwrap().orbit.camera(), &start);
+        let requests = app.trace_requests;
+        update(
+            &mut app,
+            Action::Click {
+                column: image.x + 5,
+                row: image.y + 3,
+            },
+        );
+        assert_eq!(app.trace_requests, requests, "no pixel is picked");
+        update(
+            &mut app,
+            Action::Drag {
+                column: image.x + 9,
+                row: image.y + 3,
+            },
+        );
+        let dragged = app.ray_view.as_ref().unwrap().orbit.camera().clone();
+        assert_ne!(dragged, start);
+        assert!(
+            (dragged.eye.y - start.eye.y).abs() < 1e-9,
+            "a sideways drag only yaws"
+        );
+        // The wheel zooms towards the target.
+        let target = app.ray_view.as_ref().unwrap().orbit.target();
+        let distance =
+            |app: &App| (app.ray_view.as_ref().unwrap().orbit.camera().eye - target).length();
+        let before = distance(&app);
+        update(
+            &mut app,
+            Action::Wheel {
+                column: image.x + 2,
+                row: image.y + 2,
+                lines: -1,
+            },
+        );
+        assert!(distance(&app) < before);
     }
 }

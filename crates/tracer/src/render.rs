@@ -235,7 +235,13 @@ pub(crate) fn trace_sample<R: Recorder>(
 
 /// The camera ray of sample `sample` of pixel `(x, y)`.
 #[inline]
-fn camera_ray(camera: &PreparedCamera, options: &RenderOptions, x: u32, y: u32, sample: u32) -> Ray {
+fn camera_ray(
+    camera: &PreparedCamera,
+    options: &RenderOptions,
+    x: u32,
+    y: u32,
+    sample: u32,
+) -> Ray {
     let (dx, dy) = sample_offset(x, y, sample, options.samples());
     camera.ray(x as f32 + dx, y as f32 + dy, options.width, options.height)
 }

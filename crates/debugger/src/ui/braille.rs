@@ -77,7 +77,8 @@ impl BrailleCanvas {
     pub fn draw(&self, area: Rect, buf: &mut Buffer, background: impl Fn(u16, u16) -> Color) {
         for row in 0..self.rows.min(area.height) {
             for column in 0..self.columns.min(area.width) {
-                let cell = self.cells[usize::from(row) * usize::from(self.columns) + usize::from(column)];
+                let cell =
+                    self.cells[usize::from(row) * usize::from(self.columns) + usize::from(column)];
                 let Some(color) = cell.color else { continue };
                 let Some(target) = buf.cell_mut((area.x + column, area.y + row)) else {
                     continue;

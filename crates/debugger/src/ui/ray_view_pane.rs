@@ -88,7 +88,12 @@ pub fn draw(app: &App, view: &RayViewState, pane: Rect, buf: &mut Buffer) {
             // Thick: the line and its neighbours one dot right and one down.
             let color = depth.color(SELECTED);
             for (ox, oy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)] {
-                canvas.line((from.0 + ox, from.1 + oy), (to.0 + ox, to.1 + oy), color, true);
+                canvas.line(
+                    (from.0 + ox, from.1 + oy),
+                    (to.0 + ox, to.1 + oy),
+                    color,
+                    true,
+                );
             }
         } else {
             canvas.line(from, to, depth.color(kind_color(ray.kind)), false);
@@ -171,13 +176,27 @@ fn legend(app: &App, width: u16) -> Line<'static> {
         return Line::from(" no ray tree yet: Enter traces the cursor pixel ");
     }
     let names: [&str; 6] = if width >= 66 {
-        ["camera", "reflected", "transmitted", "shadow", "blocked", "selected"]
+        [
+            "camera",
+            "reflected",
+            "transmitted",
+            "shadow",
+            "blocked",
+            "selected",
+        ]
     } else if width >= 45 {
         ["cam", "refl", "trans", "shadow", "blocked", "sel"]
     } else {
         ["cam", "refl", "trans", "lit", "blocked", "sel"]
     };
-    let colors = [CAMERA, REFLECTED, TRANSMITTED, SHADOW_LIT, SHADOW_BLOCKED, SELECTED];
+    let colors = [
+        CAMERA,
+        REFLECTED,
+        TRANSMITTED,
+        SHADOW_LIT,
+        SHADOW_BLOCKED,
+        SELECTED,
+    ];
     let mut spans = vec![Span::raw(" ")];
     for (name, color) in names.iter().zip(colors) {
         let [r, g, b] = color;

@@ -193,7 +193,10 @@ fn glass_pixel_in_3d(width: u16, height: u16) -> App {
     for _ in 0..3 {
         update(&mut app, Action::MoveCursor { dx: 0, dy: -1 });
     }
-    assert_eq!(app.cursor, GLASS_PIXEL, "arrows orbit the view, not the cursor");
+    assert_eq!(
+        app.cursor, GLASS_PIXEL,
+        "arrows orbit the view, not the cursor"
+    );
     let job = app.backdrop_job().expect("a backdrop to render");
     app.apply_backdrop(job.run());
     assert!(app.backdrop_job().is_none(), "the backdrop is current");
