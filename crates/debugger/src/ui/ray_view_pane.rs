@@ -25,7 +25,7 @@ const SHADOW_BLOCKED: [u8; 3] = [255, 40, 40];
 const SELECTED: [u8; 3] = [255, 0, 255];
 
 /// How bright the backdrop is drawn, so that the rays stand out against it.
-const BACKDROP_BRIGHTNESS: f32 = 0.4;
+const BACKDROP_BRIGHTNESS: f32 = 0.25;
 
 /// Rays that hit nothing (and shadow rays to directional lights) are drawn this many times
 /// the distance from the scene's camera to the point it looks at.
