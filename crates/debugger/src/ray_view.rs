@@ -141,7 +141,7 @@ impl ViewProjection {
     }
 
     /// A point in camera space: (right, up, depth).
-    fn to_camera(&self, point: DVec3) -> DVec3 {
+    fn camera_space(&self, point: DVec3) -> DVec3 {
         let offset = point - self.eye;
         DVec3::new(
             offset.dot(self.right),
@@ -151,7 +151,7 @@ impl ViewProjection {
     }
 
     /// A camera-space point (in front of the near plane) on the grid.
-    fn to_grid(&self, p: DVec3) -> (f64, f64) {
+    fn grid_point(&self, p: DVec3) -> (f64, f64) {
         let aspect = self.width / self.height;
         let scale = if self.perspective {
             self.half_height * p.z
@@ -166,17 +166,18 @@ impl ViewProjection {
     /// Where `point` lands on the grid; `None` behind the near plane (perspective only: an
     /// orthographic view sees behind its eye as well).
     pub fn project(&self, point: DVec3) -> Option<(f64, f64)> {
-        let p = self.to_camera(point);
-        if self.perspective && !(p.z >= NEAR) {
+        let p = self.camera_space(point);
+        // NaN depths fail the test too.
+        if self.perspective && p.z.partial_cmp(&NEAR).is_none_or(|o| o.is_lt()) {
             return None;
         }
-        Some(self.to_grid(p))
+        Some(self.grid_point(p))
     }
 
     /// The part of the segment `a`–`b` in front of the near plane and on the grid, as grid
     /// points; `None` when no part of it is.
     pub fn project_segment(&self, a: DVec3, b: DVec3) -> Option<((f64, f64), (f64, f64))> {
-        let (mut pa, mut pb) = (self.to_camera(a), self.to_camera(b));
+        let (mut pa, mut pb) = (self.camera_space(a), self.camera_space(b));
         if !(pa.is_finite() && pb.is_finite()) {
             return None;
         }
@@ -196,7 +197,12 @@ impl ViewProjection {
                 }
             }
         }
-        clip_to_rect(self.to_grid(pa), self.to_grid(pb), self.width, self.height)
+        clip_to_rect(
+            self.grid_point(pa),
+            self.grid_point(pb),
+            self.width,
+            self.height,
+        )
     }
 }
 
@@ -228,7 +234,7 @@ pub fn clip_to_rect(
             }
         }
     }
-    if !(enter <= leave) {
+    if enter.partial_cmp(&leave).is_none_or(|o| o.is_gt()) {
         return None;
     }
     let at = |t: f64| (a.0 + dx * t, a.1 + dy * t);
