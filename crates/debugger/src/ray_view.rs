@@ -31,9 +31,6 @@ pub struct Segment {
     pub kind: SegmentKind,
     pub from: DVec3,
     pub to: DVec3,
-    /// Whether the ray ends at a surface (a hit or a blocker) rather than at its light or
-    /// nowhere (a miss, drawn to a fixed length).
-    pub ends_on_surface: bool,
 }
 
 fn vector(v: [f32; 3]) -> DVec3 {
@@ -53,20 +50,20 @@ pub fn segments(tree: &RayTree, miss_length: f64) -> Vec<Segment> {
             let from = vector(node.origin);
             let direction = vector(node.direction);
             let along = |t: f64| from + direction * t;
-            let (kind, to, ends_on_surface) = match node.kind {
+            let (kind, to) = match node.kind {
                 RayKind::Shadow => match &node.shadow {
                     Some(shadow) if shadow.result == ShadowOutcome::Blocked => {
                         let t = shadow
                             .blocker
                             .as_ref()
                             .map_or(miss_length, |b| f64::from(b.t));
-                        (SegmentKind::ShadowBlocked, along(t), true)
+                        (SegmentKind::ShadowBlocked, along(t))
                     }
                     Some(shadow) => {
                         let t = shadow.max_t.map_or(miss_length, f64::from);
-                        (SegmentKind::ShadowLit, along(t), false)
+                        (SegmentKind::ShadowLit, along(t))
                     }
-                    None => (SegmentKind::ShadowLit, along(miss_length), false),
+                    None => (SegmentKind::ShadowLit, along(miss_length)),
                 },
                 other => {
                     let kind = match other {
@@ -75,8 +72,8 @@ pub fn segments(tree: &RayTree, miss_length: f64) -> Vec<Segment> {
                         _ => SegmentKind::Camera,
                     };
                     match &node.hit {
-                        Some(hit) => (kind, vector(hit.point), true),
-                        None => (kind, along(miss_length), false),
+                        Some(hit) => (kind, vector(hit.point)),
+                        None => (kind, along(miss_length)),
                     }
                 }
             };
@@ -86,7 +83,6 @@ pub fn segments(tree: &RayTree, miss_length: f64) -> Vec<Segment> {
                     kind,
                     from,
                     to,
-                    ends_on_surface,
                 });
             }
             id += 1;

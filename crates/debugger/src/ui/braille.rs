@@ -34,11 +34,6 @@ impl BrailleCanvas {
         }
     }
 
-    /// The size in dots.
-    pub fn dots(&self) -> (f64, f64) {
-        (f64::from(self.columns) * 2.0, f64::from(self.rows) * 4.0)
-    }
-
     /// Sets the dot at (`x`, `y`) (dots from the top left); outside the grid it is ignored.
     pub fn dot(&mut self, x: i64, y: i64, color: Color, bold: bool) {
         let (column, row) = (x.div_euclid(2), y.div_euclid(4));

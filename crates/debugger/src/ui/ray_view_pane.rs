@@ -7,9 +7,10 @@ use ratatui::layout::Rect;
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::Widget;
+use whitted_ir::LightKind;
 use whitted_tracer::display::linear_to_srgb8_rgb;
 
-use crate::app::App;
+use crate::app::{App, Picked};
 use crate::image_view::ColorDepth;
 use crate::ray_view::{segments, SegmentKind, ViewProjection};
 use crate::ray_view_state::{Backdrop, RayViewState};
@@ -23,6 +24,7 @@ const TRANSMITTED: [u8; 3] = [255, 170, 0];
 const SHADOW_LIT: [u8; 3] = [40, 255, 40];
 const SHADOW_BLOCKED: [u8; 3] = [255, 40, 40];
 const SELECTED: [u8; 3] = [255, 0, 255];
+const LIGHT: [u8; 3] = [255, 255, 120];
 
 /// How bright the backdrop is drawn, so that the rays stand out against it.
 const BACKDROP_BRIGHTNESS: f32 = 0.25;
@@ -69,17 +71,32 @@ pub fn draw(app: &App, view: &RayViewState, pane: Rect, buf: &mut Buffer) {
     let backdrop = view.backdrop.as_ref();
     draw_backdrop(backdrop, depth, area, buf);
 
-    let Some(picked) = &app.picked else {
-        return;
-    };
+    let (width, height) = (f64::from(area.width) * 2.0, f64::from(area.height) * 4.0);
+    let projection = ViewProjection::new(view.orbit.camera(), width, height);
+    if let Some(picked) = &app.picked {
+        draw_rays(app, view, picked, &projection, area, buf);
+    }
+    // Over the rays, so that the shadow rays can be seen to end at them.
+    draw_lights(app, &projection, area, buf);
+}
+
+/// The picked pixel's rays in braille over the backdrop, the selected one thick.
+fn draw_rays(
+    app: &App,
+    view: &RayViewState,
+    picked: &Picked,
+    projection: &ViewProjection,
+    area: Rect,
+    buf: &mut Buffer,
+) {
+    let depth = app.color_depth;
+    let backdrop = view.backdrop.as_ref();
     let tree = &picked.tree;
     let camera = &app.loaded.scene.camera;
     let miss_length = ((camera.look_at - camera.eye).length() * MISS_LENGTH).max(1.0);
     let mut rays = segments(tree.tree(), miss_length);
     rays.sort_by_key(|s| (s.node == tree.selected(), draw_rank(s.kind)));
     let mut canvas = BrailleCanvas::new(area.width, area.height);
-    let (width, height) = canvas.dots();
-    let projection = ViewProjection::new(view.orbit.camera(), width, height);
     for ray in &rays {
         let Some((from, to)) = projection.project_segment(ray.from, ray.to) else {
             continue;
@@ -102,6 +119,34 @@ pub fn draw(app: &App, view: &RayViewState, pane: Rect, buf: &mut Buffer) {
     canvas.draw(area, buf, |column, row| {
         cell_background(backdrop, depth, column, row)
     });
+}
+
+/// Each point and spot light as a star where it is in view, so that the shadow rays
+/// towards it can be seen to reach it.
+fn draw_lights(app: &App, projection: &ViewProjection, area: Rect, buf: &mut Buffer) {
+    let style = Style::new()
+        .fg(app.color_depth.color(LIGHT))
+        .add_modifier(Modifier::BOLD);
+    for (_, light) in app.loaded.scene.lights.iter() {
+        let position = match light.kind {
+            LightKind::Point { position, .. } | LightKind::Spot { position, .. } => position,
+            LightKind::Directional { .. } => continue,
+        };
+        let Some((x, y)) = projection.project(position) else {
+            continue;
+        };
+        // Dots to cells: two dots across and four down per cell.
+        let (column, row) = ((x / 2.0).floor(), (y / 4.0).floor());
+        if column >= 0.0
+            && row >= 0.0
+            && column < f64::from(area.width)
+            && row < f64::from(area.height)
+        {
+            if let Some(cell) = buf.cell_mut((area.x + column as u16, area.y + row as u16)) {
+                cell.set_char('✶').set_style(style);
+            }
+        }
+    }
 }
 
 fn dimmed(linear: [f32; 3]) -> [u8; 3] {
@@ -205,4 +250,47 @@ fn legend(app: &App, width: u16) -> Line<'static> {
         spans.push(Span::raw(format!("{name} ")));
     }
     Line::from(spans)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::app::LoadedScene;
+    use crate::test_scene::whitted_scene;
+    use whitted_ir::{Camera, DVec3, Projection};
+
+    /// A camera looking straight at the sun sees its star in the middle of the pane; one
+    /// looking away does not.
+    #[test]
+    fn a_point_light_in_view_is_drawn_as_a_star() {
+        let app = App::new(
+            "scenes/whitted.scene".into(),
+            LoadedScene::new(whitted_scene()),
+            Rect::new(0, 0, 120, 40),
+            "/tmp".into(),
+        );
+        let sun = DVec3::new(-6.0, 10.0, -8.0);
+        let area = Rect::new(0, 0, 21, 11);
+        let star_cells = |look_at: DVec3| {
+            let camera = Camera {
+                eye: sun - DVec3::new(0.0, 0.0, 5.0),
+                look_at,
+                up: DVec3::Y,
+                projection: Projection::Perspective {
+                    vertical_fov_degrees: 45.0,
+                },
+            };
+            let projection = ViewProjection::new(&camera, 42.0, 44.0);
+            let mut buf = Buffer::empty(area);
+            draw_lights(&app, &projection, area, &mut buf);
+            buf.content()
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| c.symbol() == "✶")
+                .map(|(i, _)| i)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(star_cells(sun), vec![5 * 21 + 10]);
+        assert!(star_cells(sun - DVec3::new(0.0, 0.0, 10.0)).is_empty());
+    }
 }
