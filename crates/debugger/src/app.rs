@@ -457,6 +457,13 @@ impl App {
                 }
                 self.pixel_stats = None;
                 self.heat_map = None;
+                // A 3D view not yet moved follows the scene's (possibly new) camera.
+                if self.ray_view.as_ref().is_some_and(|v| v.orbit.is_home()) {
+                    self.ray_view = Some(RayViewState::new(
+                        &self.loaded.scene.camera,
+                        self.picked.as_ref().map(|p| p.tree.tree()),
+                    ));
+                }
                 let retrace = self.retrace_picked();
                 let note = match warnings {
                     0 => String::new(),
@@ -714,5 +721,29 @@ mod tests {
             app.picked.as_ref().map(|p| p.tree.tree().pixel),
             Some([10, 10])
         );
+    }
+
+    /// The 3D view follows a reloaded scene's camera until it is moved, and a moved view
+    /// stays where the user put it; either way its backdrop is rendered again.
+    #[test]
+    fn a_reload_moves_an_unmoved_3d_view_to_the_new_camera_and_rerenders_its_backdrop() {
+        let mut app = app();
+        app.toggle_ray_view();
+        let job = app.backdrop_job().expect("a backdrop");
+        app.apply_backdrop(job.run());
+        assert!(app.backdrop_job().is_none());
+        let mut moved_camera = whitted_scene().into_inner();
+        moved_camera.camera.eye.y += 2.0;
+        let new_camera = moved_camera.camera.clone();
+        let reloaded = whitted_ir::validate(moved_camera).unwrap();
+        app.apply_reload(Ok((LoadedScene::new(reloaded.clone()), 0)));
+        let view = app.ray_view.as_ref().expect("still shown");
+        assert_eq!(view.orbit.camera(), &new_camera);
+        assert!(app.backdrop_job().is_some(), "the new scene is rendered");
+
+        app.ray_view.as_mut().unwrap().orbit.orbit(0.3, 0.0);
+        let orbited = app.ray_view.as_ref().unwrap().orbit.camera().clone();
+        app.apply_reload(Ok((LoadedScene::new(reloaded), 0)));
+        assert_eq!(app.ray_view.as_ref().unwrap().orbit.camera(), &orbited);
     }
 }
