@@ -503,3 +503,116 @@ fn a_course_scene_shows_its_txt_lines() {
         s.contains("debugger exited with 0")
     });
 }
+
+/// The left pane (the image or the 3D view) of a 120-column screen: its first 60 characters
+/// of every line.
+fn left_pane(screen: &str) -> String {
+    screen
+        .lines()
+        .map(|line| line.chars().take(60).collect::<String>() + "\n")
+        .collect()
+}
+
+/// Whether the 3D view is fully drawn: its title, its whole legend on the bottom border
+/// (written after the rows above it), and no backdrop render under way.
+fn ray_view_done(screen: &str) -> bool {
+    screen.contains("3D rays of (400, 270)")
+        && line_with(screen, "━cam").contains("━sel")
+        && !screen.contains("rendering the view")
+}
+
+/// Waits for `ready`, then until the screen stays the same for a moment: keys sent in a
+/// burst each redraw the view, and the last of them is wanted.
+fn wait_settled(tmux: &Tmux, what: &str, ready: impl Fn(&str) -> bool) -> String {
+    loop {
+        let screen = tmux.wait_for(what, &ready);
+        std::thread::sleep(Duration::from_millis(300));
+        if tmux.screen() == screen {
+            return screen;
+        }
+    }
+}
+
+fn braille_count(text: &str) -> usize {
+    text.chars()
+        .filter(|c| ('\u{2801}'..='\u{28ff}').contains(c))
+        .count()
+}
+
+#[test]
+fn the_3d_view_shows_the_glass_pixels_rays_from_an_orbited_camera() {
+    let scene = repository().join("scenes/whitted.scene");
+    let command = format!(
+        "COLORTERM=truecolor '{}' debug '{}' --pixel 400,270",
+        whitted(),
+        scene.display()
+    );
+    let tmux = Tmux::start("rays3d", &repository(), &command, 120, 40);
+    tmux.wait_for("the tree of the glass pixel", |s| {
+        s.contains("Ray tree of (400, 270)") && s.contains("rendered in")
+    });
+    tmux.keys(&["v"]);
+    let home = wait_settled(&tmux, "the 3D view from the scene's camera", ray_view_done);
+    assert!(!home.contains("Image 640×480"), "{home}");
+    let legend = line_with(&home, "━cam");
+    for name in ["refl", "trans", "shadow", "blocked", "sel"] {
+        assert!(
+            legend.contains(&format!("━{name}")),
+            "legend: {legend}\n{home}"
+        );
+    }
+    assert!(
+        line_with(&home, "3D rays").contains("orbit"),
+        "the title says the keys:\n{home}"
+    );
+
+    // Orbit 60° to the right and 15° up: the rays are seen from the side.
+    tmux.keys(&["Right"; 12]);
+    tmux.keys(&["Up"; 3]);
+    let orbited = wait_settled(&tmux, "the orbited view", |s| {
+        left_pane(s) != left_pane(&home) && ray_view_done(s)
+    });
+    let drawn = braille_count(&left_pane(&orbited));
+    assert!(drawn > 30, "{drawn} braille cells:\n{orbited}");
+    let colored = tmux.run(&["capture-pane", "-e", "-p", "-t", &tmux.session]);
+    let colored = String::from_utf8_lossy(&colored.stdout);
+    for (name, rgb) in [
+        ("selected camera", "255;0;255"),
+        ("reflected", "0;230;255"),
+        ("transmitted", "255;170;0"),
+        ("lit shadow", "40;255;40"),
+        ("blocked shadow", "255;40;40"),
+    ] {
+        assert!(
+            colored.contains(&format!("38;2;{rgb}m")),
+            "no {name} ray in its colour:\n{orbited}"
+        );
+    }
+
+    // A drag with the left button orbits too (SGR mouse reports, as a terminal sends them).
+    let press = |kind: u8, column: u16, release: bool| {
+        let end = if release { 'm' } else { 'M' };
+        let report = format!("\x1b[<{kind};{column};10{end}");
+        tmux.run(&["send-keys", "-t", &tmux.session, "-l", &report]);
+    };
+    press(0, 20, false);
+    for column in 21..=30 {
+        press(32, column, false);
+    }
+    press(0, 30, true);
+    wait_settled(&tmux, "the dragged view", |s| {
+        left_pane(s) != left_pane(&orbited) && ray_view_done(s)
+    });
+
+    // 0 puts the camera back: the very frame the view opened with.
+    tmux.keys(&["0"]);
+    tmux.wait_for("the scene's camera again", |s| {
+        left_pane(s) == left_pane(&home)
+    });
+    tmux.keys(&["v"]);
+    tmux.wait_for("the image again", |s| s.contains("Image 640×480"));
+    tmux.keys(&["q"]);
+    tmux.wait_for("the shell after quitting", |s| {
+        s.contains("debugger exited with 0")
+    });
+}

@@ -100,6 +100,15 @@ pub enum Action {
     },
     /// Enter in the explanation: goes to the selected entry's ray or source line.
     ExplainGo,
+    /// Shows the 3D ray view in the image pane, or the image again.
+    ToggleRayView,
+    /// Puts the 3D view's camera back at the scene's camera.
+    ResetRayView,
+    /// The mouse moved with the left button down, to this cell: orbits the 3D view.
+    Drag {
+        column: u16,
+        row: u16,
+    },
 }
 
 /// The keys `?` lists: (section, keys, what they do). Every binding in
@@ -111,8 +120,9 @@ pub const KEY_HELP: &[(&str, &str, &str)] = &[
     ("Image", "+ / -, wheel", "zoom in / out at the cursor"),
     ("Image", "Ctrl/Alt+arrows", "pan the view"),
     ("Image", "f", "fit the image to the pane"),
-    ("Image", "o  d", "overlay: rays / deepest level"),
+    ("Image", "o / d", "overlay: rays / deepest level"),
     ("Image", "s", "mark the selected hit point"),
+    ("Image", "v", "3D ray view (keys in its title)"),
     ("Ray tree", "↑↓ jk", "previous / next ray"),
     ("Ray tree", "← h", "collapse, or go to the parent"),
     ("Ray tree", "→ l", "expand, or go to the first child"),
@@ -168,6 +178,7 @@ pub fn action_for_key(key: KeyEvent, focus: Focus, help_open: bool) -> Option<Ac
         KeyCode::Char('[') => Some(Action::Step { forward: false }),
         KeyCode::Char('}') => Some(Action::RunToEvent { forward: true }),
         KeyCode::Char('{') => Some(Action::RunToEvent { forward: false }),
+        KeyCode::Char('v') => Some(Action::ToggleRayView),
         _ => None,
     };
     if global.is_some() {
@@ -204,6 +215,7 @@ fn image_key(code: KeyCode, shift: bool) -> Option<Action> {
         KeyCode::Char('K') => (0, -10),
         KeyCode::Char('J') => (0, 10),
         KeyCode::Enter => return Some(Action::TraceCursor),
+        KeyCode::Char('0') => return Some(Action::ResetRayView),
         _ => return None,
     };
     Some(Action::MoveCursor { dx, dy })
@@ -241,6 +253,7 @@ pub fn action_for_mouse(mouse: MouseEvent) -> Option<Action> {
     let (column, row) = (mouse.column, mouse.row);
     match mouse.kind {
         MouseEventKind::Down(MouseButton::Left) => Some(Action::Click { column, row }),
+        MouseEventKind::Drag(MouseButton::Left) => Some(Action::Drag { column, row }),
         MouseEventKind::ScrollUp => Some(Action::Wheel {
             column,
             row,
@@ -402,5 +415,27 @@ mod tests {
             })
         );
         assert_eq!(action_for_mouse(mouse(MouseEventKind::Moved)), None);
+    }
+
+    #[test]
+    fn v_shows_the_3d_view_0_resets_it_and_left_drags_orbit_it() {
+        assert_eq!(
+            action_for_key(key(KeyCode::Char('v')), Focus::Tree, false),
+            Some(Action::ToggleRayView)
+        );
+        assert_eq!(
+            action_for_key(key(KeyCode::Char('0')), Focus::Image, false),
+            Some(Action::ResetRayView)
+        );
+        let drag = MouseEvent {
+            kind: MouseEventKind::Drag(MouseButton::Left),
+            column: 7,
+            row: 2,
+            modifiers: KeyModifiers::NONE,
+        };
+        assert_eq!(
+            action_for_mouse(drag),
+            Some(Action::Drag { column: 7, row: 2 })
+        );
     }
 }

@@ -17,6 +17,7 @@ use crate::framebuffer::Framebuffer;
 use crate::heat_map::{HeatMap, HeatMapKind};
 use crate::image_view::{ColorDepth, Viewport};
 use crate::layout::{self, Panes};
+use crate::ray_view_state::{BackdropJob, BackdropRendered, RayViewState};
 use crate::trace_job::{Explained, TraceFailure, TraceJob, Traced};
 use crate::tree_view::TreeView;
 
@@ -187,6 +188,8 @@ pub struct App {
     /// A line the source pane shows instead of the selected ray's definition (a finding's,
     /// after Enter in the explanation) and what to call it; cleared when the ray changes.
     pub source_focus: Option<(whitted_ir::Span, String)>,
+    /// The 3D ray view, when the image pane shows it instead of the image (`v`).
+    pub ray_view: Option<RayViewState>,
 }
 
 impl App {
@@ -226,6 +229,7 @@ impl App {
             explain_open: false,
             explain_selected: 0,
             source_focus: None,
+            ray_view: None,
         }
     }
 
@@ -338,6 +342,13 @@ impl App {
                         false,
                     );
                 }
+                // A 3D view not yet moved turns to orbit the new pixel's hit.
+                if self.ray_view.as_ref().is_some_and(|v| v.orbit.is_home()) {
+                    self.ray_view = Some(RayViewState::new(
+                        &self.loaded.scene.camera,
+                        Some(view.tree()),
+                    ));
+                }
                 self.picked = Some(Picked {
                     tree: view,
                     trace_time,
@@ -382,6 +393,31 @@ impl App {
             }
             Err(message) => ExplanationState::Failed(message),
         };
+    }
+
+    /// Shows the 3D ray view in the image pane (from the scene's camera, orbiting the picked
+    /// pixel's first hit), or the image again.
+    pub fn toggle_ray_view(&mut self) {
+        self.ray_view = match self.ray_view {
+            Some(_) => None,
+            None => Some(RayViewState::new(
+                &self.loaded.scene.camera,
+                self.picked.as_ref().map(|p| p.tree.tree()),
+            )),
+        };
+    }
+
+    /// The backdrop render the 3D view needs now (after a move, a resize or a reload), if any.
+    pub fn backdrop_job(&mut self) -> Option<BackdropJob> {
+        let area = self.image_area()?;
+        let view = self.ray_view.as_mut()?;
+        view.backdrop_job(&self.loaded, &self.options, area.width, area.height)
+    }
+
+    pub fn apply_backdrop(&mut self, rendered: BackdropRendered) {
+        if let Some(view) = &mut self.ray_view {
+            view.apply_backdrop(rendered);
+        }
     }
 
     /// Called by the event loop when it starts a render with this generation number.
@@ -475,6 +511,13 @@ impl App {
                 }
                 self.pixel_stats = None;
                 self.heat_map = None;
+                // A 3D view not yet moved follows the scene's (possibly new) camera.
+                if self.ray_view.as_ref().is_some_and(|v| v.orbit.is_home()) {
+                    self.ray_view = Some(RayViewState::new(
+                        &self.loaded.scene.camera,
+                        self.picked.as_ref().map(|p| p.tree.tree()),
+                    ));
+                }
                 let retrace = self.retrace_picked();
                 let note = match warnings {
                     0 => String::new(),
@@ -732,5 +775,29 @@ mod tests {
             app.picked.as_ref().map(|p| p.tree.tree().pixel),
             Some([10, 10])
         );
+    }
+
+    /// The 3D view follows a reloaded scene's camera until it is moved, and a moved view
+    /// stays where the user put it; either way its backdrop is rendered again.
+    #[test]
+    fn a_reload_moves_an_unmoved_3d_view_to_the_new_camera_and_rerenders_its_backdrop() {
+        let mut app = app();
+        app.toggle_ray_view();
+        let job = app.backdrop_job().expect("a backdrop");
+        app.apply_backdrop(job.run());
+        assert!(app.backdrop_job().is_none());
+        let mut moved_camera = whitted_scene().into_inner();
+        moved_camera.camera.eye.y += 2.0;
+        let new_camera = moved_camera.camera.clone();
+        let reloaded = whitted_ir::validate(moved_camera).unwrap();
+        app.apply_reload(Ok((LoadedScene::new(reloaded.clone()), 0)));
+        let view = app.ray_view.as_ref().expect("still shown");
+        assert_eq!(view.orbit.camera(), &new_camera);
+        assert!(app.backdrop_job().is_some(), "the new scene is rendered");
+
+        app.ray_view.as_mut().unwrap().orbit.orbit(0.3, 0.0);
+        let orbited = app.ray_view.as_ref().unwrap().orbit.camera().clone();
+        app.apply_reload(Ok((LoadedScene::new(reloaded), 0)));
+        assert_eq!(app.ray_view.as_ref().unwrap().orbit.camera(), &orbited);
     }
 }

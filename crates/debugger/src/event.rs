@@ -34,6 +34,8 @@ pub enum Event {
     Traced(crate::trace_job::Traced),
     /// The explanation of a traced pixel's tree, worked out after it on the same worker.
     Explained(crate::trace_job::Explained),
+    /// A backdrop of the 3D ray view, rendered off the UI thread (or cancelled).
+    Backdrop(crate::ray_view_state::BackdropRendered),
     /// A watched scene file changed on disk.
     FileChanged,
     /// The loop's timer: nothing arrived before the next deadline.

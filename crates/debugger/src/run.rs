@@ -173,6 +173,10 @@ fn event_loop(
     // When the batch being drawn picked a pixel: when its first event arrived.
     let mut picked_at: Option<Instant> = None;
     loop {
+        if let Some(job) = app.backdrop_job() {
+            // Without a thread there is no backdrop; the rays are still drawn.
+            let _ = job.spawn(runner.events.clone());
+        }
         guard
             .terminal
             .draw(|frame| frame.render_widget(&*app, frame.area()))?;
@@ -275,6 +279,10 @@ fn handle(app: &mut App, event: Event) -> Vec<Effect> {
         }
         Event::Explained(explained) => {
             app.apply_explained(explained);
+            Vec::new()
+        }
+        Event::Backdrop(rendered) => {
+            app.apply_backdrop(rendered);
             Vec::new()
         }
         Event::RenderDone { generation, result } => {

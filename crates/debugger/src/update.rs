@@ -24,6 +24,9 @@ pub fn update(app: &mut App, action: Action) -> Vec<Effect> {
 }
 
 fn apply(app: &mut App, action: Action) -> Vec<Effect> {
+    if app.ray_view.is_some() && ray_view_action(app, action) {
+        return Vec::new();
+    }
     match action {
         Action::Quit => app.should_quit = true,
         // Esc stops a runaway trace first; with none under way it quits.
@@ -86,8 +89,83 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
         Action::Step { forward } => follow_update::step(app, forward),
         Action::RunToEvent { forward } => follow_update::run_to_event(app, forward),
         Action::ExplainGo => follow_update::go(app),
+        Action::ToggleRayView => {
+            app.toggle_ray_view();
+            app.focus = Focus::Image;
+        }
+        Action::ResetRayView => {
+            app.set_message("0 resets the 3D view's camera (v shows it)", false)
+        }
+        // Drags only orbit the 3D view.
+        Action::Drag { .. } => {}
     }
     Vec::new()
+}
+
+/// How far one arrow press orbits the 3D view (Shift: ten presses).
+const ORBIT_STEP_DEGREES: f64 = 5.0;
+/// How far a drag across one cell orbits it (a row is twice as tall as a column is wide).
+const DRAG_DEGREES_PER_COLUMN: f64 = 3.0;
+const ZOOM_STEP: f64 = 1.25;
+
+/// In the 3D view, the image's moves steer its camera instead: arrows orbit, +/- and the
+/// wheel zoom, pans pan, 0 resets, and a press and drag in the pane orbits. Whether the
+/// action was taken here.
+fn ray_view_action(app: &mut App, action: Action) -> bool {
+    let area = app.image_area();
+    let Some(view) = app.ray_view.as_mut() else {
+        return false;
+    };
+    let inside = |column: u16, row: u16| {
+        area.is_some_and(|a| a.contains(ratatui::layout::Position::new(column, row)))
+    };
+    if let Action::Click { .. } = action {
+        // Only a press inside the pane starts a drag.
+        view.drag_from = None;
+    }
+    let orbit = &mut view.orbit;
+    match action {
+        Action::MoveCursor { dx, dy } => orbit.orbit(
+            f64::from(dx) * ORBIT_STEP_DEGREES.to_radians(),
+            -f64::from(dy) * ORBIT_STEP_DEGREES.to_radians(),
+        ),
+        Action::ZoomIn => orbit.zoom(ZOOM_STEP),
+        Action::ZoomOut => orbit.zoom(1.0 / ZOOM_STEP),
+        Action::Wheel { column, row, lines } if inside(column, row) => {
+            orbit.zoom(if lines < 0 {
+                ZOOM_STEP
+            } else {
+                1.0 / ZOOM_STEP
+            });
+        }
+        Action::Pan { columns, rows } => {
+            // As a fraction of the view's height: a row is two of the backdrop's pixels,
+            // a column one.
+            let half_rows = f64::from(area.map_or(1, |a| a.height.max(1))) * 2.0;
+            orbit.pan(
+                f64::from(columns) / half_rows,
+                -f64::from(rows) * 2.0 / half_rows,
+            );
+        }
+        Action::ResetRayView => orbit.reset(),
+        Action::Click { column, row } if inside(column, row) && !app.help_open => {
+            view.drag_from = Some((column, row));
+            app.focus = Focus::Image;
+        }
+        Action::Drag { column, row } => {
+            // The scene follows the mouse: dragging right turns it right (the camera goes
+            // left), dragging down tips its top towards the viewer (the camera rises).
+            if let Some((from_column, from_row)) = view.drag_from {
+                let dx = f64::from(column) - f64::from(from_column);
+                let dy = f64::from(row) - f64::from(from_row);
+                let step = DRAG_DEGREES_PER_COLUMN.to_radians();
+                orbit.orbit(-dx * step, dy * 2.0 * step);
+                view.drag_from = Some((column, row));
+            }
+        }
+        _ => return false,
+    }
+    true
 }
 
 /// The image point zooming keeps in place: the centre of the cursor pixel.
@@ -512,5 +590,117 @@ mod tests {
         assert_eq!(app.inspector_scroll, 7);
         update(&mut app, Action::InspectorScroll(i32::MIN));
         assert_eq!(app.inspector_scroll, 0);
+    }
+
+    #[test]
+    fn in_the_3d_view_arrows_orbit_zoom_pans_and_0_resets_to_the_scene_camera() {
+        let mut app = picked_app();
+        let scene_camera = app.loaded.scene.camera.clone();
+        update(&mut app, Action::ToggleRayView);
+        let view = app.ray_view.as_ref().expect("the 3D view is shown");
+        assert_eq!(
+            view.orbit.camera(),
+            &scene_camera,
+            "it starts at the scene's camera"
+        );
+        let hit = app
+            .picked
+            .as_ref()
+            .unwrap()
+            .tree
+            .node(0)
+            .unwrap()
+            .hit
+            .clone()
+            .unwrap();
+        let target = view.orbit.target();
+        assert!(
+            (target.x - f64::from(hit.point[0])).abs() < 1e-6,
+            "it orbits the hit"
+        );
+        let cursor = app.cursor;
+        update(&mut app, Action::MoveCursor { dx: 1, dy: 0 });
+        update(&mut app, Action::ZoomIn);
+        update(
+            &mut app,
+            Action::Pan {
+                columns: 4,
+                rows: 0,
+            },
+        );
+        assert_eq!(app.cursor, cursor, "the cursor stays");
+        let moved = app.ray_view.as_ref().unwrap().orbit.camera().clone();
+        assert_ne!(moved, scene_camera);
+        update(&mut app, Action::ResetRayView);
+        assert_eq!(app.ray_view.as_ref().unwrap().orbit.camera(), &scene_camera);
+        update(&mut app, Action::ToggleRayView);
+        assert!(app.ray_view.is_none());
+        update(&mut app, Action::MoveCursor { dx: 1, dy: 0 });
+        assert_eq!(
+            app.cursor,
+            (cursor.0 + 1, cursor.1),
+            "the image's keys are back"
+        );
+    }
+
+    #[test]
+    fn a_drag_that_starts_in_the_3d_view_orbits_it_and_a_click_there_picks_nothing() {
+        let mut app = picked_app();
+        update(&mut app, Action::ToggleRayView);
+        let image = app.image_area().unwrap();
+        let tree = layout::inner(app.panes().unwrap().tree);
+        let start = app.ray_view.as_ref().unwrap().orbit.camera().clone();
+        // A drag from outside the pane does nothing.
+        update(
+            &mut app,
+            Action::Click {
+                column: tree.x + 1,
+                row: tree.y + 1,
+            },
+        );
+        update(
+            &mut app,
+            Action::Drag {
+                column: image.x + 9,
+                row: image.y + 3,
+            },
+        );
+        assert_eq!(app.ray_view.as_ref().unwrap().orbit.camera(), &start);
+        let requests = app.trace_requests;
+        update(
+            &mut app,
+            Action::Click {
+                column: image.x + 5,
+                row: image.y + 3,
+            },
+        );
+        assert_eq!(app.trace_requests, requests, "no pixel is picked");
+        update(
+            &mut app,
+            Action::Drag {
+                column: image.x + 9,
+                row: image.y + 3,
+            },
+        );
+        let dragged = app.ray_view.as_ref().unwrap().orbit.camera().clone();
+        assert_ne!(dragged, start);
+        assert!(
+            (dragged.eye.y - start.eye.y).abs() < 1e-9,
+            "a sideways drag only yaws"
+        );
+        // The wheel zooms towards the target.
+        let target = app.ray_view.as_ref().unwrap().orbit.target();
+        let distance =
+            |app: &App| (app.ray_view.as_ref().unwrap().orbit.camera().eye - target).length();
+        let before = distance(&app);
+        update(
+            &mut app,
+            Action::Wheel {
+                column: image.x + 2,
+                row: image.y + 2,
+                lines: -1,
+            },
+        );
+        assert!(distance(&app) < before);
     }
 }

@@ -16,8 +16,9 @@ use std::time::Instant;
 
 use glam::Vec3A;
 use rayon::prelude::*;
-use whitted_ir::Settings;
+use whitted_ir::{Camera, Settings};
 
+use crate::camera::PreparedCamera;
 use crate::ray::Ray;
 use crate::recorder::{NoRecord, PixelStats, Recorder};
 use crate::sampling::sample_offset;
@@ -173,7 +174,22 @@ pub fn render(
     options: &RenderOptions,
     observer: &dyn RenderObserver,
 ) -> Option<(Image, RenderStats)> {
-    render_recorded::<NoRecord>(scene, options, observer).map(|(image, stats, _)| (image, stats))
+    render_recorded::<NoRecord>(scene, &scene.camera, options, observer)
+        .map(|(image, stats, _)| (image, stats))
+}
+
+/// [`render`] from another camera than the scene's: the same tracing code, for views of the
+/// scene from elsewhere (the debugger's 3D ray view). Preparing the camera is cheap; the
+/// scene (and its BVH) is used as it is.
+pub fn render_from(
+    scene: &PreparedScene,
+    camera: &Camera,
+    options: &RenderOptions,
+    observer: &dyn RenderObserver,
+) -> Option<(Image, RenderStats)> {
+    let camera = PreparedCamera::new(camera);
+    render_recorded::<NoRecord>(scene, &camera, options, observer)
+        .map(|(image, stats, _)| (image, stats))
 }
 
 /// [`render`], also gathering [`PixelStats`] for every pixel (row-major, like the image),
@@ -183,7 +199,7 @@ pub fn render_with_pixel_stats(
     options: &RenderOptions,
     observer: &dyn RenderObserver,
 ) -> Option<(Image, RenderStats, Vec<PixelStats>)> {
-    render_recorded::<PixelStats>(scene, options, observer)
+    render_recorded::<PixelStats>(scene, &scene.camera, options, observer)
 }
 
 /// Traces sample `sample` of pixel `(x, y)` with `rec` attached, running exactly the code
@@ -213,17 +229,21 @@ pub(crate) fn trace_sample<R: Recorder>(
     sample: u32,
     rec: &mut R,
 ) -> Vec3A {
-    let ray = camera_ray(scene, options, x, y, sample);
+    let ray = camera_ray(&scene.camera, options, x, y, sample);
     tracer.trace(&ray, &PathState::camera(), rec)
 }
 
 /// The camera ray of sample `sample` of pixel `(x, y)`.
 #[inline]
-fn camera_ray(scene: &PreparedScene, options: &RenderOptions, x: u32, y: u32, sample: u32) -> Ray {
+fn camera_ray(
+    camera: &PreparedCamera,
+    options: &RenderOptions,
+    x: u32,
+    y: u32,
+    sample: u32,
+) -> Ray {
     let (dx, dy) = sample_offset(x, y, sample, options.samples());
-    scene
-        .camera
-        .ray(x as f32 + dx, y as f32 + dy, options.width, options.height)
+    camera.ray(x as f32 + dx, y as f32 + dy, options.width, options.height)
 }
 
 /// A worker's reusable state: a tracer (with its query scratch space) and the buffers of
@@ -248,6 +268,7 @@ struct Band<'i, R> {
 
 fn render_recorded<R: Recorder + Default + Send>(
     scene: &PreparedScene,
+    camera: &PreparedCamera,
     options: &RenderOptions,
     observer: &dyn RenderObserver,
 ) -> Option<(Image, RenderStats, Vec<R>)> {
@@ -279,7 +300,7 @@ fn render_recorded<R: Recorder + Default + Send>(
                 let x0 = (index as u32 % tiles_x) * TILE_SIZE;
                 let y0 = (index as u32 / tiles_x) * TILE_SIZE;
                 let band = bands.get((y0 / TILE_SIZE) as usize)?;
-                render_tile::<R>(worker, scene, options, observer, band, x0, y0)
+                render_tile::<R>(worker, camera, options, observer, band, x0, y0)
             },
         )
         .try_reduce(RayCounters::default, |mut a, b| {
@@ -308,7 +329,7 @@ fn render_recorded<R: Recorder + Default + Send>(
 /// of the image. Returns the tile's ray counts, or `None` when the observer cancels.
 fn render_tile<R: Recorder + Default>(
     worker: &mut Worker<'_, R>,
-    scene: &PreparedScene,
+    camera: &PreparedCamera,
     options: &RenderOptions,
     observer: &dyn RenderObserver,
     band: &Mutex<Band<'_, R>>,
@@ -330,7 +351,7 @@ fn render_tile<R: Recorder + Default>(
         rays.clear();
         for x in x0..x0 + width {
             for sample in 0..samples {
-                rays.push(camera_ray(scene, options, x, y, sample));
+                rays.push(camera_ray(camera, options, x, y, sample));
             }
         }
         // The rays in the order they were made: pixel by pixel, sample by sample, exactly
@@ -377,4 +398,28 @@ fn render_tile<R: Recorder + Default>(
     }
     worker.pixels = tile.pixels;
     Some(std::mem::take(&mut tracer.counters))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::whitted_classic;
+
+    /// From the scene's own camera `render_from` is `render`, bit for bit; from another
+    /// camera it is a different picture of the same scene.
+    #[test]
+    fn render_from_the_scene_camera_is_render_and_from_elsewhere_differs() {
+        let scene = whitted_classic().build().unwrap();
+        let prepared = PreparedScene::new(&scene);
+        let mut options = RenderOptions::from_settings(&scene.settings);
+        options.width = 40;
+        options.height = 30;
+        let (image, _) = render(&prepared, &options, &NoObserver).unwrap();
+        let (same, _) = render_from(&prepared, &scene.camera, &options, &NoObserver).unwrap();
+        assert_eq!(image, same);
+        let mut above = scene.camera.clone();
+        above.eye.y += 5.0;
+        let (other, _) = render_from(&prepared, &above, &options, &NoObserver).unwrap();
+        assert_ne!(image, other);
+    }
 }

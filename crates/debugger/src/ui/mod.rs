@@ -1,12 +1,14 @@
 //! Drawing: the whole screen as a function of the [`App`] (`impl Widget for &App`). Each pane
 //! has its own module; none of them changes state.
 
+mod braille;
 mod errors_pane;
 mod explain_pane;
 pub mod format;
 mod help;
 mod image_pane;
 mod inspector;
+mod ray_view_pane;
 #[cfg(test)]
 mod snapshot_tests;
 mod source_pane;
@@ -28,7 +30,10 @@ impl Widget for &App {
             too_small(area, buf);
             return;
         };
-        image_pane::draw(self, panes.image, buf);
+        match &self.ray_view {
+            Some(view) => ray_view_pane::draw(self, view, panes.image, buf),
+            None => image_pane::draw(self, panes.image, buf),
+        }
         tree_pane::draw(self, panes.tree, buf);
         if self.explain_open {
             explain_pane::draw(self, panes.inspector, buf);

@@ -236,3 +236,74 @@ fn collapsed_tree_while_stepping_at_80x24() {
     let app = collapsed_busy_pixel(80, 24);
     assert_snapshot!(draw(&app).backend());
 }
+
+/// The glass pixel's rays in the 3D view, orbited 60° to the right and 15° up, with the
+/// backdrop rendered here (synchronously), so the frame is the same on every run.
+fn glass_pixel_in_3d(width: u16, height: u16) -> App {
+    let mut app = rendered_app(width, height);
+    pick_glass_pixel(&mut app);
+    update(&mut app, Action::ToggleRayView);
+    for _ in 0..12 {
+        update(&mut app, Action::MoveCursor { dx: 1, dy: 0 });
+    }
+    for _ in 0..3 {
+        update(&mut app, Action::MoveCursor { dx: 0, dy: -1 });
+    }
+    assert_eq!(
+        app.cursor, GLASS_PIXEL,
+        "arrows orbit the view, not the cursor"
+    );
+    let job = app.backdrop_job().expect("a backdrop to render");
+    app.apply_backdrop(job.run());
+    assert!(app.backdrop_job().is_none(), "the backdrop is current");
+    app
+}
+
+/// The foreground colours of the braille cells in the image pane.
+fn braille_colors(app: &App, terminal: &Terminal<TestBackend>) -> Vec<ratatui::style::Color> {
+    let pane = app.panes().expect("a layout").image;
+    let buffer = terminal.backend().buffer();
+    let mut colors = Vec::new();
+    for y in pane.top()..pane.bottom() {
+        for x in pane.left()..pane.right() {
+            let cell = &buffer[(x, y)];
+            if cell
+                .symbol()
+                .chars()
+                .next()
+                .is_some_and(|c| ('\u{2801}'..='\u{28ff}').contains(&c))
+            {
+                colors.push(cell.fg);
+            }
+        }
+    }
+    colors
+}
+
+#[test]
+fn glass_pixel_rays_in_3d_from_an_orbited_camera_at_120x40() {
+    use ratatui::style::Color;
+    let app = glass_pixel_in_3d(120, 40);
+    let terminal = draw(&app);
+    let colors = braille_colors(&app, &terminal);
+    // The selected camera ray (magenta), reflected (cyan), transmitted (orange) and shadow
+    // rays, lit (green) and blocked (red), each drawn somewhere.
+    for (name, color) in [
+        ("selected", Color::Rgb(255, 0, 255)),
+        ("reflected", Color::Rgb(0, 230, 255)),
+        ("transmitted", Color::Rgb(255, 170, 0)),
+        ("lit shadow", Color::Rgb(40, 255, 40)),
+        ("blocked shadow", Color::Rgb(255, 40, 40)),
+    ] {
+        assert!(colors.contains(&color), "no {name} ray drawn: {colors:?}");
+    }
+    assert_snapshot!(terminal.backend());
+}
+
+#[test]
+fn glass_pixel_rays_in_3d_from_an_orbited_camera_at_80x24() {
+    let app = glass_pixel_in_3d(80, 24);
+    let terminal = draw(&app);
+    assert!(braille_colors(&app, &terminal).len() > 10);
+    assert_snapshot!(terminal.backend());
+}
