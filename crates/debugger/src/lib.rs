@@ -15,6 +15,7 @@ pub mod heat_map;
 pub mod hit_point;
 pub mod image_view;
 pub mod layout;
+pub mod palette;
 pub mod projection;
 mod reload;
 mod render_job;
