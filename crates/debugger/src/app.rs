@@ -16,7 +16,9 @@ use crate::action::Focus;
 use crate::framebuffer::Framebuffer;
 use crate::heat_map::{HeatMap, HeatMapKind};
 use crate::image_view::{ColorDepth, Viewport};
-use crate::layout::{self, Panes};
+use crate::layout::{self, Arrangement, Panes};
+use crate::line_input::LineInput;
+use crate::search::Search;
 use crate::trace_job::{TraceFailure, TraceJob, Traced};
 use crate::tree_view::TreeView;
 
@@ -139,7 +141,16 @@ pub struct App {
     pub picked: Option<Picked>,
     pub source_target: SourceTarget,
     pub inspector_scroll: u16,
+    /// How many columns the inspector is scrolled sideways.
+    pub inspector_columns: u16,
     pub help_open: bool,
+    pub help_scroll: u16,
+    /// `z`: the focused pane fills the body.
+    pub zoomed: bool,
+    /// The `/` prompt while it is open (it takes the keys).
+    pub search_prompt: Option<LineInput>,
+    /// The last submitted search of the picked tree, for `n` / `N`.
+    pub search: Option<Search>,
     /// Set after a failed reload, cleared by a good one.
     pub errors: Option<SceneErrors>,
     pub reloading: bool,
@@ -182,7 +193,12 @@ impl App {
             picked: None,
             source_target: SourceTarget::Object,
             inspector_scroll: 0,
+            inspector_columns: 0,
             help_open: false,
+            help_scroll: 0,
+            zoomed: false,
+            search_prompt: None,
+            search: None,
             errors: None,
             reloading: false,
             message: None,
@@ -202,9 +218,18 @@ impl App {
         (self.options.width, self.options.height)
     }
 
+    /// What decides the layout besides the terminal size.
+    pub fn arrangement(&self) -> Arrangement {
+        Arrangement {
+            errors: self.errors.is_some(),
+            focus: self.focus,
+            zoomed: self.zoomed,
+        }
+    }
+
     /// The panes for the current terminal size (`None` when it is too small).
     pub fn panes(&self) -> Option<Panes> {
-        layout::panes(self.area, self.image_size(), self.errors.is_some())
+        layout::panes(self.area, self.image_size(), self.arrangement())
     }
 
     /// The area the image is drawn in (inside the pane's border).
@@ -212,10 +237,11 @@ impl App {
         self.panes().map(|p| layout::inner(p.image))
     }
 
-    /// The rows the tree pane shows.
+    /// The rays the tree pane shows: the rows inside its border but the column header.
     pub fn tree_rows(&self) -> usize {
-        self.panes()
-            .map_or(1, |p| usize::from(layout::inner(p.tree).height))
+        self.panes().map_or(1, |p| {
+            usize::from(layout::inner(p.tree).height.saturating_sub(1)).max(1)
+        })
     }
 
     pub fn viewport(&self) -> Viewport {
@@ -291,6 +317,7 @@ impl App {
                     Some(previous) if tracing.retrace => TreeView::new_like(tree, &previous.tree),
                     _ => {
                         self.inspector_scroll = 0;
+                        self.search = None;
                         TreeView::new(tree)
                     }
                 };
@@ -636,9 +663,10 @@ mod tests {
         assert_eq!(traced.result.as_ref().err(), Some(&TraceFailure::Cancelled));
         app.apply_trace(traced);
         assert!(app.picked.is_none(), "a cancelled trace leaves no tree");
-        // With no trace under way, Esc quits.
+        // With no trace under way, Esc still does not quit (q does).
         crate::update::update(&mut app, crate::action::Action::Cancel);
-        assert!(app.should_quit);
+        assert!(!app.should_quit);
+        assert!(app.message.as_ref().unwrap().text.contains("q quits"));
     }
 
     #[test]

@@ -1,5 +1,7 @@
 //! The inspector pane: every field of the selected ray (docs/ray-tree.md), colours with
-//! swatches beside their numbers, so the pixel's colour can be read off term by term.
+//! swatches beside their numbers, so the pixel's colour can be read off term by term. A
+//! header names the columns; ↑↓ scroll the lines under it and ←→ scroll everything
+//! sideways together, so the columns stay aligned with their header.
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -48,16 +50,64 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         node.kind.name(),
         node.depth
     );
-    let block = pane_block(Line::from(title), focused);
     let lines = Lines::new(app.color_depth).node(app, tree, id, node);
-    let inner_height = usize::from(block.inner(pane).height);
-    let longest_scroll = lines.len().saturating_sub(inner_height);
-    let scroll = usize::from(app.inspector_scroll).min(longest_scroll);
-    let mut paragraph = Paragraph::new(lines).block(block);
-    if longest_scroll > 0 {
-        paragraph = paragraph.scroll((u16::try_from(scroll).unwrap_or(u16::MAX), 0));
+    let mut block = pane_block(Line::from(title), focused);
+    let inner = block.inner(pane);
+    if inner.height < 2 {
+        block.render(pane, buf);
+        return;
     }
-    paragraph.render(pane, buf);
+    let body = Rect {
+        y: inner.y + 1,
+        height: inner.height - 1,
+        ..inner
+    };
+    let widest = lines.iter().map(Line::width).max().unwrap_or(0);
+    let hidden_columns = widest.saturating_sub(usize::from(inner.width));
+    let columns = usize::from(app.inspector_columns).min(hidden_columns);
+    let hidden_lines = lines.len().saturating_sub(usize::from(body.height));
+    let scroll = usize::from(app.inspector_scroll).min(hidden_lines);
+    // Say where more is, and which keys bring it.
+    let mut more = Vec::new();
+    if scroll > 0 || hidden_lines > scroll {
+        more.push("↑↓");
+    }
+    if columns > 0 || hidden_columns > columns {
+        more.push("←→");
+    }
+    if !more.is_empty() {
+        block = block.title_bottom(Line::from(format!(" more: {} ", more.join(" "))).right_aligned());
+    }
+    block.render(pane, buf);
+    let offset = (
+        u16::try_from(scroll).unwrap_or(u16::MAX),
+        u16::try_from(columns).unwrap_or(u16::MAX),
+    );
+    Paragraph::new(header())
+        .scroll((0, offset.1))
+        .render(Rect { height: 1, ..inner }, buf);
+    Paragraph::new(lines).scroll(offset).render(body, buf);
+}
+
+/// The column header: the field's name, its value (for a colour, its swatch and then r, g
+/// and b over their numbers), and a note on what it is.
+fn header() -> Line<'static> {
+    let text = format!(
+        "{:<width$}{:<7}{:<6}{:<6}{:<3}{}",
+        "field",
+        "value",
+        "r",
+        "g",
+        "b",
+        "note",
+        width = LABEL_WIDTH + 1
+    );
+    Line::from(Span::styled(
+        text,
+        Style::new()
+            .fg(Color::Gray)
+            .add_modifier(Modifier::BOLD | Modifier::UNDERLINED),
+    ))
 }
 
 /// Builds the inspector's lines: a label column, then values.
