@@ -203,7 +203,9 @@ mod tests {
             (48, 16)
         );
         assert_eq!(inner(inspector.source).height, 3);
-        let image = panes(area, (640, 480), arranged(Focus::Image)).unwrap().image;
+        let image = panes(area, (640, 480), arranged(Focus::Image))
+            .unwrap()
+            .image;
         assert_eq!((image.width, image.height), (48, 16));
     }
 

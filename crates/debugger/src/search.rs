@@ -124,12 +124,16 @@ mod tests {
         let mut search = Search::new("shadow", &tree);
         let count = search.matches.len();
         assert!(count > 2, "{count}");
-        assert!(search.describe().starts_with(&format!("match 1 of {count}")));
+        assert!(search
+            .describe()
+            .starts_with(&format!("match 1 of {count}")));
         let first = search.current_match();
         assert_eq!(search.step(false), search.matches.last().copied());
         assert_eq!(search.step(true), first);
         search.step(true);
-        assert!(search.describe().starts_with(&format!("match 2 of {count}")));
+        assert!(search
+            .describe()
+            .starts_with(&format!("match 2 of {count}")));
         let none = Search::new("foo", &tree);
         assert_eq!(none.describe(), "no ray matches `foo`");
         assert_eq!(none.clone().step(true), None);

@@ -75,7 +75,10 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
             if app.picked.is_some() {
                 app.search_prompt = Some(crate::line_input::LineInput::new(""));
             } else {
-                app.set_message("no ray tree to search: move the cursor and press Enter", false);
+                app.set_message(
+                    "no ray tree to search: move the cursor and press Enter",
+                    false,
+                );
             }
         }
         Action::PromptKey(key) => prompt_key(app, key),
@@ -636,7 +639,12 @@ mod tests {
         let second = app.picked.as_ref().unwrap().tree.selected();
         update(&mut app, Action::SearchStep { forward: false });
         update(&mut app, Action::SearchStep { forward: false });
-        assert!(app.message.as_ref().unwrap().text.starts_with(&format!("match {count} of")));
+        assert!(app
+            .message
+            .as_ref()
+            .unwrap()
+            .text
+            .starts_with(&format!("match {count} of")));
         assert_ne!(app.picked.as_ref().unwrap().tree.selected(), second);
         // Esc ends the search; a query with no match says so and moves nothing.
         update(&mut app, Action::Cancel);
@@ -651,14 +659,22 @@ mod tests {
     fn esc_in_the_prompt_closes_it_without_searching() {
         let mut app = picked_app();
         update(&mut app, Action::StartSearch);
-        update(&mut app, Action::PromptKey(KeyEvent::from(KeyCode::Char('s'))));
+        update(
+            &mut app,
+            Action::PromptKey(KeyEvent::from(KeyCode::Char('s'))),
+        );
         update(&mut app, Action::PromptKey(KeyEvent::from(KeyCode::Esc)));
         assert!(app.search_prompt.is_none() && app.search.is_none());
         assert!(!app.should_quit);
         let mut untraced = self::app();
         update(&mut untraced, Action::StartSearch);
         assert!(untraced.search_prompt.is_none());
-        assert!(untraced.message.as_ref().unwrap().text.contains("no ray tree"));
+        assert!(untraced
+            .message
+            .as_ref()
+            .unwrap()
+            .text
+            .contains("no ray tree"));
     }
 
     #[test]

@@ -43,7 +43,9 @@ pub fn draw(area: Rect, scroll: u16, buf: &mut Buffer) {
         inner.width.saturating_sub(1),
         inner.height,
     );
-    Paragraph::new(lines).scroll((scroll, 0)).render(padded, buf);
+    Paragraph::new(lines)
+        .scroll((scroll, 0))
+        .render(padded, buf);
 }
 
 /// One line per key; the pane's name only on the first line of its group.

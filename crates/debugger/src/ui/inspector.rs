@@ -76,38 +76,67 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         more.push("←→");
     }
     if !more.is_empty() {
-        block = block.title_bottom(Line::from(format!(" more: {} ", more.join(" "))).right_aligned());
+        block =
+            block.title_bottom(Line::from(format!(" more: {} ", more.join(" "))).right_aligned());
     }
     block.render(pane, buf);
-    let offset = (
-        u16::try_from(scroll).unwrap_or(u16::MAX),
-        u16::try_from(columns).unwrap_or(u16::MAX),
+    let mut all = vec![header()];
+    all.extend(
+        lines
+            .into_iter()
+            .skip(scroll)
+            .take(usize::from(body.height)),
     );
-    Paragraph::new(header())
-        .scroll((0, offset.1))
-        .render(Rect { height: 1, ..inner }, buf);
-    Paragraph::new(lines).scroll(offset).render(body, buf);
+    if columns == 0 {
+        Paragraph::new(all).render(inner, buf);
+        return;
+    }
+    // Scrolled sideways, the field names stay put and the rest moves under its header.
+    let label_width = (LABEL_WIDTH as u16 + 1).min(inner.width);
+    let (labels, rest): (Vec<Line<'_>>, Vec<Line<'_>>) = all.into_iter().map(split_label).unzip();
+    Paragraph::new(labels).render(
+        Rect {
+            width: label_width,
+            ..inner
+        },
+        buf,
+    );
+    Paragraph::new(rest)
+        .scroll((0, u16::try_from(columns).unwrap_or(u16::MAX)))
+        .render(
+            Rect {
+                x: inner.x + label_width,
+                width: inner.width - label_width,
+                ..inner
+            },
+            buf,
+        );
+}
+
+/// A line's field name (its first span, when it fills the label column) and the rest.
+/// Section titles have no field name: all of them is the rest.
+fn split_label(line: Line<'static>) -> (Line<'static>, Line<'static>) {
+    let mut spans = line.spans;
+    let is_label = spans
+        .first()
+        .is_some_and(|span| span.width() == LABEL_WIDTH + 1);
+    if is_label {
+        let label = spans.remove(0);
+        (Line::from(label), Line::from(spans))
+    } else {
+        (Line::default(), Line::from(spans))
+    }
 }
 
 /// The column header: the field's name, its value (for a colour, its swatch and then r, g
 /// and b over their numbers), and a note on what it is.
 fn header() -> Line<'static> {
-    let text = format!(
-        "{:<width$}{:<7}{:<6}{:<6}{:<3}{}",
-        "field",
-        "value",
-        "r",
-        "g",
-        "b",
-        "note",
-        width = LABEL_WIDTH + 1
-    );
-    Line::from(Span::styled(
-        text,
-        Style::new()
-            .fg(Color::Gray)
-            .add_modifier(Modifier::BOLD | Modifier::UNDERLINED),
-    ))
+    let style = Style::new()
+        .fg(Color::Gray)
+        .add_modifier(Modifier::BOLD | Modifier::UNDERLINED);
+    let field = format!("{:<width$}", "field", width = LABEL_WIDTH + 1);
+    let rest = format!("{:<7}{:<6}{:<6}{:<3}{}", "value", "r", "g", "b", "note");
+    Line::from(vec![Span::styled(field, style), Span::styled(rest, style)])
 }
 
 /// Builds the inspector's lines: a label column, then values.

@@ -49,8 +49,9 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         .skip(tree.scroll())
         .take(usize::from(area.height - 1));
     let matches = app.search.as_ref().map_or(&[][..], |s| &s.matches[..]);
+    let numbers = shows_numbers(usize::from(area.width));
     for (row, &id) in rows.enumerate() {
-        let line = row_line(app, tree, id, usize::from(area.width));
+        let line = row_line(app, tree, id, usize::from(area.width), numbers);
         let selected = id == tree.selected();
         let style = match (selected, focused) {
             (true, true) => Style::new().add_modifier(Modifier::REVERSED),
@@ -68,9 +69,14 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
 /// The width of the numbers after a row's swatch: ` 0.19 0.29 0.69`.
 const NUMBERS_WIDTH: usize = 15;
 
-/// Whether a row of `width` columns with a head of `head_width` shows the numbers.
-fn shows_numbers(width: usize, head_width: usize) -> bool {
-    width >= head_width + 8 + 3 + NUMBERS_WIDTH
+/// The width of a camera ray's head (marker, kind, depth): `▼ camera      d0 `.
+const HEAD_WIDTH: usize = 2 + 11 + 4;
+
+/// Whether a pane `width` columns wide shows the numbers after the swatches: when a camera
+/// ray's row keeps 8 columns for what it met. The choice is the same for every row, so that
+/// the numbers stay under their header (deeper rows cut what they met first).
+fn shows_numbers(width: usize) -> bool {
+    width >= HEAD_WIDTH + 8 + 3 + NUMBERS_WIDTH
 }
 
 /// The column header: the ray's kind and depth, what it met, and its contribution to the
@@ -79,9 +85,8 @@ fn shows_numbers(width: usize, head_width: usize) -> bool {
 fn header_line(width: usize) -> Line<'static> {
     // Over a camera ray's head (marker, kind, depth "d0"): the kind and "d" for depth.
     let head = format!("  {:<11} {:<3}", "ray", "d");
-    let head_width = head.chars().count();
     let left = format!("{head}what it met");
-    let right = if shows_numbers(width, head_width) {
+    let right = if shows_numbers(width) {
         "adds  r    g    b"
     } else {
         "adds"
@@ -102,7 +107,13 @@ fn header_line(width: usize) -> Line<'static> {
 
 /// One ray's row, fitted to `width` columns: the label is cut first, the numbers only
 /// when the pane is very narrow.
-fn row_line(app: &App, tree: &TreeView, id: NodeId, width: usize) -> Line<'static> {
+fn row_line(
+    app: &App,
+    tree: &TreeView,
+    id: NodeId,
+    width: usize,
+    show_numbers: bool,
+) -> Line<'static> {
     let Some(node) = tree.node(id) else {
         return Line::default();
     };
@@ -117,7 +128,6 @@ fn row_line(app: &App, tree: &TreeView, id: NodeId, width: usize) -> Line<'stati
     let [r, g, b] = contribution;
     let numbers = format!(" {r:.2} {g:.2} {b:.2}");
     let head_width = head.chars().count();
-    let show_numbers = shows_numbers(width, head_width);
     let tail = 3 + if show_numbers { numbers.len() } else { 0 };
     let label_width = width.saturating_sub(head_width + tail);
     let mut description = describe(node);
