@@ -479,12 +479,13 @@ impl App {
                     .as_ref()
                     .map(|p| p.tree.tree().pixel)
                     .unwrap_or_default();
+                // The path first: on a narrow status line the end is what gets cut.
                 self.set_message(
                     format!(
-                        "wrote the ray tree of ({}, {}) to {}",
+                        "wrote {} (the ray tree of ({}, {}))",
+                        path.display(),
                         pixel[0],
-                        pixel[1],
-                        path.display()
+                        pixel[1]
                     ),
                     false,
                 );

@@ -88,11 +88,12 @@ pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
             })],
         });
     }
+    // Said even on the narrowest line: the other panes are hidden, and how to get them back.
     if app.zoomed {
         parts.push(Part {
-            rank: 1,
+            rank: 0,
             spans: vec![Span::styled(
-                "zoomed: Tab next pane, z back",
+                "zoomed: z back, Tab next",
                 Style::new().fg(Color::Yellow),
             )],
         });
