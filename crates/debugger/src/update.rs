@@ -40,7 +40,11 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
             app.help_scroll = 0;
         }
         Action::HelpScroll(lines) => {
-            app.help_scroll = (i32::from(app.help_scroll) + lines).clamp(0, 200) as u16;
+            // No further than the last key: the help has a line per key and a border.
+            let rows = crate::action::KEY_HELP.len() + 2;
+            let hidden = rows.saturating_sub(usize::from(app.area.height));
+            let scrolled = i64::from(app.help_scroll) + i64::from(lines);
+            app.help_scroll = scrolled.clamp(0, hidden as i64) as u16;
         }
         Action::MoveCursor { dx, dy } => move_cursor(app, dx, dy),
         Action::MoveCursorByCells { dx, dy } => {
@@ -726,6 +730,20 @@ mod tests {
         assert!(!app.help_open, "a click closes the help");
         update(&mut app, Action::Quit);
         assert!(app.should_quit);
+    }
+
+    #[test]
+    fn the_help_scrolls_no_further_than_its_last_line() {
+        let mut app = app();
+        app.area = Rect::new(0, 0, 80, 24);
+        update(&mut app, Action::ToggleHelp);
+        update(&mut app, Action::HelpScroll(100));
+        let hidden = crate::action::KEY_HELP.len() + 2 - 24;
+        assert_eq!(usize::from(app.help_scroll), hidden);
+        update(&mut app, Action::HelpScroll(-1));
+        assert_eq!(usize::from(app.help_scroll), hidden - 1);
+        update(&mut app, Action::HelpScroll(-100));
+        assert_eq!(app.help_scroll, 0);
     }
 
     #[test]
