@@ -322,6 +322,10 @@ impl App {
                     }
                 };
                 view.keep_selection_in_view(self.tree_rows());
+                // A re-traced tree may have other rays: the search's matches are found again.
+                if let Some(search) = &mut self.search {
+                    *search = Search::new(&search.query, &view);
+                }
                 if view.tree().unrecorded > 0 {
                     self.set_message(
                         format!(
@@ -572,6 +576,12 @@ mod tests {
             picked.tree.select(transmitted);
         }
         let selected = app.picked.as_ref().map(|p| p.tree.selected());
+        // A search made before the reload: its (here stale) matches are found again.
+        app.search = Some(Search {
+            query: "transmitted".into(),
+            matches: vec![999],
+            current: 0,
+        });
         app.reloading = true;
         let effects = app.apply_reload(Ok((LoadedScene::new(whitted_scene()), 0)));
         assert_eq!(effects, vec![Effect::StartRender, Effect::Trace]);
@@ -579,6 +589,11 @@ mod tests {
         assert!(app.errors.is_none());
         finish_trace(&mut app);
         assert_eq!(app.picked.as_ref().map(|p| p.tree.selected()), selected);
+        let tree = &app.picked.as_ref().unwrap().tree;
+        assert_eq!(
+            app.search.as_ref().map(|s| s.matches.clone()),
+            Some(crate::search::matching_rays(tree, "transmitted"))
+        );
         assert_eq!(
             app.message.as_ref().unwrap().text,
             "reloaded scenes/whitted.scene"
