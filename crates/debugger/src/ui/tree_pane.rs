@@ -79,24 +79,20 @@ fn shows_numbers(width: usize) -> bool {
     width >= HEAD_WIDTH + 8 + 3 + NUMBERS_WIDTH
 }
 
-/// The column header: the ray's kind and depth, what it met, and its contribution to the
-/// pixel (the swatch and, when they fit, r g b over the numbers). The numbers show when
-/// the camera ray's row has room for them (rows below, deeper, may drop them).
+/// The column header: the ray's kind and depth, what it met, and its share of the pixel
+/// (over the swatch and, when they show, r g b over the numbers). In a narrow pane "what it
+/// met" is cut, never the share's header.
 fn header_line(width: usize) -> Line<'static> {
     // Over a camera ray's head (marker, kind, depth "d0"): the kind and "d" for depth.
     let head = format!("  {:<11} {:<3}", "ray", "d");
-    let left = format!("{head}what it met");
     let right = if shows_numbers(width) {
-        "adds  r    g    b"
+        "share r    g    b"
     } else {
-        "adds"
+        "share"
     };
-    let gap = width.saturating_sub(left.chars().count() + right.chars().count());
-    let text = if gap == 0 {
-        format::truncate(&format!("{left} {right}"), width)
-    } else {
-        format!("{left}{}{right}", " ".repeat(gap))
-    };
+    let left_width = width.saturating_sub(right.len() + 1);
+    let left = format::truncate(&format!("{head}what it met"), left_width);
+    let text = format::truncate(&format!("{left:<left_width$} {right}"), width);
     Line::from(Span::styled(
         text,
         Style::new()
