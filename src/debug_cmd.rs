@@ -41,13 +41,23 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
         watch,
         recompile,
         pixel: args.pixel.map(|[x, y]| (x, y)),
-        export_dir: std::env::current_dir().unwrap_or_else(|_| PathBuf::from(".")),
+        export_dir: export_dir(&args.scene.scene),
     };
     whitted_debugger::run(session).map_err(|error| match error {
         DebugError::NotATerminal => Failure::Usage(error.to_string()),
         DebugError::Terminal(_) => Failure::Message(error.to_string()),
         DebugError::Signal(signal) => Failure::Signal(signal),
     })
+}
+
+/// Where `e` writes the ray tree's JSON: beside the scene file (not wherever the debugger
+/// was started), as an absolute path so that the status line says exactly where.
+fn export_dir(scene: &Path) -> PathBuf {
+    let folder = match scene.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::path::absolute(&folder).unwrap_or(folder)
 }
 
 /// Compiles the scene again (with the front end its content calls for, and the same `-D`

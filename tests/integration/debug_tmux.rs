@@ -142,8 +142,11 @@ fn line_with<'a>(screen: &'a str, needle: &str) -> &'a str {
 
 #[test]
 fn pick_the_glass_sphere_walk_to_the_transmitted_ray_export_and_quit() {
+    // The scene in one folder, the debugger started in another: `e` writes beside the scene.
     let out = tempfile::tempdir().expect("a temporary directory");
-    let scene = repository().join("scenes/whitted.scene");
+    let scene_dir = tempfile::tempdir().expect("a temporary directory");
+    let scene = scene_dir.path().join("whitted.scene");
+    std::fs::copy(repository().join("scenes/whitted.scene"), &scene).expect("a scene copy");
     let command = format!("'{}' debug '{}'", whitted(), scene.display());
     let tmux = Tmux::start("pick", out.path(), &command, 120, 40);
 
@@ -159,7 +162,10 @@ fn pick_the_glass_sphere_walk_to_the_transmitted_ray_export_and_quit() {
     );
 
     // The glass sphere is right of centre (+x is on the image's left): 80 px right, 30 down.
-    tmux.keys(&["L", "L", "L", "L", "L", "L", "L", "L", "J", "J", "J"]);
+    // An arrow moves one cell (11 pixels at this size), Shift+arrow (HJKL) one pixel.
+    tmux.keys(&["Right"; 7]);
+    tmux.wait_for("seven cells right", |s| s.contains("(397, 240)"));
+    tmux.keys(&["L", "L", "L", "Down", "Down", "Down", "K", "K", "K"]);
     tmux.wait_for("the cursor on (400, 270)", |s| s.contains("(400, 270)"));
     tmux.keys(&["Enter"]);
     let screen = tmux.wait_for("the ray tree of the pixel", |s| {
@@ -200,10 +206,18 @@ fn pick_the_glass_sphere_walk_to_the_transmitted_ray_export_and_quit() {
         "{screen}"
     );
 
-    // Export the tree as JSON into the working directory.
+    // Export the tree as JSON beside the scene (not into the working directory), and say
+    // the whole path.
     tmux.keys(&["e"]);
-    tmux.wait_for("the export message", |s| s.contains("wrote the ray tree"));
-    let exported = out.path().join("whitted-400-270.ray-tree.json");
+    let screen = tmux.wait_for("the export message", |s| {
+        s.contains("(the ray tree of (400, 270))")
+    });
+    let exported = scene_dir.path().join("whitted-400-270.ray-tree.json");
+    assert!(
+        screen.contains(&exported.display().to_string()),
+        "the status line says where:\n{screen}"
+    );
+    assert!(!out.path().join("whitted-400-270.ray-tree.json").exists());
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&exported).expect("the export file exists"))
             .expect("the export is JSON");
@@ -272,8 +286,13 @@ fn resizing_to_a_tiny_terminal_says_so_and_back_redraws() {
     tmux.wait_for("the full layout again", |s| {
         s.contains("Ray tree of (400, 270)") && !s.contains("Terminal too small")
     });
+    // Esc never quits (it leaves modes; q quits).
     tmux.keys(&["Escape"]);
-    tmux.wait_for("the shell after Esc", |s| {
+    tmux.wait_for("Esc's hint", |s| {
+        s.contains("Esc closes and leaves modes; q quits")
+    });
+    tmux.keys(&["q"]);
+    tmux.wait_for("the shell after q", |s| {
         s.contains("debugger exited with 0")
     });
     assert_eq!(tmux.pane_flag("alternate_on"), "0");
@@ -613,6 +632,94 @@ fn the_3d_view_shows_the_glass_pixels_rays_from_an_orbited_camera() {
     tmux.wait_for("the image again", |s| s.contains("Image 640×480"));
     tmux.keys(&["q"]);
     tmux.wait_for("the shell after quitting", |s| {
+        s.contains("debugger exited with 0")
+    });
+}
+
+/// Issue 13's "done when": a new user at 80x24 picks the glass sphere of
+/// scenes/whitted.scene, finds its transmitted ray, reads its numbers and sees its source
+/// line without resizing, with keys only.
+#[test]
+fn a_new_user_at_80x24_finds_the_glass_sphere_s_transmitted_ray_and_reads_it() {
+    let command = format!("'{}' debug scenes/whitted.scene", whitted());
+    let tmux = Tmux::start("small", &repository(), &command, 80, 24);
+    tmux.wait_for("the finished image", |s| s.contains("rendered in"));
+
+    // At 80x24 the image pane shows 17 pixels a cell: five cells right and two down pass
+    // the sphere's pixel (400, 270) by a little; single pixels (Shift: HJKL) come back.
+    tmux.keys(&["Right"; 5]);
+    tmux.keys(&["Down"; 2]);
+    tmux.wait_for("the cursor five cells right, two down", |s| {
+        s.contains("(405, 274)")
+    });
+    tmux.keys(&["H", "H", "H", "H", "H", "K", "K", "K", "K"]);
+    tmux.wait_for("the cursor on the glass sphere", |s| {
+        s.contains("(400, 270)")
+    });
+    tmux.keys(&["Enter"]);
+    let screen = tmux.wait_for("the ray tree", |s| s.contains("Ray tree of (400, 270)"));
+    assert!(
+        line_with(&screen, "▼ camera").contains("glass sph"),
+        "the camera ray hits the glass sphere:\n{screen}"
+    );
+    assert!(
+        screen.contains("what it met"),
+        "the tree has a header:\n{screen}"
+    );
+
+    // Search the tree: the prompt is on the status line, Enter selects the first match.
+    tmux.keys(&["/"]);
+    tmux.wait_for("the search prompt", |s| s.contains("search rays /"));
+    tmux.keys(&["t", "r", "a", "n", "s", "m", "i", "t", "t", "e", "d"]);
+    tmux.wait_for("the typed query", |s| {
+        s.contains("search rays /transmitted")
+    });
+    tmux.keys(&["Enter"]);
+    let screen = tmux.wait_for("the first match", |s| {
+        s.contains("match 1 of 4 for `transmitted`")
+    });
+    assert!(screen.contains("Inspector · transmitted ray"), "{screen}");
+
+    // The inspector, focused, gets the wider column: its numbers and the source line show.
+    tmux.keys(&["Tab"]);
+    let screen = tmux.wait_for("the focused inspector", |s| {
+        s.contains("┏ Inspector · transmitted ray, depth 1")
+    });
+    for wanted in [
+        "ior           1.000 → 1.500",
+        "object        glass sphere (sphere)",
+        "coefficient   ██ 0.900 0.900 0.900  kt",
+        "field         value  r     g     b",
+    ] {
+        assert!(screen.contains(wanted), "`{wanted}` on screen:\n{screen}");
+    }
+    assert!(
+        line_with(&screen, "Source · ").contains("scenes/whitted.scene:20:1"),
+        "{screen}"
+    );
+    assert!(
+        line_with(&screen, "20 │").contains("sphere \"glass sphere\""),
+        "the sphere's line shows:\n{screen}"
+    );
+
+    // Zoomed, the inspector has the whole screen: the colour sums can be read in full.
+    tmux.keys(&["z"]);
+    tmux.wait_for("the zoomed inspector", |s| {
+        s.contains("zoomed: z back, Tab next")
+    });
+    tmux.keys(&["PageDown"]);
+    let screen = tmux.wait_for("the returned colour", |s| s.contains("= returned"));
+    assert!(
+        line_with(&screen, "+ reflected").contains("kr × its colour"),
+        "{screen}"
+    );
+    // Esc leaves the zoom, and does not quit.
+    tmux.keys(&["Escape"]);
+    tmux.wait_for("the layout again", |s| {
+        s.contains("Ray tree of (400, 270)") && !s.contains("zoomed: z back")
+    });
+    tmux.keys(&["q"]);
+    tmux.wait_for("the shell after q", |s| {
         s.contains("debugger exited with 0")
     });
 }

@@ -36,11 +36,19 @@ impl Focus {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Action {
     Quit,
-    /// Esc: cancels the trace under way, or quits when there is none.
+    /// Esc: cancels the trace under way, else leaves the zoomed pane, else ends the search.
+    /// It never quits (q does).
     Cancel,
     ToggleHelp,
+    /// Scrolls the help by lines.
+    HelpScroll(i32),
     /// Moves the image cursor by pixels.
     MoveCursor {
+        dx: i32,
+        dy: i32,
+    },
+    /// Moves the image cursor by display cells: one column across, one half-block row down.
+    MoveCursorByCells {
         dx: i32,
         dy: i32,
     },
@@ -78,6 +86,18 @@ pub enum Action {
     TreePage(i32),
     TreeToggle,
     InspectorScroll(i32),
+    /// Scrolls the inspector sideways by columns.
+    InspectorScrollSideways(i32),
+    /// Zooms the focused pane to the whole body, or restores the layout.
+    ToggleZoom,
+    /// Opens the `/` prompt to search the ray tree.
+    StartSearch,
+    /// A key for the open prompt.
+    PromptKey(KeyEvent),
+    /// Selects the next (`forward`) or previous ray matching the search.
+    SearchStep {
+        forward: bool,
+    },
     ToggleOverlay(HeatMapKind),
     ToggleHitPoint,
     /// Shows the material's definition in the source pane instead of the object's, or back.
@@ -114,8 +134,8 @@ pub enum Action {
 /// The keys `?` lists: (section, keys, what they do). Every binding in
 /// [`action_for_key`] appears here.
 pub const KEY_HELP: &[(&str, &str, &str)] = &[
-    ("Image", "←↑↓→ hjkl", "move the cursor one pixel"),
-    ("Image", "Shift+move HJKL", "move the cursor ten pixels"),
+    ("Image", "←↑↓→ hjkl", "move the cursor one cell"),
+    ("Image", "Shift+move HJKL", "move the cursor one pixel"),
     ("Image", "Enter, click", "trace the pixel: its ray tree"),
     ("Image", "+ / -, wheel", "zoom in / out at the cursor"),
     ("Image", "Ctrl/Alt+arrows", "pan the view"),
@@ -128,19 +148,34 @@ pub const KEY_HELP: &[(&str, &str, &str)] = &[
     ("Ray tree", "→ l", "expand, or go to the first child"),
     ("Ray tree", "Enter", "expand or collapse"),
     ("Ray tree", "Home End PgUp/Dn", "first / last / page"),
-    ("Ray tree", "a  p", "all rays; follow heaviest child"),
-    ("Ray tree", "] [  } {", "step, run to event: fwd / back"),
+    ("Ray tree", "n N", "next / previous match of /"),
+    ("Ray tree", "a", "all rays / collapse light ones"),
+    ("Ray tree", "p", "follow the heaviest child"),
+    ("Ray tree", "] [", "step forward / back, trace order"),
+    ("Ray tree", "} {", "run to the next / previous event"),
     ("Inspector", "↑↓ PgUp/Dn", "scroll"),
-    ("Inspector", "x  Enter", "explain pixel; go to entry"),
+    ("Inspector", "←→ hl", "scroll sideways"),
+    ("Inspector", "x", "explain the pixel (Enter: go)"),
     ("Source", "m", "material / object definition"),
     ("Anywhere", "Tab Shift+Tab", "next / previous pane"),
-    ("Anywhere", "r  e", "reload; write the tree as JSON"),
-    ("Anywhere", "?  q  Esc", "help; quit (Esc: cancel trace)"),
+    ("Anywhere", "z", "zoom the pane (Tab: next pane)"),
+    ("Anywhere", "/", "search rays: kind, object, light"),
+    ("Anywhere", "r", "reload (automatic on save)"),
+    ("Anywhere", "e", "export the tree (JSON, by scene)"),
+    ("Anywhere", "?", "this help"),
+    ("Anywhere", "Esc", "close, leave zoom/search, cancel"),
+    ("Anywhere", "q", "quit"),
 ];
 
-/// The action for a key, given which pane has focus and whether the help is open (then any
-/// key closes it).
-pub fn action_for_key(key: KeyEvent, focus: Focus, help_open: bool) -> Option<Action> {
+/// The action for a key, given which pane has focus, whether the help is open (then
+/// ↑↓ PgUp/PgDn scroll it and any other key closes it) and whether a prompt is open (then
+/// it takes every key).
+pub fn action_for_key(
+    key: KeyEvent,
+    focus: Focus,
+    help_open: bool,
+    prompt_open: bool,
+) -> Option<Action> {
     if key.kind == KeyEventKind::Release {
         return None;
     }
@@ -150,8 +185,17 @@ pub fn action_for_key(key: KeyEvent, focus: Focus, help_open: bool) -> Option<Ac
     if control && matches!(key.code, KeyCode::Char('c' | 'C')) {
         return Some(Action::Quit);
     }
+    if prompt_open {
+        return Some(Action::PromptKey(key));
+    }
     if help_open {
-        return Some(Action::ToggleHelp);
+        return Some(match key.code {
+            KeyCode::Up | KeyCode::Char('k') => Action::HelpScroll(-1),
+            KeyCode::Down | KeyCode::Char('j') => Action::HelpScroll(1),
+            KeyCode::PageUp => Action::HelpScroll(-10),
+            KeyCode::PageDown => Action::HelpScroll(10),
+            _ => Action::ToggleHelp,
+        });
     }
     if control || alt {
         return pan_for(key.code);
@@ -179,6 +223,8 @@ pub fn action_for_key(key: KeyEvent, focus: Focus, help_open: bool) -> Option<Ac
         KeyCode::Char('}') => Some(Action::RunToEvent { forward: true }),
         KeyCode::Char('{') => Some(Action::RunToEvent { forward: false }),
         KeyCode::Char('v') => Some(Action::ToggleRayView),
+        KeyCode::Char('z') => Some(Action::ToggleZoom),
+        KeyCode::Char('/') => Some(Action::StartSearch),
         _ => None,
     };
     if global.is_some() {
@@ -202,23 +248,28 @@ fn pan_for(code: KeyCode) -> Option<Action> {
     Some(Action::Pan { columns, rows })
 }
 
+/// Plain moves go by display cells (at fit zoom one pixel is a fraction of a cell, too
+/// small a step to see); Shift+move and HJKL go by single image pixels.
 fn image_key(code: KeyCode, shift: bool) -> Option<Action> {
-    let step = if shift { 10 } else { 1 };
     let (dx, dy) = match code {
-        KeyCode::Left | KeyCode::Char('h') => (-step, 0),
-        KeyCode::Right | KeyCode::Char('l') => (step, 0),
-        KeyCode::Up | KeyCode::Char('k') => (0, -step),
-        KeyCode::Down | KeyCode::Char('j') => (0, step),
+        KeyCode::Left | KeyCode::Char('h') => (-1, 0),
+        KeyCode::Right | KeyCode::Char('l') => (1, 0),
+        KeyCode::Up | KeyCode::Char('k') => (0, -1),
+        KeyCode::Down | KeyCode::Char('j') => (0, 1),
         // Shift+h arrives as 'H' (with or without the SHIFT flag, depending on the terminal).
-        KeyCode::Char('H') => (-10, 0),
-        KeyCode::Char('L') => (10, 0),
-        KeyCode::Char('K') => (0, -10),
-        KeyCode::Char('J') => (0, 10),
+        KeyCode::Char('H') => return Some(Action::MoveCursor { dx: -1, dy: 0 }),
+        KeyCode::Char('L') => return Some(Action::MoveCursor { dx: 1, dy: 0 }),
+        KeyCode::Char('K') => return Some(Action::MoveCursor { dx: 0, dy: -1 }),
+        KeyCode::Char('J') => return Some(Action::MoveCursor { dx: 0, dy: 1 }),
         KeyCode::Enter => return Some(Action::TraceCursor),
         KeyCode::Char('0') => return Some(Action::ResetRayView),
         _ => return None,
     };
-    Some(Action::MoveCursor { dx, dy })
+    Some(if shift {
+        Action::MoveCursor { dx, dy }
+    } else {
+        Action::MoveCursorByCells { dx, dy }
+    })
 }
 
 fn tree_key(code: KeyCode) -> Option<Action> {
@@ -232,6 +283,8 @@ fn tree_key(code: KeyCode) -> Option<Action> {
         KeyCode::PageUp => Action::TreePage(-10),
         KeyCode::PageDown => Action::TreePage(10),
         KeyCode::Enter | KeyCode::Char(' ') => Action::TreeToggle,
+        KeyCode::Char('n') => Action::SearchStep { forward: true },
+        KeyCode::Char('N') => Action::SearchStep { forward: false },
         _ => return None,
     })
 }
@@ -244,6 +297,10 @@ fn inspector_key(code: KeyCode) -> Option<Action> {
         KeyCode::PageDown => Action::InspectorScroll(10),
         KeyCode::Home => Action::InspectorScroll(i32::MIN),
         KeyCode::Enter => Action::ExplainGo,
+        KeyCode::Left | KeyCode::Char('h') => Action::InspectorScrollSideways(-8),
+        KeyCode::Right | KeyCode::Char('l') => Action::InspectorScrollSideways(8),
+        KeyCode::Char('n') => Action::SearchStep { forward: true },
+        KeyCode::Char('N') => Action::SearchStep { forward: false },
         _ => return None,
     })
 }
@@ -284,54 +341,103 @@ mod tests {
     fn arrows_move_the_cursor_in_the_image_and_the_selection_in_the_tree() {
         let right = key(KeyCode::Right);
         assert_eq!(
-            action_for_key(right, Focus::Image, false),
-            Some(Action::MoveCursor { dx: 1, dy: 0 })
+            action_for_key(right, Focus::Image, false, false),
+            Some(Action::MoveCursorByCells { dx: 1, dy: 0 })
         );
         assert_eq!(
-            action_for_key(shifted(KeyCode::Up), Focus::Image, false),
-            Some(Action::MoveCursor { dx: 0, dy: -10 })
+            action_for_key(key(KeyCode::Char('j')), Focus::Image, false, false),
+            Some(Action::MoveCursorByCells { dx: 0, dy: 1 })
+        );
+        // Shift and HJKL go by single pixels, however the terminal reports the shift.
+        assert_eq!(
+            action_for_key(shifted(KeyCode::Up), Focus::Image, false, false),
+            Some(Action::MoveCursor { dx: 0, dy: -1 })
         );
         assert_eq!(
-            action_for_key(shifted(KeyCode::Char('J')), Focus::Image, false),
-            Some(Action::MoveCursor { dx: 0, dy: 10 })
+            action_for_key(shifted(KeyCode::Char('J')), Focus::Image, false, false),
+            Some(Action::MoveCursor { dx: 0, dy: 1 })
         );
         assert_eq!(
-            action_for_key(right, Focus::Tree, false),
+            action_for_key(key(KeyCode::Char('H')), Focus::Image, false, false),
+            Some(Action::MoveCursor { dx: -1, dy: 0 })
+        );
+        assert_eq!(
+            action_for_key(right, Focus::Tree, false, false),
             Some(Action::TreeRight)
         );
         assert_eq!(
-            action_for_key(key(KeyCode::Char('k')), Focus::Tree, false),
+            action_for_key(key(KeyCode::Char('k')), Focus::Tree, false, false),
             Some(Action::TreeUp)
         );
         assert_eq!(
-            action_for_key(key(KeyCode::Down), Focus::Inspector, false),
+            action_for_key(key(KeyCode::Down), Focus::Inspector, false, false),
             Some(Action::InspectorScroll(1))
         );
+        assert_eq!(
+            action_for_key(key(KeyCode::Right), Focus::Inspector, false, false),
+            Some(Action::InspectorScrollSideways(8))
+        );
+    }
+
+    #[test]
+    fn search_zoom_and_matches_have_their_keys() {
+        for focus in [Focus::Image, Focus::Tree, Focus::Inspector] {
+            assert_eq!(
+                action_for_key(key(KeyCode::Char('/')), focus, false, false),
+                Some(Action::StartSearch)
+            );
+            assert_eq!(
+                action_for_key(key(KeyCode::Char('z')), focus, false, false),
+                Some(Action::ToggleZoom)
+            );
+        }
+        for focus in [Focus::Tree, Focus::Inspector] {
+            assert_eq!(
+                action_for_key(key(KeyCode::Char('N')), focus, false, false),
+                Some(Action::SearchStep { forward: false })
+            );
+        }
+        // n in the image is the what-if task's (next matching pixel).
+        assert_eq!(
+            action_for_key(key(KeyCode::Char('n')), Focus::Image, false, false),
+            None
+        );
+    }
+
+    #[test]
+    fn an_open_prompt_takes_every_key_even_q_and_esc() {
+        for code in [KeyCode::Char('q'), KeyCode::Esc, KeyCode::Char('?')] {
+            assert_eq!(
+                action_for_key(key(code), Focus::Tree, false, true),
+                Some(Action::PromptKey(key(code)))
+            );
+        }
     }
 
     #[test]
     fn global_keys_work_in_every_pane() {
         for focus in [Focus::Image, Focus::Tree, Focus::Inspector] {
             assert_eq!(
-                action_for_key(key(KeyCode::Char('q')), focus, false),
+                action_for_key(key(KeyCode::Char('q')), focus, false, false),
                 Some(Action::Quit)
             );
             assert_eq!(
-                action_for_key(key(KeyCode::Esc), focus, false),
+                action_for_key(key(KeyCode::Esc), focus, false, false),
                 Some(Action::Cancel)
             );
             assert_eq!(
-                action_for_key(key(KeyCode::Char('e')), focus, false),
+                action_for_key(key(KeyCode::Char('e')), focus, false, false),
                 Some(Action::Export)
             );
             assert_eq!(
-                action_for_key(key(KeyCode::Tab), focus, false),
+                action_for_key(key(KeyCode::Tab), focus, false, false),
                 Some(Action::FocusNext)
             );
             assert_eq!(
                 action_for_key(
                     KeyEvent::new(KeyCode::Left, KeyModifiers::CONTROL),
                     focus,
+                    false,
                     false
                 ),
                 Some(Action::Pan {
@@ -356,28 +462,37 @@ mod tests {
         for focus in [Focus::Image, Focus::Tree, Focus::Inspector] {
             for (c, action) in bindings {
                 assert_eq!(
-                    action_for_key(key(KeyCode::Char(c)), focus, false),
+                    action_for_key(key(KeyCode::Char(c)), focus, false, false),
                     Some(action)
                 );
             }
         }
         assert_eq!(
-            action_for_key(key(KeyCode::Enter), Focus::Inspector, false),
+            action_for_key(key(KeyCode::Enter), Focus::Inspector, false, false),
             Some(Action::ExplainGo)
         );
     }
 
     #[test]
-    fn with_help_open_any_key_closes_it_but_ctrl_c_still_quits() {
+    fn with_help_open_arrows_scroll_it_other_keys_close_it_and_ctrl_c_still_quits() {
         assert_eq!(
-            action_for_key(key(KeyCode::Char('x')), Focus::Image, true),
+            action_for_key(key(KeyCode::Char('x')), Focus::Image, true, false),
             Some(Action::ToggleHelp)
+        );
+        assert_eq!(
+            action_for_key(key(KeyCode::Esc), Focus::Image, true, false),
+            Some(Action::ToggleHelp)
+        );
+        assert_eq!(
+            action_for_key(key(KeyCode::Down), Focus::Image, true, false),
+            Some(Action::HelpScroll(1))
         );
         assert_eq!(
             action_for_key(
                 KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL),
                 Focus::Image,
-                true
+                true,
+                false
             ),
             Some(Action::Quit)
         );
@@ -387,9 +502,9 @@ mod tests {
     fn key_releases_and_unbound_keys_do_nothing() {
         let mut release = key(KeyCode::Char('q'));
         release.kind = KeyEventKind::Release;
-        assert_eq!(action_for_key(release, Focus::Image, false), None);
+        assert_eq!(action_for_key(release, Focus::Image, false, false), None);
         assert_eq!(
-            action_for_key(key(KeyCode::Char('z')), Focus::Image, false),
+            action_for_key(key(KeyCode::Char('y')), Focus::Image, false, false),
             None
         );
     }
@@ -420,11 +535,11 @@ mod tests {
     #[test]
     fn v_shows_the_3d_view_0_resets_it_and_left_drags_orbit_it() {
         assert_eq!(
-            action_for_key(key(KeyCode::Char('v')), Focus::Tree, false),
+            action_for_key(key(KeyCode::Char('v')), Focus::Tree, false, false),
             Some(Action::ToggleRayView)
         );
         assert_eq!(
-            action_for_key(key(KeyCode::Char('0')), Focus::Image, false),
+            action_for_key(key(KeyCode::Char('0')), Focus::Image, false, false),
             Some(Action::ResetRayView)
         );
         let drag = MouseEvent {

@@ -16,8 +16,10 @@ use crate::action::Focus;
 use crate::framebuffer::Framebuffer;
 use crate::heat_map::{HeatMap, HeatMapKind};
 use crate::image_view::{ColorDepth, Viewport};
-use crate::layout::{self, Panes};
+use crate::layout::{self, Arrangement, Panes};
+use crate::line_input::LineInput;
 use crate::ray_view_state::{BackdropJob, BackdropRendered, RayViewState};
+use crate::search::Search;
 use crate::trace_job::{Explained, TraceFailure, TraceJob, Traced};
 use crate::tree_view::TreeView;
 
@@ -162,7 +164,16 @@ pub struct App {
     pub picked: Option<Picked>,
     pub source_target: SourceTarget,
     pub inspector_scroll: u16,
+    /// How many columns the inspector is scrolled sideways.
+    pub inspector_columns: u16,
     pub help_open: bool,
+    pub help_scroll: u16,
+    /// `z`: the focused pane fills the body.
+    pub zoomed: bool,
+    /// The `/` prompt while it is open (it takes the keys).
+    pub search_prompt: Option<LineInput>,
+    /// The last submitted search of the picked tree, for `n` / `N`.
+    pub search: Option<Search>,
     /// Set after a failed reload, cleared by a good one.
     pub errors: Option<SceneErrors>,
     pub reloading: bool,
@@ -213,7 +224,12 @@ impl App {
             picked: None,
             source_target: SourceTarget::Object,
             inspector_scroll: 0,
+            inspector_columns: 0,
             help_open: false,
+            help_scroll: 0,
+            zoomed: false,
+            search_prompt: None,
+            search: None,
             errors: None,
             reloading: false,
             message: None,
@@ -237,9 +253,18 @@ impl App {
         (self.options.width, self.options.height)
     }
 
+    /// What decides the layout besides the terminal size.
+    pub fn arrangement(&self) -> Arrangement {
+        Arrangement {
+            errors: self.errors.is_some(),
+            focus: self.focus,
+            zoomed: self.zoomed,
+        }
+    }
+
     /// The panes for the current terminal size (`None` when it is too small).
     pub fn panes(&self) -> Option<Panes> {
-        layout::panes(self.area, self.image_size(), self.errors.is_some())
+        layout::panes(self.area, self.image_size(), self.arrangement())
     }
 
     /// The area the image is drawn in (inside the pane's border).
@@ -247,10 +272,11 @@ impl App {
         self.panes().map(|p| layout::inner(p.image))
     }
 
-    /// The rows the tree pane shows.
+    /// The rays the tree pane shows: the rows inside its border but the column header.
     pub fn tree_rows(&self) -> usize {
-        self.panes()
-            .map_or(1, |p| usize::from(layout::inner(p.tree).height))
+        self.panes().map_or(1, |p| {
+            usize::from(layout::inner(p.tree).height.saturating_sub(1)).max(1)
+        })
     }
 
     pub fn viewport(&self) -> Viewport {
@@ -327,11 +353,16 @@ impl App {
                     _ => {
                         self.inspector_scroll = 0;
                         self.explain_selected = 0;
+                        self.search = None;
                         TreeView::new(tree)
                     }
                 };
                 self.source_focus = None;
                 view.keep_selection_in_view(self.tree_rows());
+                // A re-traced tree may have other rays: the search's matches are found again.
+                if let Some(search) = &mut self.search {
+                    *search = Search::new(&search.query, &view);
+                }
                 if view.tree().unrecorded > 0 {
                     self.set_message(
                         format!(
@@ -549,12 +580,13 @@ impl App {
                     .as_ref()
                     .map(|p| p.tree.tree().pixel)
                     .unwrap_or_default();
+                // The path first: on a narrow status line the end is what gets cut.
                 self.set_message(
                     format!(
-                        "wrote the ray tree of ({}, {}) to {}",
+                        "wrote {} (the ray tree of ({}, {}))",
+                        path.display(),
                         pixel[0],
-                        pixel[1],
-                        path.display()
+                        pixel[1]
                     ),
                     false,
                 );
@@ -641,6 +673,12 @@ mod tests {
             picked.tree.select(transmitted);
         }
         let selected = app.picked.as_ref().map(|p| p.tree.selected());
+        // A search made before the reload: its (here stale) matches are found again.
+        app.search = Some(Search {
+            query: "transmitted".into(),
+            matches: vec![999],
+            current: 0,
+        });
         app.reloading = true;
         let effects = app.apply_reload(Ok((LoadedScene::new(whitted_scene()), 0)));
         assert_eq!(effects, vec![Effect::StartRender, Effect::Trace]);
@@ -648,6 +686,11 @@ mod tests {
         assert!(app.errors.is_none());
         finish_trace(&mut app);
         assert_eq!(app.picked.as_ref().map(|p| p.tree.selected()), selected);
+        let tree = &app.picked.as_ref().unwrap().tree;
+        assert_eq!(
+            app.search.as_ref().map(|s| s.matches.clone()),
+            Some(crate::search::matching_rays(tree, "transmitted"))
+        );
         assert_eq!(
             app.message.as_ref().unwrap().text,
             "reloaded scenes/whitted.scene"
@@ -733,9 +776,10 @@ mod tests {
         assert_eq!(traced.result.as_ref().err(), Some(&TraceFailure::Cancelled));
         app.apply_trace(traced);
         assert!(app.picked.is_none(), "a cancelled trace leaves no tree");
-        // With no trace under way, Esc quits.
+        // With no trace under way, Esc still does not quit (q does).
         crate::update::update(&mut app, crate::action::Action::Cancel);
-        assert!(app.should_quit);
+        assert!(!app.should_quit);
+        assert!(app.message.as_ref().unwrap().text.contains("q quits"));
     }
 
     #[test]

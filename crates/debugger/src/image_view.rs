@@ -79,7 +79,8 @@ impl Viewport {
     }
 }
 
-/// Whether the terminal shows 24-bit colour; otherwise colours go to the 256-colour cube.
+/// Whether the terminal shows 24-bit colour; otherwise colours go to the nearest xterm-256
+/// palette entry ([`crate::palette`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ColorDepth {
     TrueColor,
@@ -101,43 +102,10 @@ impl ColorDepth {
     pub fn color(self, [r, g, b]: [u8; 3]) -> Color {
         match self {
             ColorDepth::TrueColor => Color::Rgb(r, g, b),
-            ColorDepth::Indexed256 => Color::Indexed(xterm_index(r, g, b)),
+            ColorDepth::Indexed256 => {
+                Color::Indexed(crate::palette::nearest_xterm_index([r, g, b]))
+            }
         }
-    }
-}
-
-/// The nearest xterm-256 colour: the 6x6x6 cube or the 24-step grey ramp.
-fn xterm_index(r: u8, g: u8, b: u8) -> u8 {
-    const LEVELS: [u8; 6] = [0, 95, 135, 175, 215, 255];
-    let nearest_level = |v: u8| {
-        (0..6)
-            .min_by_key(|&i| (i32::from(LEVELS[i]) - i32::from(v)).abs())
-            .unwrap_or(0) as u8
-    };
-    let (ri, gi, bi) = (nearest_level(r), nearest_level(g), nearest_level(b));
-    let cube = [
-        LEVELS[ri as usize],
-        LEVELS[gi as usize],
-        LEVELS[bi as usize],
-    ];
-    let grey_level = ((u32::from(r) + u32::from(g) + u32::from(b)) / 3) as u8;
-    let grey_index = if grey_level < 8 {
-        0
-    } else {
-        ((grey_level - 8) / 10).min(23)
-    };
-    let grey = 8 + grey_index * 10;
-    let distance = |c: [u8; 3]| -> i32 {
-        [r, g, b]
-            .iter()
-            .zip(c)
-            .map(|(&a, b)| (i32::from(a) - i32::from(b)).pow(2))
-            .sum()
-    };
-    if distance([grey; 3]) < distance(cube) {
-        232 + grey_index
-    } else {
-        16 + 36 * ri + 6 * gi + bi
     }
 }
 
@@ -280,9 +248,14 @@ mod tests {
             ColorDepth::TrueColor
         );
         assert_eq!(ColorDepth::from_colorterm(None), ColorDepth::Indexed256);
-        assert_eq!(xterm_index(255, 0, 0), 196);
-        assert_eq!(xterm_index(0, 0, 0), 16);
-        assert_eq!(xterm_index(128, 128, 128), 244);
+        assert_eq!(
+            ColorDepth::Indexed256.color([255, 0, 0]),
+            Color::Indexed(196)
+        );
+        assert_eq!(
+            ColorDepth::Indexed256.color([128, 128, 128]),
+            Color::Indexed(244)
+        );
     }
 
     #[test]

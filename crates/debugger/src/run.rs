@@ -253,10 +253,12 @@ fn event_loop(
 /// Input and render events: the part of event handling that needs no worker handles.
 fn handle(app: &mut App, event: Event) -> Vec<Effect> {
     match event {
-        Event::Key(key) => match action_for_key(key, app.focus, app.help_open) {
-            Some(action) => update(app, action),
-            None => Vec::new(),
-        },
+        Event::Key(key) => {
+            match action_for_key(key, app.focus, app.help_open, app.search_prompt.is_some()) {
+                Some(action) => update(app, action),
+                None => Vec::new(),
+            }
+        }
         Event::Mouse(mouse) => match action_for_mouse(mouse) {
             Some(action) => update(app, action),
             None => Vec::new(),

@@ -4,11 +4,15 @@
 
 use std::path::Path;
 
+use ratatui::crossterm::event::KeyEvent;
+
 use crate::action::{Action, Focus};
 use crate::app::{App, Effect, SourceTarget, View};
 use crate::follow_update;
 use crate::image_view::Viewport;
 use crate::layout;
+use crate::line_input::InputOutcome;
+use crate::search::Search;
 
 /// Applies one action; returns what the event loop must do about it.
 pub fn update(app: &mut App, action: Action) -> Vec<Effect> {
@@ -20,6 +24,11 @@ pub fn update(app: &mut App, action: Action) -> Vec<Effect> {
     if app.trace_requests != requests {
         effects.push(Effect::Trace);
     }
+    // Focus and zoom change the tree pane's height: keep the selected ray in sight.
+    let rows = app.tree_rows();
+    if let Some(picked) = &mut app.picked {
+        picked.tree.keep_selection_in_view(rows);
+    }
     effects
 }
 
@@ -29,16 +38,24 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
     }
     match action {
         Action::Quit => app.should_quit = true,
-        // Esc stops a runaway trace first; with none under way it quits.
-        Action::Cancel => {
-            if app.cancel_trace() {
-                app.set_message("cancelled the trace", false);
-            } else {
-                app.should_quit = true;
-            }
+        Action::Cancel => cancel(app),
+        Action::ToggleHelp => {
+            app.help_open = !app.help_open;
+            app.help_scroll = 0;
         }
-        Action::ToggleHelp => app.help_open = !app.help_open,
+        Action::HelpScroll(lines) => {
+            // No further than the last key: the help has a line per key and a border.
+            let rows = crate::action::KEY_HELP.len() + 2;
+            let hidden = rows.saturating_sub(usize::from(app.area.height));
+            let scrolled = i64::from(app.help_scroll) + i64::from(lines);
+            app.help_scroll = scrolled.clamp(0, hidden as i64) as u16;
+        }
         Action::MoveCursor { dx, dy } => move_cursor(app, dx, dy),
+        Action::MoveCursorByCells { dx, dy } => {
+            // One cell is `scale` image pixels across and one half-block row down.
+            let step = app.viewport().scale.round().max(1.0) as i32;
+            move_cursor(app, dx.saturating_mul(step), dy.saturating_mul(step));
+        }
         Action::TraceCursor => app.trace_cursor(),
         Action::Click { column, row } => click(app, column, row),
         Action::Wheel { column, row, lines } => wheel(app, column, row, lines),
@@ -57,6 +74,23 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
         Action::TreePage(rows) => tree(app, |t| t.page(rows as isize)),
         Action::TreeToggle => tree(app, |t| t.toggle()),
         Action::InspectorScroll(lines) => scroll_inspector(app, lines),
+        Action::InspectorScrollSideways(columns) => {
+            app.inspector_columns =
+                (i32::from(app.inspector_columns) + columns).clamp(0, 500) as u16;
+        }
+        Action::ToggleZoom => app.zoomed = !app.zoomed,
+        Action::StartSearch => {
+            if app.picked.is_some() {
+                app.search_prompt = Some(crate::line_input::LineInput::new(""));
+            } else {
+                app.set_message(
+                    "no ray tree to search: move the cursor and press Enter",
+                    false,
+                );
+            }
+        }
+        Action::PromptKey(key) => prompt_key(app, key),
+        Action::SearchStep { forward } => search_step(app, forward),
         Action::ToggleOverlay(kind) => {
             app.overlay = if app.overlay == Some(kind) {
                 None
@@ -68,7 +102,11 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
                 app.set_message("the overlay appears when the render finishes", false);
             }
         }
-        Action::ToggleHitPoint => app.show_hit_point = !app.show_hit_point,
+        Action::ToggleHitPoint => {
+            app.show_hit_point = !app.show_hit_point;
+            let state = if app.show_hit_point { "on" } else { "off" };
+            app.set_message(format!("hit-point mark {state}"), false);
+        }
         Action::ToggleSourceTarget => {
             app.source_target = match app.source_target {
                 SourceTarget::Object => SourceTarget::Material,
@@ -102,8 +140,10 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
     Vec::new()
 }
 
-/// How far one arrow press orbits the 3D view (Shift: ten presses).
+/// How far one arrow press orbits the 3D view; Shift+arrow (a single pixel's move on the
+/// image) turns it by a fine step.
 const ORBIT_STEP_DEGREES: f64 = 5.0;
+const FINE_ORBIT_STEP_DEGREES: f64 = 1.0;
 /// How far a drag across one cell orbits it (a row is twice as tall as a column is wide).
 const DRAG_DEGREES_PER_COLUMN: f64 = 3.0;
 const ZOOM_STEP: f64 = 1.25;
@@ -125,9 +165,13 @@ fn ray_view_action(app: &mut App, action: Action) -> bool {
     }
     let orbit = &mut view.orbit;
     match action {
-        Action::MoveCursor { dx, dy } => orbit.orbit(
+        Action::MoveCursorByCells { dx, dy } => orbit.orbit(
             f64::from(dx) * ORBIT_STEP_DEGREES.to_radians(),
             -f64::from(dy) * ORBIT_STEP_DEGREES.to_radians(),
+        ),
+        Action::MoveCursor { dx, dy } => orbit.orbit(
+            f64::from(dx) * FINE_ORBIT_STEP_DEGREES.to_radians(),
+            -f64::from(dy) * FINE_ORBIT_STEP_DEGREES.to_radians(),
         ),
         Action::ZoomIn => orbit.zoom(ZOOM_STEP),
         Action::ZoomOut => orbit.zoom(1.0 / ZOOM_STEP),
@@ -166,6 +210,70 @@ fn ray_view_action(app: &mut App, action: Action) -> bool {
         _ => return false,
     }
     true
+}
+
+/// Esc leaves whatever the user is in, one thing at a time, and never quits (`q` does, as
+/// in gitui and lazygit): a trace under way, the zoomed pane, the 3D view, the search.
+fn cancel(app: &mut App) {
+    if app.cancel_trace() {
+        app.set_message("cancelled the trace", false);
+    } else if app.zoomed {
+        app.zoomed = false;
+    } else if app.ray_view.take().is_some() {
+        app.set_message("3D view closed (v opens it)", false);
+    } else if app.search.take().is_some() {
+        app.set_message("search ended", false);
+    } else {
+        app.set_message("Esc closes and leaves modes; q quits", false);
+    }
+}
+
+/// A key for the `/` prompt: editing keys edit, Enter searches, Esc closes it.
+fn prompt_key(app: &mut App, key: KeyEvent) {
+    let Some(prompt) = &mut app.search_prompt else {
+        return;
+    };
+    match prompt.handle(key) {
+        InputOutcome::Edited | InputOutcome::Ignored => {}
+        InputOutcome::Cancelled => app.search_prompt = None,
+        InputOutcome::Submitted => {
+            let query = prompt.text().trim().to_string();
+            app.search_prompt = None;
+            if query.is_empty() {
+                return;
+            }
+            let Some(picked) = &app.picked else {
+                return;
+            };
+            let search = Search::new(&query, &picked.tree);
+            app.set_message(search.describe(), false);
+            if let Some(id) = search.current_match() {
+                select_ray(app, id);
+                // The match is a tree row: n / N step from there.
+                app.focus = Focus::Tree;
+            }
+            app.search = Some(search);
+        }
+    }
+}
+
+/// `n` / `N`: the next or previous ray matching the last search.
+fn search_step(app: &mut App, forward: bool) {
+    let Some(search) = &mut app.search else {
+        app.set_message("no search yet: / searches the ray tree", false);
+        return;
+    };
+    let target = search.step(forward);
+    let description = search.describe();
+    app.set_message(description, false);
+    if let Some(id) = target {
+        select_ray(app, id);
+    }
+}
+
+/// Selects a ray of the picked tree (opening its ancestors) and shows it.
+fn select_ray(app: &mut App, id: crate::tree_view::NodeId) {
+    tree(app, |t| t.select(id));
 }
 
 /// The image point zooming keeps in place: the centre of the cursor pixel.
@@ -251,7 +359,11 @@ fn click(app: &mut App, column: u16, row: u16) {
     } else if tree_area.contains(position) {
         app.focus = Focus::Tree;
         if let Some(picked) = &mut app.picked {
-            let index = picked.tree.scroll() + usize::from(row - tree_area.y);
+            // The first row is the column header.
+            let Some(row) = (row - tree_area.y).checked_sub(1) else {
+                return;
+            };
+            let index = picked.tree.scroll() + usize::from(row);
             if let Some(&id) = picked.tree.visible().get(index) {
                 if id != picked.tree.selected() {
                     picked.tree.select(id);
@@ -342,6 +454,7 @@ mod tests {
     use crate::app::LoadedScene;
     use crate::heat_map::HeatMapKind;
     use crate::test_scene::{whitted_scene, GLASS_PIXEL};
+    use ratatui::crossterm::event::KeyCode;
     use ratatui::layout::Rect;
     use whitted_tracer::RayKind;
 
@@ -412,11 +525,20 @@ mod tests {
     fn a_click_on_a_tree_row_selects_that_ray() {
         let mut app = picked_app();
         let tree = layout::inner(app.panes().unwrap().tree);
+        // The first row is the header: a click there selects nothing.
         update(
             &mut app,
             Action::Click {
                 column: tree.x + 3,
-                row: tree.y + 2,
+                row: tree.y,
+            },
+        );
+        assert_eq!(app.picked.as_ref().unwrap().tree.selected(), 0);
+        update(
+            &mut app,
+            Action::Click {
+                column: tree.x + 3,
+                row: tree.y + 3,
             },
         );
         assert_eq!(app.focus, Focus::Tree);
@@ -537,6 +659,133 @@ mod tests {
         assert_eq!(app.overlay, None);
         update(&mut app, Action::ToggleHitPoint);
         assert!(!app.show_hit_point);
+        assert_eq!(app.message.as_ref().unwrap().text, "hit-point mark off");
+        update(&mut app, Action::ToggleHitPoint);
+        assert_eq!(app.message.as_ref().unwrap().text, "hit-point mark on");
+    }
+
+    /// At fit zoom an arrow moves the cursor one display cell: `scale` pixels (11 at
+    /// 120x40, where a pixel step was 1/11 of a cell), and Shift one pixel.
+    #[test]
+    fn arrows_move_a_cell_at_fit_zoom_and_shift_moves_a_pixel() {
+        let mut app = app();
+        let scale = app.viewport().scale;
+        assert!((10.5..11.5).contains(&scale), "{scale}");
+        update(&mut app, Action::MoveCursorByCells { dx: 1, dy: 0 });
+        assert_eq!(app.cursor, (331, 240));
+        update(&mut app, Action::MoveCursorByCells { dx: 0, dy: -2 });
+        assert_eq!(app.cursor, (331, 218));
+        update(&mut app, Action::MoveCursor { dx: -1, dy: 1 });
+        assert_eq!(app.cursor, (330, 219));
+        // The drawn cursor moves one column per cell step.
+        let area = app.image_area().unwrap();
+        let before = app.viewport().cell_of(app.cursor.0, app.cursor.1, area);
+        update(&mut app, Action::MoveCursorByCells { dx: 1, dy: 0 });
+        let after = app.viewport().cell_of(app.cursor.0, app.cursor.1, area);
+        assert_eq!(after.map(|c| c.0), before.map(|c| c.0 + 1));
+        // Zoomed in past one pixel per cell, a cell step is one pixel.
+        for _ in 0..5 {
+            update(&mut app, Action::ZoomIn);
+        }
+        let cursor = app.cursor;
+        update(&mut app, Action::MoveCursorByCells { dx: 1, dy: 0 });
+        assert_eq!(app.cursor, (cursor.0 + 1, cursor.1));
+    }
+
+    #[test]
+    fn z_zooms_the_focused_pane_tab_cycles_it_and_z_or_esc_restore() {
+        let mut app = app();
+        update(&mut app, Action::ToggleZoom);
+        let body = Rect::new(0, 0, 120, 39);
+        assert_eq!(app.panes().unwrap().image, body);
+        assert_eq!(app.image_area(), Some(layout::inner(body)));
+        update(&mut app, Action::FocusNext);
+        let panes = app.panes().unwrap();
+        assert_eq!((panes.tree, panes.image.is_empty()), (body, true));
+        update(&mut app, Action::ToggleZoom);
+        assert!(!app.zoomed);
+        update(&mut app, Action::ToggleZoom);
+        update(&mut app, Action::Cancel);
+        assert!(!app.zoomed && !app.should_quit);
+    }
+
+    fn search(app: &mut App, query: &str) {
+        update(app, Action::StartSearch);
+        assert!(app.search_prompt.is_some(), "the prompt opens");
+        for c in query.chars() {
+            update(app, Action::PromptKey(KeyEvent::from(KeyCode::Char(c))));
+        }
+        update(app, Action::PromptKey(KeyEvent::from(KeyCode::Enter)));
+        assert!(app.search_prompt.is_none(), "Enter closes the prompt");
+    }
+
+    #[test]
+    fn slash_finds_rays_by_kind_and_n_and_shift_n_step_through_the_matches() {
+        let mut app = picked_app();
+        // A collapsed parent is opened to show the match.
+        app.picked.as_mut().unwrap().tree.left();
+        assert_eq!(app.picked.as_ref().unwrap().tree.visible().len(), 1);
+        search(&mut app, "transmitted");
+        let tree = &app.picked.as_ref().unwrap().tree;
+        let node = tree.selected_node().unwrap();
+        assert_eq!((node.kind, node.depth), (RayKind::Transmitted, 1));
+        assert!(tree.visible().contains(&tree.selected()));
+        assert_eq!(app.focus, Focus::Tree);
+        let count = app.search.as_ref().unwrap().matches.len();
+        assert_eq!(
+            app.message.as_ref().unwrap().text,
+            format!("match 1 of {count} for `transmitted` (n / N: next / previous)")
+        );
+        update(&mut app, Action::SearchStep { forward: true });
+        assert!(app.message.as_ref().unwrap().text.starts_with("match 2 of"));
+        let second = app.picked.as_ref().unwrap().tree.selected();
+        update(&mut app, Action::SearchStep { forward: false });
+        update(&mut app, Action::SearchStep { forward: false });
+        assert!(app
+            .message
+            .as_ref()
+            .unwrap()
+            .text
+            .starts_with(&format!("match {count} of")));
+        assert_ne!(app.picked.as_ref().unwrap().tree.selected(), second);
+        // Esc ends the search; a query with no match says so and moves nothing.
+        update(&mut app, Action::Cancel);
+        assert!(app.search.is_none());
+        let selected = app.picked.as_ref().unwrap().tree.selected();
+        search(&mut app, "foo");
+        assert_eq!(app.message.as_ref().unwrap().text, "no ray matches `foo`");
+        assert_eq!(app.picked.as_ref().unwrap().tree.selected(), selected);
+    }
+
+    #[test]
+    fn esc_in_the_prompt_closes_it_without_searching() {
+        let mut app = picked_app();
+        update(&mut app, Action::StartSearch);
+        update(
+            &mut app,
+            Action::PromptKey(KeyEvent::from(KeyCode::Char('s'))),
+        );
+        update(&mut app, Action::PromptKey(KeyEvent::from(KeyCode::Esc)));
+        assert!(app.search_prompt.is_none() && app.search.is_none());
+        assert!(!app.should_quit);
+        let mut untraced = self::app();
+        update(&mut untraced, Action::StartSearch);
+        assert!(untraced.search_prompt.is_none());
+        assert!(untraced
+            .message
+            .as_ref()
+            .unwrap()
+            .text
+            .contains("no ray tree"));
+    }
+
+    #[test]
+    fn the_inspector_scrolls_sideways_but_not_left_of_its_start() {
+        let mut app = app();
+        update(&mut app, Action::InspectorScrollSideways(8));
+        assert_eq!(app.inspector_columns, 8);
+        update(&mut app, Action::InspectorScrollSideways(-20));
+        assert_eq!(app.inspector_columns, 0);
     }
 
     #[test]
@@ -579,6 +828,20 @@ mod tests {
         assert!(!app.help_open, "a click closes the help");
         update(&mut app, Action::Quit);
         assert!(app.should_quit);
+    }
+
+    #[test]
+    fn the_help_scrolls_no_further_than_its_last_line() {
+        let mut app = app();
+        app.area = Rect::new(0, 0, 80, 24);
+        update(&mut app, Action::ToggleHelp);
+        update(&mut app, Action::HelpScroll(100));
+        let hidden = crate::action::KEY_HELP.len() + 2 - 24;
+        assert_eq!(usize::from(app.help_scroll), hidden);
+        update(&mut app, Action::HelpScroll(-1));
+        assert_eq!(usize::from(app.help_scroll), hidden - 1);
+        update(&mut app, Action::HelpScroll(-100));
+        assert_eq!(app.help_scroll, 0);
     }
 
     #[test]

@@ -1,5 +1,5 @@
 //! The `?` overlay: every key in one table (pane, keys, what they do), centred over the
-//! screen. It fits the smallest terminal the layout accepts.
+//! screen; ↑↓ scroll it when the terminal is shorter than the table.
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -12,7 +12,7 @@ use crate::action::KEY_HELP;
 const SECTION_WIDTH: usize = 10;
 const KEY_WIDTH: usize = 18;
 
-pub fn draw(area: Rect, buf: &mut Buffer) {
+pub fn draw(area: Rect, scroll: u16, buf: &mut Buffer) {
     let lines = help_lines();
     let content_width = lines.iter().map(Line::width).max().unwrap_or(0) as u16;
     let width = (content_width + 4).min(area.width);
@@ -24,9 +24,17 @@ pub fn draw(area: Rect, buf: &mut Buffer) {
         height,
     );
     Clear.render(popup, buf);
+    let inner_rows = height.saturating_sub(2);
+    let hidden = (lines.len() as u16).saturating_sub(inner_rows);
+    let scroll = scroll.min(hidden);
+    let title = if hidden > 0 {
+        " Keys · ↑↓ scroll · other keys close "
+    } else {
+        " Keys · any key closes "
+    };
     let block = Block::bordered()
         .border_style(Style::new().fg(Color::Yellow))
-        .title(" Keys · any key closes ");
+        .title(title);
     let inner = block.inner(popup);
     block.render(popup, buf);
     let padded = Rect::new(
@@ -35,7 +43,9 @@ pub fn draw(area: Rect, buf: &mut Buffer) {
         inner.width.saturating_sub(1),
         inner.height,
     );
-    Paragraph::new(lines).render(padded, buf);
+    Paragraph::new(lines)
+        .scroll((scroll, 0))
+        .render(padded, buf);
 }
 
 /// One line per key; the pane's name only on the first line of its group.
@@ -66,14 +76,30 @@ mod tests {
     use crate::layout::{MIN_HEIGHT, MIN_WIDTH};
 
     #[test]
-    fn the_help_fits_the_smallest_layout() {
+    fn the_help_fits_the_smallest_layout_in_width_and_scrolls_in_height() {
         let lines = help_lines();
         let width = lines.iter().map(Line::width).max().unwrap() + 4;
         assert!(width <= usize::from(MIN_WIDTH), "{width}");
-        assert!(
-            lines.len() + 2 <= usize::from(MIN_HEIGHT),
-            "{}",
-            lines.len()
-        );
+        let area = Rect::new(0, 0, MIN_WIDTH, MIN_HEIGHT);
+        let text = |scroll| {
+            let mut buf = Buffer::empty(area);
+            draw(area, scroll, &mut buf);
+            (0..area.height)
+                .map(|y| {
+                    (0..area.width)
+                        .map(|x| buf[(x, y)].symbol().to_string())
+                        .collect::<String>()
+                })
+                .collect::<Vec<_>>()
+                .join("\n")
+        };
+        let last = KEY_HELP.last().unwrap().2;
+        if lines.len() + 2 > usize::from(MIN_HEIGHT) {
+            assert!(!text(0).contains(last));
+            assert!(text(100).contains(last), "scrolled to the end");
+        } else {
+            assert!(text(0).contains(last));
+        }
+        assert!(text(0).contains(KEY_HELP[0].2));
     }
 }

@@ -1,5 +1,7 @@
 //! The inspector pane: every field of the selected ray (docs/ray-tree.md), colours with
-//! swatches beside their numbers, so the pixel's colour can be read off term by term.
+//! swatches beside their numbers, so the pixel's colour can be read off term by term. A
+//! header names the columns; ↑↓ scroll the lines under it and ←→ scroll everything
+//! sideways together, so the columns stay aligned with their header.
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -47,16 +49,93 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         node.kind.name(),
         node.depth
     );
-    let block = pane_block(Line::from(title), focused);
     let lines = Lines::new(app.color_depth).node(app, tree, id, node);
-    let inner_height = usize::from(block.inner(pane).height);
-    let longest_scroll = lines.len().saturating_sub(inner_height);
-    let scroll = usize::from(app.inspector_scroll).min(longest_scroll);
-    let mut paragraph = Paragraph::new(lines).block(block);
-    if longest_scroll > 0 {
-        paragraph = paragraph.scroll((u16::try_from(scroll).unwrap_or(u16::MAX), 0));
+    let mut block = pane_block(Line::from(title), focused);
+    let inner = block.inner(pane);
+    if inner.height < 2 {
+        block.render(pane, buf);
+        return;
     }
-    paragraph.render(pane, buf);
+    let body = Rect {
+        y: inner.y + 1,
+        height: inner.height - 1,
+        ..inner
+    };
+    let widest = lines.iter().map(Line::width).max().unwrap_or(0);
+    let hidden_columns = widest.saturating_sub(usize::from(inner.width));
+    let columns = usize::from(app.inspector_columns).min(hidden_columns);
+    let hidden_lines = lines.len().saturating_sub(usize::from(body.height));
+    let scroll = usize::from(app.inspector_scroll).min(hidden_lines);
+    // Say where more is, and which keys bring it.
+    let mut more = Vec::new();
+    if scroll > 0 || hidden_lines > scroll {
+        more.push("↑↓");
+    }
+    if columns > 0 || hidden_columns > columns {
+        more.push("←→");
+    }
+    if !more.is_empty() {
+        block =
+            block.title_bottom(Line::from(format!(" more: {} ", more.join(" "))).right_aligned());
+    }
+    block.render(pane, buf);
+    let mut all = vec![header()];
+    all.extend(
+        lines
+            .into_iter()
+            .skip(scroll)
+            .take(usize::from(body.height)),
+    );
+    if columns == 0 {
+        Paragraph::new(all).render(inner, buf);
+        return;
+    }
+    // Scrolled sideways, the field names stay put and the rest moves under its header.
+    let label_width = (LABEL_WIDTH as u16 + 1).min(inner.width);
+    let (labels, rest): (Vec<Line<'_>>, Vec<Line<'_>>) = all.into_iter().map(split_label).unzip();
+    Paragraph::new(labels).render(
+        Rect {
+            width: label_width,
+            ..inner
+        },
+        buf,
+    );
+    Paragraph::new(rest)
+        .scroll((0, u16::try_from(columns).unwrap_or(u16::MAX)))
+        .render(
+            Rect {
+                x: inner.x + label_width,
+                width: inner.width - label_width,
+                ..inner
+            },
+            buf,
+        );
+}
+
+/// A line's field name (its first span, when it fills the label column) and the rest.
+/// Section titles have no field name: all of them is the rest.
+fn split_label(line: Line<'static>) -> (Line<'static>, Line<'static>) {
+    let mut spans = line.spans;
+    let is_label = spans
+        .first()
+        .is_some_and(|span| span.width() == LABEL_WIDTH + 1);
+    if is_label {
+        let label = spans.remove(0);
+        (Line::from(label), Line::from(spans))
+    } else {
+        (Line::default(), Line::from(spans))
+    }
+}
+
+/// The column header: the field's name, its value (for a colour, its swatch and then r, g
+/// and b over their numbers), and a note on what it is.
+fn header() -> Line<'static> {
+    let style = Style::new()
+        .fg(Color::Gray)
+        .add_modifier(Modifier::BOLD | Modifier::UNDERLINED);
+    let field = format!("{:<width$}", "field", width = LABEL_WIDTH + 1);
+    let rest = format!("{:<7}{:<6}{:<6}{:<3}{}", "value", "r", "g", "b", "note");
+    Line::from(vec![Span::styled(field, style), Span::styled(rest, style)])
 }
 
 /// Builds the inspector's lines: a label column, then values.

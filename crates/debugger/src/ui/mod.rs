@@ -19,49 +19,71 @@ use ratatui::buffer::Buffer;
 use ratatui::layout::{Alignment, Rect};
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{Block, Paragraph, Widget, Wrap};
+use ratatui::widgets::{Block, BorderType, Paragraph, Widget, Wrap};
 
 use crate::app::App;
 use crate::layout::{self, MIN_HEIGHT, MIN_WIDTH};
 
 impl Widget for &App {
     fn render(self, area: Rect, buf: &mut Buffer) {
-        let Some(panes) = layout::panes(area, self.image_size(), self.errors.is_some()) else {
+        let Some(panes) = layout::panes(area, self.image_size(), self.arrangement()) else {
             too_small(area, buf);
             return;
         };
-        match &self.ray_view {
-            Some(view) => ray_view_pane::draw(self, view, panes.image, buf),
-            None => image_pane::draw(self, panes.image, buf),
+        // Zoomed, the panes other than the focused one are empty: not drawn.
+        if !panes.image.is_empty() {
+            match &self.ray_view {
+                Some(view) => ray_view_pane::draw(self, view, panes.image, buf),
+                None => image_pane::draw(self, panes.image, buf),
+            }
         }
-        tree_pane::draw(self, panes.tree, buf);
-        if self.explain_open {
-            explain_pane::draw(self, panes.inspector, buf);
-        } else {
-            inspector::draw(self, panes.inspector, buf);
+        if !panes.tree.is_empty() {
+            tree_pane::draw(self, panes.tree, buf);
         }
-        match &self.errors {
-            Some(errors) => errors_pane::draw(errors, panes.source, buf),
-            None => source_pane::draw(self, panes.source, buf),
+        if !panes.inspector.is_empty() {
+            if self.explain_open {
+                explain_pane::draw(self, panes.inspector, buf);
+            } else {
+                inspector::draw(self, panes.inspector, buf);
+            }
         }
-        status::draw(self, panes.status, buf);
+        if !panes.source.is_empty() {
+            match &self.errors {
+                Some(errors) => errors_pane::draw(errors, panes.source, buf),
+                None => source_pane::draw(self, panes.source, buf),
+            }
+        }
+        match &self.search_prompt {
+            Some(prompt) => status::draw_prompt(prompt, panes.status, buf),
+            None => status::draw(self, panes.status, buf),
+        }
         if self.help_open {
-            help::draw(area, buf);
+            help::draw(area, self.help_scroll, buf);
         }
     }
 }
 
-/// A pane's frame: its title, highlighted when the pane has the keyboard.
+/// A pane's frame and title. The pane with the keyboard has a thick yellow border and its
+/// title in black on yellow, so it stands out even in a 16-colour or monochrome terminal
+/// (the border's shape differs, not only its colour).
 fn pane_block(title: Line<'static>, focused: bool) -> Block<'static> {
-    let border = if focused {
-        Style::new().fg(Color::Yellow).add_modifier(Modifier::BOLD)
+    if focused {
+        Block::bordered()
+            .border_type(BorderType::Thick)
+            .border_style(Style::new().fg(Color::Yellow).add_modifier(Modifier::BOLD))
+            .title(title)
+            .title_style(
+                Style::new()
+                    .fg(Color::Black)
+                    .bg(Color::Yellow)
+                    .add_modifier(Modifier::BOLD),
+            )
     } else {
-        Style::new().fg(Color::DarkGray)
-    };
-    Block::bordered()
-        .border_style(border)
-        .title(title)
-        .title_style(Style::new().fg(Color::Reset).add_modifier(Modifier::BOLD))
+        Block::bordered()
+            .border_style(Style::new().fg(Color::DarkGray))
+            .title(title)
+            .title_style(Style::new().fg(Color::Reset).add_modifier(Modifier::BOLD))
+    }
 }
 
 /// Said instead of drawing a layout that cannot fit.

@@ -1,11 +1,13 @@
 //! Screen snapshots of whole frames (ratatui's TestBackend, insta): the layout at the usual
-//! sizes, a picked pixel with its tree, the help, a failed reload, a terminal too small.
+//! sizes, a picked pixel with its tree, every pane focused and zoomed at 80x24 and 120x40,
+//! the search prompt, the help, a failed reload, a terminal too small.
 //! Timings that vary from run to run are pinned before drawing.
 
 use std::time::Duration;
 
 use insta::assert_snapshot;
 use ratatui::backend::TestBackend;
+use ratatui::crossterm::event::{KeyCode, KeyEvent};
 use ratatui::layout::Rect;
 use ratatui::Terminal;
 use whitted_ir::{Diagnostic, SourceFile, SourceMap, Span};
@@ -306,4 +308,80 @@ fn glass_pixel_rays_in_3d_from_an_orbited_camera_at_80x24() {
     let terminal = draw(&app);
     assert!(braille_colors(&app, &terminal).len() > 10);
     assert_snapshot!(terminal.backend());
+}
+
+/// The glass pixel picked, its transmitted ray found with `/transmitted` (the tree focused,
+/// the parent opened), in a `width × height` terminal.
+fn transmitted_ray_found(width: u16, height: u16) -> App {
+    let mut app = rendered_app(width, height);
+    pick_glass_pixel(&mut app);
+    update(&mut app, Action::StartSearch);
+    for c in "transmitted".chars() {
+        update(
+            &mut app,
+            Action::PromptKey(KeyEvent::from(KeyCode::Char(c))),
+        );
+    }
+    update(&mut app, Action::PromptKey(KeyEvent::from(KeyCode::Enter)));
+    assert_eq!(app.focus, Focus::Tree);
+    app
+}
+
+/// Every pane focused, and zoomed, at the small and middle sizes: the focused pane
+/// gets the room (at 80x24), its border is thick and its title reversed.
+#[test]
+fn every_pane_focused_and_zoomed_at_80x24_and_120x40() {
+    for (width, height) in [(80, 24), (120, 40)] {
+        let mut app = transmitted_ray_found(width, height);
+        for focus in [Focus::Tree, Focus::Inspector, Focus::Image] {
+            app.focus = focus;
+            let name = format!("{focus:?}_focused_at_{width}x{height}").to_lowercase();
+            assert_snapshot!(name, draw(&app).backend());
+        }
+        update(&mut app, Action::ToggleZoom);
+        for focus in [Focus::Image, Focus::Tree, Focus::Inspector] {
+            assert_eq!(app.focus, focus, "Tab cycles the zoomed pane");
+            let name = format!("{focus:?}_zoomed_at_{width}x{height}").to_lowercase();
+            assert_snapshot!(name, draw(&app).backend());
+            update(&mut app, Action::FocusNext);
+        }
+    }
+}
+
+#[test]
+fn the_inspector_scrolled_sideways_keeps_its_header_over_its_columns_at_80x24() {
+    let mut app = transmitted_ray_found(80, 24);
+    update(&mut app, Action::FocusNext);
+    assert_eq!(app.focus, Focus::Inspector);
+    update(&mut app, Action::InspectorScrollSideways(16));
+    assert_snapshot!(draw(&app).backend());
+}
+
+#[test]
+fn the_search_prompt_on_the_status_line() {
+    for (width, height) in [(80, 24), (120, 40)] {
+        let mut app = rendered_app(width, height);
+        pick_glass_pixel(&mut app);
+        update(&mut app, Action::StartSearch);
+        for c in "glass".chars() {
+            update(
+                &mut app,
+                Action::PromptKey(KeyEvent::from(KeyCode::Char(c))),
+            );
+        }
+        update(&mut app, Action::PromptKey(KeyEvent::from(KeyCode::Left)));
+        let name = format!("search_prompt_at_{width}x{height}");
+        assert_snapshot!(name, draw(&app).backend());
+    }
+}
+
+#[test]
+fn help_at_120x40_and_scrolled_at_80x24() {
+    let mut app = rendered_app(120, 40);
+    update(&mut app, Action::ToggleHelp);
+    assert_snapshot!("help_at_120x40", draw(&app).backend());
+    let mut app = rendered_app(80, 24);
+    update(&mut app, Action::ToggleHelp);
+    update(&mut app, Action::HelpScroll(10));
+    assert_snapshot!("help_scrolled_at_80x24", draw(&app).backend());
 }

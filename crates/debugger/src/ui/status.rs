@@ -9,6 +9,7 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::Widget;
 
 use crate::app::{App, RenderState};
+use crate::line_input::LineInput;
 
 use super::format::{self, swatch};
 
@@ -87,6 +88,16 @@ pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
             })],
         });
     }
+    // Said even on the narrowest line: the other panes are hidden, and how to get them back.
+    if app.zoomed {
+        parts.push(Part {
+            rank: 0,
+            spans: vec![Span::styled(
+                "zoomed: z back, Tab next",
+                Style::new().fg(Color::Yellow),
+            )],
+        });
+    }
     parts.push(Part {
         rank: 2,
         spans: vec![Span::styled("? help", Style::new().fg(Color::Yellow))],
@@ -101,6 +112,29 @@ pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
         spans.extend(part.spans);
     }
     Line::from(spans).render(area, buf);
+}
+
+/// The `/` prompt in place of the status line: what is typed, the cursor as a reversed
+/// cell, and what Enter and Esc do.
+pub fn draw_prompt(prompt: &LineInput, area: Rect, buf: &mut Buffer) {
+    let text = prompt.text();
+    let split = text
+        .char_indices()
+        .nth(prompt.cursor())
+        .map_or(text.len(), |(i, _)| i);
+    let (before, rest) = text.split_at(split);
+    let mut rest = rest.chars();
+    let under_cursor = rest.next().map_or(" ".to_string(), String::from);
+    let after: String = rest.collect();
+    let hint = Style::new().fg(Color::DarkGray);
+    Line::from(vec![
+        Span::styled(" search rays /", Style::new().fg(Color::Yellow)),
+        Span::raw(before.to_string()),
+        Span::styled(under_cursor, Style::new().add_modifier(Modifier::REVERSED)),
+        Span::raw(after),
+        Span::styled("   Enter: find · Esc: cancel", hint),
+    ])
+    .render(area, buf);
 }
 
 /// Drops the highest-ranked parts until the line fits (the last part left is cut).

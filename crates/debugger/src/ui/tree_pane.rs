@@ -1,5 +1,6 @@
 //! The ray-tree pane: one row per ray — kind, depth, what it hit (or why it ended) and its
-//! contribution to the pixel, with a swatch — indented under the ray that spawned it.
+//! contribution to the pixel, with a swatch — indented under the ray that spawned it, under
+//! a header naming each column.
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -41,28 +42,77 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let area = block.inner(pane);
     block.render(pane, buf);
 
+    if area.is_empty() {
+        return;
+    }
+    header_line(usize::from(area.width)).render(Rect { height: 1, ..area }, buf);
     let visible = tree.visible();
     let rows = visible
         .iter()
         .skip(tree.scroll())
-        .take(usize::from(area.height));
+        .take(usize::from(area.height - 1));
+    let matches = app.search.as_ref().map_or(&[][..], |s| &s.matches[..]);
+    let numbers = shows_numbers(usize::from(area.width));
     for (row, &id) in rows.enumerate() {
-        let line = row_line(app, tree, id, usize::from(area.width));
+        let line = row_line(app, tree, id, usize::from(area.width), numbers);
         let selected = id == tree.selected();
         let style = match (selected, focused) {
             (true, true) => Style::new().add_modifier(Modifier::REVERSED),
             (true, false) => Style::new().bg(Color::DarkGray),
+            // Search matches are underlined, so the next one can be seen.
+            _ if matches.contains(&id) => Style::new().add_modifier(Modifier::UNDERLINED),
             _ => Style::new(),
         };
-        let row_area = Rect::new(area.x, area.y + row as u16, area.width, 1);
+        let row_area = Rect::new(area.x, area.y + 1 + row as u16, area.width, 1);
         buf.set_style(row_area, style);
         line.render(row_area, buf);
     }
 }
 
+/// The width of the numbers after a row's swatch: ` 0.19 0.29 0.69`.
+const NUMBERS_WIDTH: usize = 15;
+
+/// The width of a camera ray's head (marker, kind, depth): `▼ camera      d0 `.
+const HEAD_WIDTH: usize = 2 + 11 + 4;
+
+/// Whether a pane `width` columns wide shows the numbers after the swatches: when a camera
+/// ray's row keeps 8 columns for what it met. The choice is the same for every row, so that
+/// the numbers stay under their header (deeper rows cut what they met first).
+fn shows_numbers(width: usize) -> bool {
+    width >= HEAD_WIDTH + 8 + 3 + NUMBERS_WIDTH
+}
+
+/// The column header: the ray's kind and depth, what it met, and its share of the pixel
+/// (over the swatch and, when they show, r g b over the numbers). In a narrow pane "what it
+/// met" is cut, never the share's header.
+fn header_line(width: usize) -> Line<'static> {
+    // Over a camera ray's head (marker, kind, depth "d0"): the kind and "d" for depth.
+    let head = format!("  {:<11} {:<3}", "ray", "d");
+    let right = if shows_numbers(width) {
+        "share r    g    b"
+    } else {
+        "share"
+    };
+    let left_width = width.saturating_sub(right.len() + 1);
+    let left = format::truncate(&format!("{head}what it met"), left_width);
+    let text = format::truncate(&format!("{left:<left_width$} {right}"), width);
+    Line::from(Span::styled(
+        text,
+        Style::new()
+            .fg(Color::Gray)
+            .add_modifier(Modifier::BOLD | Modifier::UNDERLINED),
+    ))
+}
+
 /// One ray's row, fitted to `width` columns: the label is cut first, the numbers only
 /// when the pane is very narrow.
-fn row_line(app: &App, tree: &TreeView, id: NodeId, width: usize) -> Line<'static> {
+fn row_line(
+    app: &App,
+    tree: &TreeView,
+    id: NodeId,
+    width: usize,
+    show_numbers: bool,
+) -> Line<'static> {
     let Some(node) = tree.node(id) else {
         return Line::default();
     };
@@ -77,7 +127,6 @@ fn row_line(app: &App, tree: &TreeView, id: NodeId, width: usize) -> Line<'stati
     let [r, g, b] = contribution;
     let numbers = format!(" {r:.2} {g:.2} {b:.2}");
     let head_width = head.chars().count();
-    let show_numbers = width >= head_width + 8 + 3 + numbers.len();
     let tail = 3 + if show_numbers { numbers.len() } else { 0 };
     let label_width = width.saturating_sub(head_width + tail);
     let mut description = describe(node);
