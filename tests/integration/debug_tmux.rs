@@ -352,10 +352,8 @@ fn light_rays_collapse_stepping_reaches_the_pixel_and_the_explanation_jumps_at_8
     let screen = tmux.wait_for("the inspector again", |s| {
         s.contains("Inspector · shadow ray")
     });
-    assert!(
-        screen.contains("Inspector · shadow ray, depth 1"),
-        "{screen}"
-    );
+    // At 80 columns the unfocused inspector is narrow: its title is cut after "depth".
+    assert!(screen.contains("Inspector · shadow ray, depth"), "{screen}");
     tmux.keys(&["q"]);
     tmux.wait_for("the shell after quitting", |s| {
         s.contains("debugger exited with 0")
@@ -657,7 +655,10 @@ fn a_new_user_at_80x24_finds_the_glass_sphere_s_transmitted_ray_and_reads_it() {
         s.contains("(400, 270)")
     });
     tmux.keys(&["Enter"]);
-    let screen = tmux.wait_for("the ray tree", |s| s.contains("Ray tree of (400, 270)"));
+    // At 80 columns the tree's title drops the pixel; the status line names it.
+    let screen = tmux.wait_for("the ray tree", |s| {
+        s.contains("9 of 13 rays") && line_with(s, "rendered in").contains("(400, 270)")
+    });
     assert!(
         line_with(&screen, "▼ camera").contains("glass sph"),
         "the camera ray hits the glass sphere:\n{screen}"
@@ -716,7 +717,7 @@ fn a_new_user_at_80x24_finds_the_glass_sphere_s_transmitted_ray_and_reads_it() {
     // Esc leaves the zoom, and does not quit.
     tmux.keys(&["Escape"]);
     tmux.wait_for("the layout again", |s| {
-        s.contains("Ray tree of (400, 270)") && !s.contains("zoomed: z back")
+        s.contains("Ray tree") && !s.contains("zoomed: z back")
     });
     tmux.keys(&["q"]);
     tmux.wait_for("the shell after q", |s| {
