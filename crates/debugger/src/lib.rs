@@ -15,6 +15,7 @@ pub mod heat_map;
 pub mod hit_point;
 pub mod image_view;
 pub mod layout;
+pub mod line_input;
 pub mod projection;
 mod reload;
 mod render_job;
@@ -26,6 +27,8 @@ pub mod tree_view;
 pub mod ui;
 pub mod update;
 mod watch;
+pub mod what_if;
+pub mod write_back;
 
 #[cfg(test)]
 mod test_provenance_scene;
