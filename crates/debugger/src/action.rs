@@ -84,6 +84,15 @@ pub enum Action {
     ToggleSourceTarget,
     Reload,
     Export,
+    /// Opens the what-if popup on the picked pixel.
+    WhatIf,
+    /// Opens the query prompt on the status line.
+    QueryPrompt,
+    /// A key for the open popup or prompt (it takes every key).
+    InputKey(KeyEvent),
+    /// Moves the cursor to the next (or previous) pixel the query matched, and traces it.
+    NextMatch,
+    PreviousMatch,
 }
 
 /// The keys `?` lists: (section, keys, what they do). Every binding in
@@ -92,15 +101,13 @@ pub const KEY_HELP: &[(&str, &str, &str)] = &[
     ("Image", "←↑↓→ hjkl", "move the cursor one pixel"),
     ("Image", "Shift+move HJKL", "move the cursor ten pixels"),
     ("Image", "Enter, click", "trace the pixel: its ray tree"),
-    ("Image", "+ / -, wheel", "zoom in / out at the cursor"),
+    ("Image", "+ - f, wheel", "zoom in / out; f: fit the pane"),
     ("Image", "Ctrl/Alt+arrows", "pan the view"),
-    ("Image", "f", "fit the image to the pane"),
-    ("Image", "o", "overlay: rays per pixel"),
-    ("Image", "d", "overlay: deepest level"),
+    ("Image", "o / d", "overlay: rays / deepest level"),
+    ("Image", "n / N", "next / previous query match"),
     ("Image", "s", "mark the selected hit point"),
     ("Ray tree", "↑↓ jk", "previous / next ray"),
-    ("Ray tree", "← h", "collapse, or go to the parent"),
-    ("Ray tree", "→ l", "expand, or go to the first child"),
+    ("Ray tree", "← h / → l", "collapse or parent / expand"),
     ("Ray tree", "Enter", "expand or collapse"),
     ("Ray tree", "Home End PgUp/Dn", "first / last / page"),
     ("Inspector", "↑↓ PgUp/Dn", "scroll"),
@@ -108,6 +115,8 @@ pub const KEY_HELP: &[(&str, &str, &str)] = &[
     ("Anywhere", "Tab Shift+Tab", "next / previous pane"),
     ("Anywhere", "r", "reload (automatic on save)"),
     ("Anywhere", "e", "write the ray tree as JSON"),
+    ("Anywhere", "w", "what-if: change a value"),
+    ("Anywhere", ":", "query: mark matching pixels"),
     ("Anywhere", "?", "this help"),
     ("Anywhere", "q, Esc", "quit (Esc: cancel a trace)"),
 ];
@@ -145,6 +154,8 @@ pub fn action_for_key(key: KeyEvent, focus: Focus, help_open: bool) -> Option<Ac
         KeyCode::Char('+' | '=') => Some(Action::ZoomIn),
         KeyCode::Char('-' | '_') => Some(Action::ZoomOut),
         KeyCode::Char('f') => Some(Action::Fit),
+        KeyCode::Char('w') => Some(Action::WhatIf),
+        KeyCode::Char(':') => Some(Action::QueryPrompt),
         _ => None,
     };
     if global.is_some() {
@@ -181,6 +192,8 @@ fn image_key(code: KeyCode, shift: bool) -> Option<Action> {
         KeyCode::Char('K') => (0, -10),
         KeyCode::Char('J') => (0, 10),
         KeyCode::Enter => return Some(Action::TraceCursor),
+        KeyCode::Char('n') => return Some(Action::NextMatch),
+        KeyCode::Char('N') => return Some(Action::PreviousMatch),
         _ => return None,
     };
     Some(Action::MoveCursor { dx, dy })
@@ -210,6 +223,18 @@ fn inspector_key(code: KeyCode) -> Option<Action> {
         KeyCode::Home => Action::InspectorScroll(i32::MIN),
         _ => return None,
     })
+}
+
+/// The action for a key while a popup or prompt is open: it takes every key (Ctrl+C still
+/// quits).
+pub fn input_action(key: KeyEvent) -> Option<Action> {
+    if key.kind == KeyEventKind::Release {
+        return None;
+    }
+    if key.modifiers.contains(KeyModifiers::CONTROL) && matches!(key.code, KeyCode::Char('c' | 'C')) {
+        return Some(Action::Quit);
+    }
+    Some(Action::InputKey(key))
 }
 
 /// The action for a mouse event: left clicks and the wheel; everything else is ignored.
@@ -329,6 +354,33 @@ mod tests {
         assert_eq!(
             action_for_key(key(KeyCode::Char('z')), Focus::Image, false),
             None
+        );
+    }
+
+    #[test]
+    fn what_if_query_and_match_keys() {
+        assert_eq!(
+            action_for_key(key(KeyCode::Char('w')), Focus::Tree, false),
+            Some(Action::WhatIf)
+        );
+        assert_eq!(
+            action_for_key(key(KeyCode::Char(':')), Focus::Inspector, false),
+            Some(Action::QueryPrompt)
+        );
+        assert_eq!(
+            action_for_key(key(KeyCode::Char('n')), Focus::Image, false),
+            Some(Action::NextMatch)
+        );
+        assert_eq!(
+            action_for_key(shifted(KeyCode::Char('N')), Focus::Image, false),
+            Some(Action::PreviousMatch)
+        );
+        // An open popup or prompt takes every key, `q` included; Ctrl+C still quits.
+        let q = key(KeyCode::Char('q'));
+        assert_eq!(input_action(q), Some(Action::InputKey(q)));
+        assert_eq!(
+            input_action(KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL)),
+            Some(Action::Quit)
         );
     }
 

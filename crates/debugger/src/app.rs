@@ -17,6 +17,8 @@ use crate::framebuffer::Framebuffer;
 use crate::heat_map::{HeatMap, HeatMapKind};
 use crate::image_view::{ColorDepth, Viewport};
 use crate::layout::{self, Panes};
+use crate::query_job::QueryState;
+use crate::what_if_state::WhatIf;
 use crate::trace_job::{TraceFailure, TraceJob, Traced};
 use crate::tree_view::TreeView;
 
@@ -107,6 +109,19 @@ pub enum Effect {
     Export { path: PathBuf, contents: String },
     /// Start the trace [`App::trace_job`] describes (on a worker thread).
     Trace,
+    /// Start the what-if popup's re-trace (on a worker thread).
+    WhatIfTrace,
+    /// Write a what-if change back to a scene file: `contents` replaces the file, provided
+    /// it still holds `original` (the text the scene was compiled from); then report
+    /// through [`App::apply_write_scene`].
+    WriteScene {
+        path: PathBuf,
+        original: Arc<String>,
+        contents: String,
+        line: u32,
+    },
+    /// Start the query [`App::query`] holds (on a worker thread).
+    StartQuery,
 }
 
 /// A trace under way on a worker thread.
@@ -159,6 +174,10 @@ pub struct App {
     pub traced_request_at: Option<Instant>,
     /// The node budget of recorded trees: `limits::MAX_RAY_TREE_NODES`.
     pub node_budget: usize,
+    /// The what-if popup (`w`), when open.
+    pub what_if: Option<WhatIf>,
+    /// The query prompt, run and overlay (`:`).
+    pub query: QueryState,
 }
 
 impl App {
@@ -195,7 +214,14 @@ impl App {
             trace_requests: 0,
             traced_request_at: None,
             node_budget: whitted_ir::limits::MAX_RAY_TREE_NODES,
+            what_if: None,
+            query: QueryState::default(),
         }
+    }
+
+    /// Whether a popup or prompt is open and takes every key.
+    pub fn takes_keys(&self) -> bool {
+        self.what_if.is_some() || self.query.prompt.is_some()
     }
 
     pub fn image_size(&self) -> (u32, u32) {
@@ -421,6 +447,9 @@ impl App {
                 }
                 self.pixel_stats = None;
                 self.heat_map = None;
+                // The matches were of the old scene.
+                self.query.cancel();
+                self.query.overlay = None;
                 let retrace = self.retrace_picked();
                 let note = match warnings {
                     0 => String::new(),
@@ -441,6 +470,19 @@ impl App {
         let [x, y] = self.picked.as_ref()?.tree.tree().pixel;
         self.request_trace((x, y), true);
         Some(Effect::Trace)
+    }
+
+    /// The result of writing a what-if change back to the scene file.
+    pub fn apply_write_scene(&mut self, result: Result<(PathBuf, u32), String>) {
+        match &mut self.what_if {
+            Some(what_if) => what_if.apply_write(result),
+            None => match result {
+                Ok((path, line)) => {
+                    self.set_message(format!("wrote {}:{line}", path.display()), false)
+                }
+                Err(error) => self.set_message(format!("not written: {error}"), true),
+            },
+        }
     }
 
     /// The result of writing an export.

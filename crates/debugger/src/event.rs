@@ -32,6 +32,10 @@ pub enum Event {
     Reloaded(Reloaded),
     /// A pixel's ray tree, recorded off the UI thread (or why not).
     Traced(crate::trace_job::Traced),
+    /// A what-if re-trace's answer (the popup's `w`).
+    WhatIfTraced(crate::what_if_state::WhatIfTraced),
+    /// A query's progress or answer (`:`).
+    Query(crate::query_job::QueryNews),
     /// A watched scene file changed on disk.
     FileChanged,
     /// The loop's timer: nothing arrived before the next deadline.

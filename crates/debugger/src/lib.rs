@@ -17,6 +17,7 @@ pub mod image_view;
 pub mod layout;
 pub mod line_input;
 pub mod projection;
+pub mod query_job;
 mod reload;
 mod render_job;
 mod run;
@@ -28,6 +29,7 @@ pub mod ui;
 pub mod update;
 mod watch;
 pub mod what_if;
+pub mod what_if_state;
 pub mod write_back;
 
 #[cfg(test)]

@@ -4,10 +4,15 @@
 
 use std::path::Path;
 
+use ratatui::crossterm::event::KeyEvent;
+use whitted_ir::Handle;
+
 use crate::action::{Action, Focus};
 use crate::app::{App, Effect, SourceTarget, View};
 use crate::image_view::Viewport;
 use crate::layout;
+use crate::line_input::{InputOutcome, LineInput};
+use crate::what_if_state::WhatIf;
 
 /// Applies one action; returns what the event loop must do about it.
 pub fn update(app: &mut App, action: Action) -> Vec<Effect> {
@@ -25,10 +30,15 @@ pub fn update(app: &mut App, action: Action) -> Vec<Effect> {
 fn apply(app: &mut App, action: Action) -> Vec<Effect> {
     match action {
         Action::Quit => app.should_quit = true,
-        // Esc stops a runaway trace first; with none under way it quits.
+        // Esc stops a runaway trace first, then a query, then clears the query's overlay;
+        // with none of those it quits.
         Action::Cancel => {
             if app.cancel_trace() {
                 app.set_message("cancelled the trace", false);
+            } else if app.query.cancel() {
+                app.set_message("cancelled the query", false);
+            } else if app.query.overlay.take().is_some() {
+                app.set_message("cleared the query's matches", false);
             } else {
                 app.should_quit = true;
             }
@@ -79,8 +89,96 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
             }
         }
         Action::Export => return export(app),
+        Action::WhatIf => open_what_if(app),
+        Action::QueryPrompt => {
+            app.query.prompt = Some(LineInput::new(&app.query.last_text));
+        }
+        Action::InputKey(key) => return input_key(app, key),
+        Action::NextMatch => step_match(app, false),
+        Action::PreviousMatch => step_match(app, true),
     }
     Vec::new()
+}
+
+/// `w`: the what-if popup on the picked pixel, with the material of the selected ray (or,
+/// when it hit nothing, of the camera ray).
+fn open_what_if(app: &mut App) {
+    let Some(picked) = &app.picked else {
+        app.set_message("what-if needs a ray tree: pick a pixel first (Enter)", true);
+        return;
+    };
+    let tree = &picked.tree;
+    let material = tree
+        .selected_node()
+        .and_then(|n| n.hit.as_ref())
+        .or_else(|| tree.node(0).and_then(|n| n.hit.as_ref()))
+        .map(|hit| Handle::from_index(hit.material.handle as usize));
+    app.what_if = Some(WhatIf::open(
+        app.loaded.clone(),
+        tree.tree().clone(),
+        material,
+        app.node_budget,
+    ));
+}
+
+/// A key for the open popup (first) or the query prompt.
+fn input_key(app: &mut App, key: KeyEvent) -> Vec<Effect> {
+    if let Some(what_if) = &mut app.what_if {
+        let (close, effects) = what_if.handle_key(key);
+        if close {
+            app.what_if = None;
+        }
+        return effects;
+    }
+    let Some(prompt) = &mut app.query.prompt else {
+        return Vec::new();
+    };
+    match prompt.handle(key) {
+        InputOutcome::Edited | InputOutcome::Ignored => Vec::new(),
+        InputOutcome::Cancelled => {
+            app.query.prompt = None;
+            Vec::new()
+        }
+        InputOutcome::Submitted => {
+            let text = prompt.text().trim().to_string();
+            app.query.prompt = None;
+            if text.is_empty() {
+                app.query.overlay = None;
+                return Vec::new();
+            }
+            // Kept even when wrong, so that `:` brings it back to be fixed.
+            app.query.last_text = text.clone();
+            let scene = std::sync::Arc::clone(&app.loaded.scene);
+            match app.query.start(&text, &app.loaded, &app.options, &scene) {
+                Ok(()) => {
+                    app.set_message(format!("querying {text}, Esc cancels"), false);
+                    vec![Effect::StartQuery]
+                }
+                Err(message) => {
+                    app.set_message(message, true);
+                    Vec::new()
+                }
+            }
+        }
+    }
+}
+
+/// `n` / `N`: the cursor to the next or previous matching pixel (row order), traced.
+fn step_match(app: &mut App, backward: bool) {
+    let Some(overlay) = &app.query.overlay else {
+        app.set_message("no query to step through: press : to run one", false);
+        return;
+    };
+    let Some(pixel) = overlay.step(app.cursor, backward) else {
+        app.set_message(format!("no pixel matches {}", overlay.text), false);
+        return;
+    };
+    let index = overlay.matches.iter().position(|&m| m == pixel).unwrap_or(0);
+    let count = overlay.matches.len();
+    app.cursor = pixel;
+    keep_cursor_in_view(app);
+    app.trace_cursor();
+    app.set_message(format!("match {} of {count}", index + 1), false);
 }
 
 /// The image point zooming keeps in place: the centre of the cursor pixel.

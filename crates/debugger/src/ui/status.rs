@@ -9,6 +9,7 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::Widget;
 
 use crate::app::{App, RenderState};
+use crate::line_input::LineInput;
 
 use super::format::{self, swatch};
 
@@ -19,6 +20,10 @@ struct Part {
 }
 
 pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
+    if let Some(prompt) = &app.query.prompt {
+        draw_prompt(prompt, area, buf);
+        return;
+    }
     let mut parts = Vec::new();
     parts.push(Part {
         rank: 4,
@@ -65,6 +70,26 @@ pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
         rank: 1,
         spans: cursor,
     });
+    if let Some(run) = &app.query.running {
+        let percent = (u64::from(run.rows_done) * 100)
+            .checked_div(u64::from(run.rows))
+            .unwrap_or(0);
+        parts.push(Part {
+            rank: 0,
+            spans: vec![Span::styled(
+                format!("query {percent}%, Esc cancels"),
+                Style::new().fg(Color::Yellow),
+            )],
+        });
+    } else if let Some(overlay) = &app.query.overlay {
+        parts.push(Part {
+            rank: 1,
+            spans: vec![Span::styled(
+                format!("{} match {}", overlay.matches.len(), overlay.text),
+                Style::new().fg(QUERY_COLOR),
+            )],
+        });
+    }
     if let Some(tracing) = &app.tracing {
         let (x, y) = tracing.pixel;
         parts.push(Part {
@@ -101,6 +126,32 @@ pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
         spans.extend(part.spans);
     }
     Line::from(spans).render(area, buf);
+}
+
+/// The colour the query's matches are marked in, here and over the image.
+pub const QUERY_COLOR: Color = Color::Rgb(0, 230, 255);
+
+/// The query prompt in place of the status line: `:` then the text, the cursor reversed.
+fn draw_prompt(prompt: &LineInput, area: Rect, buf: &mut Buffer) {
+    let text = prompt.text();
+    let at = text
+        .char_indices()
+        .nth(prompt.cursor())
+        .map_or(text.len(), |(i, _)| i);
+    let (before, after) = text.split_at(at);
+    let mut rest = after.chars();
+    let under = rest.next().map_or(" ".to_string(), String::from);
+    Line::from(vec![
+        Span::styled(" query: ", Style::new().fg(QUERY_COLOR).add_modifier(Modifier::BOLD)),
+        Span::raw(before.to_string()),
+        Span::styled(under, Style::new().add_modifier(Modifier::REVERSED)),
+        Span::raw(rest.as_str().to_string()),
+        Span::styled(
+            "   Enter runs it, Esc cancels; e.g. tir and not hit(\"floor\")",
+            Style::new().fg(Color::DarkGray),
+        ),
+    ])
+    .render(area, buf);
 }
 
 /// Drops the highest-ranked parts until the line fits (the last part left is cut).

@@ -1,0 +1,227 @@
+//! The what-if popup (`w`): the values that can change with their current values, the one
+//! being typed, then the old and new colour of the pixel side by side and the tree diff
+//! (rays removed, added and changed, with what they give the pixel before and after).
+
+use ratatui::buffer::Buffer;
+use ratatui::layout::Rect;
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Clear, Paragraph, Widget};
+use whitted_explain::diff::{Divergence, DivergenceKind};
+
+use crate::image_view::ColorDepth;
+use crate::what_if_state::WhatIf;
+
+use super::format::{rgb, swatch};
+
+const KEY_STYLE: Style = Style::new().fg(Color::Yellow);
+
+pub fn draw(what_if: &WhatIf, depth: ColorDepth, area: Rect, buf: &mut Buffer) {
+    let width = area.width.saturating_sub(4).min(100);
+    let height = area.height.saturating_sub(2);
+    let popup = Rect::new(
+        area.x + (area.width - width) / 2,
+        area.y + (area.height - height) / 2,
+        width,
+        height,
+    );
+    Clear.render(popup, buf);
+    let (x, y) = what_if.pixel;
+    let block = Block::bordered()
+        .border_style(Style::new().fg(Color::Yellow))
+        .title(format!(" What if · pixel ({x}, {y}) "))
+        .title_bottom(
+            Line::from(vec![
+                Span::styled(" ↑↓", KEY_STYLE),
+                Span::raw(" choose "),
+                Span::styled("Enter", KEY_STYLE),
+                Span::raw(" change "),
+                Span::styled("W", KEY_STYLE),
+                Span::raw(" write to the file "),
+                Span::styled("Esc", KEY_STYLE),
+                Span::raw(" close "),
+            ])
+            .right_aligned(),
+        );
+    let inner = block.inner(popup);
+    block.render(popup, buf);
+    let inner = Rect::new(
+        inner.x + 1,
+        inner.y,
+        inner.width.saturating_sub(1),
+        inner.height,
+    );
+    let lines = lines(what_if, depth, usize::from(inner.height));
+    Paragraph::new(lines).render(inner, buf);
+}
+
+/// Everything the popup says, cut to `rows` (the diff gives way first).
+pub fn lines(what_if: &WhatIf, depth: ColorDepth, rows: usize) -> Vec<Line<'static>> {
+    let scene = &what_if.base.scene;
+    let mut lines = Vec::new();
+    let owner_width = what_if
+        .params
+        .iter()
+        .map(|p| p.owner(scene).chars().count())
+        .max()
+        .unwrap_or(0);
+    for (index, param) in what_if.params.iter().enumerate() {
+        let selected = index == what_if.selected;
+        let marker = if selected { "▶ " } else { "  " };
+        let mut spans = vec![
+            Span::styled(marker, KEY_STYLE),
+            Span::raw(format!(
+                "{:<owner_width$}  {:<12} ",
+                param.owner(scene),
+                param.property()
+            )),
+        ];
+        let current = param.current_text(scene);
+        match (&what_if.editing, selected) {
+            (Some(input), true) => {
+                spans.push(Span::raw(format!("{current} → ")));
+                let text = input.text();
+                let at = text
+                    .char_indices()
+                    .nth(input.cursor())
+                    .map_or(text.len(), |(i, _)| i);
+                let (before, after) = text.split_at(at);
+                let mut rest = after.chars();
+                let under = rest.next().map_or(" ".to_string(), String::from);
+                spans.push(Span::styled(
+                    before.to_string(),
+                    Style::new().add_modifier(Modifier::BOLD),
+                ));
+                spans.push(Span::styled(under, Style::new().add_modifier(Modifier::REVERSED)));
+                spans.push(Span::styled(
+                    rest.as_str().to_string(),
+                    Style::new().add_modifier(Modifier::BOLD),
+                ));
+            }
+            _ => {
+                let style = if selected {
+                    Style::new().add_modifier(Modifier::BOLD)
+                } else {
+                    Style::new()
+                };
+                spans.push(Span::styled(current, style));
+                if let Some(outcome) = what_if.outcome.as_ref().filter(|o| o.param == *param) {
+                    spans.push(Span::styled(
+                        format!(" → {}", outcome.text),
+                        Style::new().fg(Color::LightCyan).add_modifier(Modifier::BOLD),
+                    ));
+                }
+            }
+        }
+        lines.push(Line::from(spans));
+    }
+    if let (Some(_), Some(param)) = (&what_if.editing, what_if.selected_param()) {
+        lines.push(Line::styled(
+            format!("  {}: {}", param.property(), param.range()),
+            Style::new().fg(Color::Gray),
+        ));
+    }
+    lines.push(Line::raw(""));
+    if let Some(note) = &what_if.note {
+        let style = if note.is_error {
+            Style::new().fg(Color::LightRed).add_modifier(Modifier::BOLD)
+        } else {
+            Style::new().fg(Color::LightGreen)
+        };
+        lines.push(Line::styled(note.text.clone(), style));
+    }
+    if what_if.running.is_some() {
+        lines.push(Line::styled(
+            "re-tracing the pixel in the changed scene…",
+            Style::new().fg(Color::Yellow),
+        ));
+    }
+    let Some(outcome) = &what_if.outcome else {
+        if what_if.note.is_none() && what_if.running.is_none() {
+            lines.push(Line::styled(
+                "Choose a value and press Enter to change it; the pixel is traced again.",
+                Style::new().fg(Color::Gray),
+            ));
+        }
+        lines.truncate(rows);
+        return lines;
+    };
+    let diff = &outcome.diff;
+    let [old, new] = diff.color;
+    lines.push(Line::from(vec![
+        Span::styled(
+            format!(
+                "{} {} → {}: ",
+                outcome.param.property(),
+                outcome.param.current_text(scene),
+                outcome.text
+            ),
+            Style::new().add_modifier(Modifier::BOLD),
+        ),
+        Span::raw("old "),
+        swatch(old, depth),
+        Span::raw(format!(" {}   new ", rgb(old))),
+        swatch(new, depth),
+        Span::raw(format!(" {}", rgb(new))),
+    ]));
+    lines.push(Line::raw(format!(
+        "  {} rays → {} rays; {} difference{} in the tree",
+        diff.rays[0],
+        diff.rays[1],
+        diff.divergences.len(),
+        if diff.divergences.len() == 1 { "" } else { "s" }
+    )));
+    let room = rows.saturating_sub(lines.len());
+    let shown = if diff.divergences.len() * 2 <= room {
+        diff.divergences.len()
+    } else {
+        room.saturating_sub(1) / 2
+    };
+    for divergence in &diff.divergences[..shown] {
+        lines.extend(divergence_lines(divergence, depth));
+    }
+    if shown < diff.divergences.len() {
+        lines.push(Line::styled(
+            format!("  … and {} more", diff.divergences.len() - shown),
+            Style::new().fg(Color::Gray),
+        ));
+    }
+    lines.truncate(rows);
+    lines
+}
+
+/// A divergence in two lines: what and where, then the values and what the rays give.
+fn divergence_lines(d: &Divergence, depth: ColorDepth) -> [Line<'static>; 2] {
+    let (mark, color, what) = match d.kind {
+        DivergenceKind::OnlyInA => ("−", Color::LightRed, "removed"),
+        DivergenceKind::OnlyInB => ("+", Color::LightGreen, "added"),
+        _ => ("~", Color::LightYellow, "changed"),
+    };
+    let route: Vec<&str> = d.route.iter().map(|k| k.name()).collect();
+    let sample = if d.sample > 0 {
+        format!("sample {}, ", d.sample)
+    } else {
+        String::new()
+    };
+    let first = Line::from(vec![
+        Span::styled(
+            format!("  {mark} {what} "),
+            Style::new().fg(color).add_modifier(Modifier::BOLD),
+        ),
+        Span::raw(format!("{sample}{} (depth {}): {}", route.join(" › "), d.depth, d.what)),
+    ]);
+    let [a, b] = d.contribution;
+    let values = match d.kind {
+        DivergenceKind::OnlyInA => d.values[0].clone(),
+        DivergenceKind::OnlyInB => d.values[1].clone(),
+        _ => format!("{} → {}", d.values[0], d.values[1]),
+    };
+    let second = Line::from(vec![
+        Span::raw(format!("      {values}; gives ")),
+        swatch(a, depth),
+        Span::raw(format!(" {} → ", rgb(a))),
+        swatch(b, depth),
+        Span::raw(format!(" {}", rgb(b))),
+    ]);
+    [first, second]
+}
