@@ -10,7 +10,7 @@ use std::sync::mpsc::Sender;
 use std::sync::Arc;
 
 use ratatui::crossterm::event::{KeyCode, KeyEvent};
-use whitted_explain::diff::{diff_trees, TreeDiff};
+use whitted_explain::diff::{diff_trees, ray_changes, RayChange, TreeDiff};
 use whitted_ir::{Handle, Material, ValidScene};
 use whitted_tracer::ray_tree::RayTree;
 use whitted_tracer::RenderOptions;
@@ -64,7 +64,10 @@ pub struct Outcome {
     pub text: String,
     pub scene: Arc<ValidScene>,
     pub tree: RayTree,
+    /// Where the trees first diverge (the cause).
     pub diff: TreeDiff,
+    /// Every ray added, removed or changed (the consequences).
+    pub rays: Vec<RayChange>,
 }
 
 /// The re-trace for a worker: build the changed scene's acceleration structure and trace the
@@ -228,7 +231,9 @@ impl WhatIf {
         match traced.result {
             Ok((loaded, tree)) => {
                 let diff = diff_trees(&self.base.scene, &self.base_tree, &loaded.scene, &tree);
+                let rays = ray_changes(&self.base_tree, &tree);
                 self.outcome = Some(Outcome {
+                    rays,
                     param: traced.param,
                     value: traced.value,
                     text: value_text(traced.value),

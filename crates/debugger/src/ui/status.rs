@@ -85,7 +85,7 @@ pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
         parts.push(Part {
             rank: 1,
             spans: vec![Span::styled(
-                format!("{} match {}", overlay.matches.len(), overlay.text),
+                format!("{}: {} px", overlay.text, overlay.matches.len()),
                 Style::new().fg(QUERY_COLOR),
             )],
         });

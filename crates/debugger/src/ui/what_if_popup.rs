@@ -7,12 +7,12 @@ use ratatui::layout::Rect;
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Clear, Paragraph, Widget};
-use whitted_explain::diff::{Divergence, DivergenceKind};
+use whitted_explain::diff::{Change, RayChange};
 
 use crate::image_view::ColorDepth;
 use crate::what_if_state::WhatIf;
 
-use super::format::{rgb, swatch};
+use super::format::{number, rgb, swatch};
 
 const KEY_STYLE: Style = Style::new().fg(Color::Yellow);
 
@@ -51,12 +51,12 @@ pub fn draw(what_if: &WhatIf, depth: ColorDepth, area: Rect, buf: &mut Buffer) {
         inner.width.saturating_sub(1),
         inner.height,
     );
-    let lines = lines(what_if, depth, usize::from(inner.height));
+    let lines = lines(what_if, depth, inner.width, usize::from(inner.height));
     Paragraph::new(lines).render(inner, buf);
 }
 
-/// Everything the popup says, cut to `rows` (the diff gives way first).
-pub fn lines(what_if: &WhatIf, depth: ColorDepth, rows: usize) -> Vec<Line<'static>> {
+/// Everything the popup says in `width` columns, cut to `rows` (the diff gives way first).
+pub fn lines(what_if: &WhatIf, depth: ColorDepth, width: u16, rows: usize) -> Vec<Line<'static>> {
     let scene = &what_if.base.scene;
     let mut lines = Vec::new();
     let owner_width = what_if
@@ -151,7 +151,7 @@ pub fn lines(what_if: &WhatIf, depth: ColorDepth, rows: usize) -> Vec<Line<'stat
     lines.push(Line::from(vec![
         Span::styled(
             format!(
-                "{} {} → {}: ",
+                "{} {} → {}  ",
                 outcome.param.property(),
                 outcome.param.current_text(scene),
                 outcome.text
@@ -164,25 +164,29 @@ pub fn lines(what_if: &WhatIf, depth: ColorDepth, rows: usize) -> Vec<Line<'stat
         swatch(new, depth),
         Span::raw(format!(" {}", rgb(new))),
     ]));
+    let cause = match diff.divergences.first() {
+        Some(first) => format!(
+            "first difference: {}: {} → {}",
+            first.what, first.values[0], first.values[1]
+        ),
+        None => "the two ray trees are the same, ray by ray".to_string(),
+    };
     lines.push(Line::raw(format!(
-        "  {} rays → {} rays; {} difference{} in the tree",
-        diff.rays[0],
-        diff.rays[1],
-        diff.divergences.len(),
-        if diff.divergences.len() == 1 { "" } else { "s" }
+        "{} rays → {} rays; {cause}",
+        diff.rays[0], diff.rays[1]
     )));
     let room = rows.saturating_sub(lines.len());
-    let shown = if diff.divergences.len() * 2 <= room {
-        diff.divergences.len()
+    let shown = if outcome.rays.len() <= room {
+        outcome.rays.len()
     } else {
-        room.saturating_sub(1) / 2
+        room.saturating_sub(1)
     };
-    for divergence in &diff.divergences[..shown] {
-        lines.extend(divergence_lines(divergence, depth));
+    for change in &outcome.rays[..shown] {
+        lines.push(ray_line(change, depth, width >= WIDE));
     }
-    if shown < diff.divergences.len() {
+    if shown < outcome.rays.len() {
         lines.push(Line::styled(
-            format!("  … and {} more", diff.divergences.len() - shown),
+            format!("… and {} more changed rays", outcome.rays.len() - shown),
             Style::new().fg(Color::Gray),
         ));
     }
@@ -190,38 +194,73 @@ pub fn lines(what_if: &WhatIf, depth: ColorDepth, rows: usize) -> Vec<Line<'stat
     lines
 }
 
-/// A divergence in two lines: what and where, then the values and what the rays give.
-fn divergence_lines(d: &Divergence, depth: ColorDepth) -> [Line<'static>; 2] {
-    let (mark, color, what) = match d.kind {
-        DivergenceKind::OnlyInA => ("−", Color::LightRed, "removed"),
-        DivergenceKind::OnlyInB => ("+", Color::LightGreen, "added"),
-        _ => ("~", Color::LightYellow, "changed"),
+/// From this many columns a changed ray shows both colours' numbers, not only the new one's.
+const WIDE: u16 = 96;
+
+/// One changed ray: added (+), removed (−) or changed (~), indented by depth, what it hits,
+/// its path weight (once when it did not change) and its colour before and after.
+fn ray_line(change: &RayChange, depth: ColorDepth, wide: bool) -> Line<'static> {
+    let (mark, color) = match change.change {
+        Change::Removed => ("−", Color::LightRed),
+        Change::Added => ("+", Color::LightGreen),
+        Change::Changed => ("~", Color::LightYellow),
     };
-    let route: Vec<&str> = d.route.iter().map(|k| k.name()).collect();
-    let sample = if d.sample > 0 {
-        format!("sample {}, ", d.sample)
+    let kind = change.route.last().map_or("ray", |k| k.name());
+    let (indent, kind_width, hits_width) = if wide {
+        ("  ".repeat(change.depth.min(8) as usize), 24, 14)
     } else {
-        String::new()
+        (" ".repeat(change.depth.min(6) as usize), 18, 12)
     };
-    let first = Line::from(vec![
+    let hits: String = change.hits.chars().take(hits_width).collect();
+    let mut spans = vec![
         Span::styled(
-            format!("  {mark} {what} "),
+            format!("{mark} "),
             Style::new().fg(color).add_modifier(Modifier::BOLD),
         ),
-        Span::raw(format!("{sample}{} (depth {}): {}", route.join(" › "), d.depth, d.what)),
-    ]);
-    let [a, b] = d.contribution;
-    let values = match d.kind {
-        DivergenceKind::OnlyInA => d.values[0].clone(),
-        DivergenceKind::OnlyInB => d.values[1].clone(),
-        _ => format!("{} → {}", d.values[0], d.values[1]),
-    };
-    let second = Line::from(vec![
-        Span::raw(format!("      {values}; gives ")),
-        swatch(a, depth),
-        Span::raw(format!(" {} → ", rgb(a))),
-        swatch(b, depth),
-        Span::raw(format!(" {}", rgb(b))),
-    ]);
-    [first, second]
+        Span::raw(format!(
+            "{:<kind_width$} {hits:<hits_width$} ",
+            format!("{indent}{kind}")
+        )),
+    ];
+    let side = |i: usize| change.weight[i].zip(change.color[i]);
+    match (side(0), side(1)) {
+        (Some((wa, ca)), Some((wb, cb))) => {
+            let weight = if wa == wb {
+                format!("w {}  ", compact(wa))
+            } else {
+                format!("w {} → {}  ", compact(wa), compact(wb))
+            };
+            spans.push(Span::raw(weight));
+            spans.push(swatch(ca, depth));
+            spans.push(Span::raw(if wide {
+                format!(" {} → ", compact(ca))
+            } else {
+                "→".to_string()
+            }));
+            spans.push(swatch(cb, depth));
+            spans.push(Span::raw(format!(" {}", compact(cb))));
+        }
+        (Some((w, c)), None) | (None, Some((w, c))) => {
+            spans.push(Span::raw(format!("w {}  ", compact(w))));
+            spans.push(swatch(c, depth));
+            spans.push(Span::raw(format!(" {}", compact(c))));
+            if change.rays_below > 0 {
+                spans.push(Span::styled(
+                    format!("  and {} rays below", change.rays_below),
+                    Style::new().fg(Color::Gray),
+                ));
+            }
+        }
+        (None, None) => {}
+    }
+    Line::from(spans)
+}
+
+/// A grey as one number, any other colour as three.
+fn compact(c: [f32; 3]) -> String {
+    if c[0] == c[1] && c[1] == c[2] {
+        number(c[0])
+    } else {
+        rgb(c)
+    }
 }
