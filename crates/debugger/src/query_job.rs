@@ -230,3 +230,152 @@ impl QueryJob {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::action::Action;
+    use crate::app::{App, Effect};
+    use crate::test_scene::whitted_scene;
+    use crate::update::update;
+    use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    use ratatui::layout::Rect;
+    use std::sync::atomic::AtomicUsize;
+
+    fn app() -> App {
+        let mut app = App::new(
+            "scenes/whitted.scene".into(),
+            LoadedScene::new(whitted_scene()),
+            Rect::new(0, 0, 120, 40),
+            "/tmp".into(),
+        );
+        // A small image keeps the whole-image query quick.
+        app.options.width = 64;
+        app.options.height = 48;
+        app
+    }
+
+    fn type_query(app: &mut App, text: &str) -> Vec<Effect> {
+        assert!(update(app, Action::QueryPrompt).is_empty());
+        assert!(app.takes_keys());
+        for c in text.chars() {
+            update(app, Action::InputKey(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)));
+        }
+        update(app, Action::InputKey(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE)))
+    }
+
+    /// Runs the job the app asked for here, reporting as the worker does.
+    fn finish_query(app: &mut App) {
+        let job = app.query.take_job().expect("a query to run");
+        let rows = AtomicUsize::new(0);
+        let result = job.run(&|| {
+            rows.fetch_add(1, Ordering::Relaxed);
+        });
+        assert_eq!(rows.load(Ordering::Relaxed), 48, "one report per row");
+        for _ in 0..48 {
+            app.query.apply(QueryNews::Row {
+                generation: job.generation,
+            });
+        }
+        if let Some(run) = &app.query.running {
+            assert_eq!(run.rows_done, run.rows);
+        }
+        if let Some((message, is_error)) = app.query.apply(QueryNews::Done {
+            generation: job.generation,
+            result,
+        }) {
+            app.set_message(message, is_error);
+        }
+    }
+
+    #[test]
+    fn a_query_marks_the_pixels_the_explain_query_finds_and_n_steps_through_them() {
+        let mut app = app();
+        assert_eq!(type_query(&mut app, "hit(\"mirror sphere\")"), vec![Effect::StartQuery]);
+        assert!(!app.takes_keys());
+        finish_query(&mut app);
+        let overlay = app.query.overlay.clone().expect("an overlay");
+        // The oracle: the same query through whitted query's entry point.
+        let query = Query::compile("hit(\"mirror sphere\")", &app.loaded.scene).unwrap();
+        let expected = whitted_explain::query::run(&app.loaded.prepared, &app.options, &query);
+        assert_eq!(overlay.mask, expected.mask);
+        assert!(!overlay.matches.is_empty());
+        let message = app.message.clone().unwrap();
+        assert!(
+            message.text.starts_with(&format!("{} pixels match", overlay.matches.len())),
+            "{message:?}"
+        );
+
+        app.cursor = (0, 0);
+        update(&mut app, Action::NextMatch);
+        assert_eq!(app.cursor, overlay.matches[0]);
+        assert!(app.tracing.is_some(), "the match is traced");
+        assert_eq!(app.message.as_ref().unwrap().text, format!("match 1 of {}", overlay.matches.len()));
+        update(&mut app, Action::NextMatch);
+        assert_eq!(app.cursor, overlay.matches[1]);
+        update(&mut app, Action::PreviousMatch);
+        update(&mut app, Action::PreviousMatch);
+        assert_eq!(app.cursor, *overlay.matches.last().unwrap(), "N wraps to the last");
+
+        // Esc cancels the trace, then clears the overlay, then quits.
+        update(&mut app, Action::Cancel);
+        assert!(app.query.overlay.is_some());
+        update(&mut app, Action::Cancel);
+        assert!(app.query.overlay.is_none() && !app.should_quit);
+    }
+
+    #[test]
+    fn a_bad_query_is_an_error_with_its_column_and_the_prompt_brings_it_back() {
+        let mut app = app();
+        assert!(type_query(&mut app, "tir and hit(\"mirorr sphere\")").is_empty());
+        let message = app.message.clone().unwrap();
+        assert!(message.is_error);
+        assert_eq!(
+            message.text,
+            "query error at column 13: no object is named \"mirorr sphere\": did you mean \"mirror sphere\"?"
+        );
+        assert!(app.query.running.is_none());
+        update(&mut app, Action::QueryPrompt);
+        assert_eq!(
+            app.query.prompt.as_ref().map(LineInput::text),
+            Some("tir and hit(\"mirorr sphere\")")
+        );
+        update(&mut app, Action::InputKey(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE)));
+        assert!(app.query.prompt.is_none());
+        update(&mut app, Action::NextMatch);
+        assert!(app.message.as_ref().unwrap().text.contains("press : to run one"));
+    }
+
+    #[test]
+    fn a_cancelled_query_leaves_no_overlay() {
+        let mut app = app();
+        type_query(&mut app, "depth >= 1");
+        let job = app.query.take_job().unwrap();
+        update(&mut app, Action::Cancel);
+        assert!(job.cancel.load(Ordering::Relaxed));
+        assert_eq!(job.run(&|| {}), Ok(None));
+        assert!(app.query.running.is_none() && app.query.overlay.is_none());
+        assert!(!app.should_quit);
+    }
+
+    #[test]
+    fn stepping_goes_in_row_order_and_wraps() {
+        let overlay = QueryOverlay {
+            text: "q".into(),
+            width: 4,
+            height: 3,
+            mask: vec![false; 12],
+            matches: vec![(3, 0), (1, 1), (2, 2)],
+        };
+        assert_eq!(overlay.step((0, 1), false), Some((1, 1)));
+        assert_eq!(overlay.step((1, 1), false), Some((2, 2)));
+        assert_eq!(overlay.step((2, 2), false), Some((3, 0)));
+        assert_eq!(overlay.step((0, 1), true), Some((3, 0)));
+        assert_eq!(overlay.step((3, 0), true), Some((2, 2)));
+        let none = QueryOverlay {
+            matches: Vec::new(),
+            ..overlay
+        };
+        assert_eq!(none.step((0, 0), false), None);
+    }
+}

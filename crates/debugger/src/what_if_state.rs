@@ -364,3 +364,169 @@ impl WhatIfJob {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_scene::{glass_pixel_tree, whitted_scene, GLASS_PIXEL, SCENE_TEXT};
+    use ratatui::crossterm::event::KeyModifiers;
+    use whitted_explain::diff::Change;
+    use whitted_tracer::ray_tree::{trace_pixel, SampleChoice};
+    use whitted_tracer::PreparedScene;
+
+    fn key(code: KeyCode) -> KeyEvent {
+        KeyEvent::new(code, KeyModifiers::NONE)
+    }
+
+    fn material(scene: &whitted_ir::Scene, name: &str) -> Handle<Material> {
+        scene
+            .materials
+            .iter()
+            .find(|(_, m)| m.name.as_deref() == Some(name))
+            .map(|(h, _)| h)
+            .unwrap()
+    }
+
+    /// The popup on the glass pixel with the glass material listed (and selected).
+    fn popup() -> WhatIf {
+        let loaded = LoadedScene::new(whitted_scene());
+        let glass = material(&loaded.scene, "glass");
+        WhatIf::open(loaded, glass_pixel_tree(), Some(glass), 100_000)
+    }
+
+    /// Types `text` over the selected value and presses Enter; runs the re-trace here.
+    fn change_to(what_if: &mut WhatIf, text: &str) -> Vec<Effect> {
+        what_if.handle_key(key(KeyCode::Enter));
+        for _ in 0..20 {
+            what_if.handle_key(key(KeyCode::Backspace));
+        }
+        for c in text.chars() {
+            what_if.handle_key(key(KeyCode::Char(c)));
+        }
+        let (closed, effects) = what_if.handle_key(key(KeyCode::Enter));
+        assert!(!closed);
+        if let Some(job) = what_if.take_job() {
+            what_if.apply(job.run());
+        }
+        effects
+    }
+
+    #[test]
+    fn a_changed_ior_retraces_the_pixel_as_the_tracer_does_on_a_scene_edited_apart() {
+        let mut what_if = popup();
+        assert_eq!(what_if.selected_param().map(Param::property), Some("ior"));
+        assert_eq!(change_to(&mut what_if, "1.0"), vec![Effect::WhatIfTrace]);
+        let outcome = what_if.outcome.as_ref().expect("a re-trace");
+
+        // The oracle: the IR edited by hand, traced through trace_pixel.
+        let mut edited = whitted_scene().into_inner();
+        let glass = material(&edited, "glass");
+        edited.materials.get_mut(glass).unwrap().ior = 1.0;
+        let edited = whitted_ir::validate(edited).unwrap();
+        let prepared = PreparedScene::new(&edited);
+        let options = RenderOptions::from_settings(&edited.settings);
+        let (x, y) = GLASS_PIXEL;
+        let expected = trace_pixel(&prepared, &edited, &options, x, y, SampleChoice::All).unwrap();
+        assert_eq!(outcome.tree.color, expected.color, "bit for bit");
+        assert_eq!(outcome.diff.color, [glass_pixel_tree().color, expected.color]);
+        assert_ne!(expected.color, glass_pixel_tree().color, "the ior matters here");
+        let first = outcome.diff.divergences.first().expect("a divergence");
+        assert_eq!(first.what, "ior of material glass (at glass sphere)");
+        assert_eq!(first.values, ["1.5".to_string(), "1".to_string()]);
+        assert!(!outcome.rays.is_empty());
+        // The popup's own scene is untouched: Esc discards the change.
+        assert_eq!(what_if.base.scene.materials[glass].ior, 1.5);
+        let (closed, _) = what_if.handle_key(key(KeyCode::Esc));
+        assert!(closed);
+    }
+
+    #[test]
+    fn a_value_out_of_range_is_said_plainly_and_traces_nothing() {
+        let mut what_if = popup();
+        assert!(change_to(&mut what_if, "-2").is_empty());
+        assert!(what_if.outcome.is_none() && what_if.running.is_none());
+        let note = what_if.note.clone().expect("a note");
+        assert!(note.is_error);
+        assert_eq!(note.text, "ior must be a number from 0.001 to 1000");
+        assert!(what_if.editing.is_some(), "the value stays open to fix");
+        // Esc leaves the edit, a second Esc the popup.
+        assert_eq!(what_if.handle_key(key(KeyCode::Esc)).0, false);
+        assert!(what_if.editing.is_none());
+        assert_eq!(what_if.handle_key(key(KeyCode::Esc)).0, true);
+    }
+
+    #[test]
+    fn a_lower_max_depth_removes_rays_and_the_list_accounts_for_every_one() {
+        let mut what_if = popup();
+        what_if.selected = 0;
+        assert_eq!(what_if.selected_param(), Some(Param::MaxDepth));
+        change_to(&mut what_if, "1");
+        let outcome = what_if.outcome.as_ref().expect("a re-trace");
+        let removed: usize = outcome
+            .rays
+            .iter()
+            .filter(|c| c.change == Change::Removed)
+            .map(|c| 1 + c.rays_below)
+            .sum();
+        assert!(removed > 0);
+        assert_eq!(outcome.diff.rays[0] - removed, outcome.diff.rays[1]);
+        assert!(outcome.rays.iter().all(|c| c.change != Change::Added));
+    }
+
+    #[test]
+    fn w_writes_the_change_on_its_line_or_says_what_to_add() {
+        let mut what_if = popup();
+        assert!(what_if.handle_key(key(KeyCode::Char('W'))).1.is_empty());
+        assert!(what_if.note.as_ref().unwrap().text.contains("change a value first"));
+        change_to(&mut what_if, "1.0");
+        let (_, effects) = what_if.handle_key(key(KeyCode::Char('W')));
+        let [Effect::WriteScene {
+            path,
+            original,
+            contents,
+            line,
+        }] = effects.as_slice()
+        else {
+            panic!("{effects:?}");
+        };
+        assert_eq!(path, &PathBuf::from("scenes/whitted.scene"));
+        assert_eq!(original.as_str(), SCENE_TEXT);
+        assert_eq!(*line, 15);
+        assert_eq!(
+            contents.as_str(),
+            SCENE_TEXT.replace("ior 1.5", "ior 1")
+        );
+        what_if.apply_write(Ok((path.clone(), 15)));
+        assert_eq!(
+            what_if.note.as_ref().unwrap().text,
+            "wrote scenes/whitted.scene:15; reloading"
+        );
+
+        // The mirror writes no ior: the line to add, and where.
+        let loaded = LoadedScene::new(whitted_scene());
+        let mirror = material(&loaded.scene, "mirror");
+        let mut what_if = WhatIf::open(loaded, glass_pixel_tree(), Some(mirror), 100_000);
+        change_to(&mut what_if, "1.3");
+        let (_, effects) = what_if.handle_key(key(KeyCode::Char('W')));
+        assert!(effects.is_empty());
+        assert_eq!(
+            what_if.note.as_ref().unwrap().text,
+            "ior is not written in the scene (a default): add `ior 1.3` inside material mirror at scenes/whitted.scene:17:1"
+        );
+    }
+
+    #[test]
+    fn an_answer_to_a_superseded_change_is_dropped() {
+        let mut what_if = popup();
+        what_if.handle_key(key(KeyCode::Enter));
+        what_if.handle_key(key(KeyCode::Backspace));
+        what_if.handle_key(key(KeyCode::Char('2')));
+        what_if.handle_key(key(KeyCode::Enter));
+        let old = what_if.take_job().unwrap();
+        change_to(&mut what_if, "1.0");
+        let kept = what_if.outcome.as_ref().map(|o| o.text.clone());
+        what_if.apply(old.run());
+        assert_eq!(what_if.outcome.as_ref().map(|o| o.text.clone()), kept);
+        assert_eq!(kept.as_deref(), Some("1"));
+    }
+}
