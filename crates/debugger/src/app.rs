@@ -18,9 +18,9 @@ use crate::heat_map::{HeatMap, HeatMapKind};
 use crate::image_view::{ColorDepth, Viewport};
 use crate::layout::{self, Panes};
 use crate::query_job::QueryState;
-use crate::what_if_state::WhatIf;
 use crate::trace_job::{TraceFailure, TraceJob, Traced};
 use crate::tree_view::TreeView;
+use crate::what_if_state::WhatIf;
 
 /// A scene ready to render and trace: the IR (names, spans, sources) and its prepared form.
 #[derive(Clone)]

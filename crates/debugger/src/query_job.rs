@@ -259,9 +259,15 @@ mod tests {
         assert!(update(app, Action::QueryPrompt).is_empty());
         assert!(app.takes_keys());
         for c in text.chars() {
-            update(app, Action::InputKey(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)));
+            update(
+                app,
+                Action::InputKey(KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE)),
+            );
         }
-        update(app, Action::InputKey(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE)))
+        update(
+            app,
+            Action::InputKey(KeyEvent::new(KeyCode::Enter, KeyModifiers::NONE)),
+        )
     }
 
     /// Runs the job the app asked for here, reporting as the worker does.
@@ -291,7 +297,10 @@ mod tests {
     #[test]
     fn a_query_marks_the_pixels_the_explain_query_finds_and_n_steps_through_them() {
         let mut app = app();
-        assert_eq!(type_query(&mut app, "hit(\"mirror sphere\")"), vec![Effect::StartQuery]);
+        assert_eq!(
+            type_query(&mut app, "hit(\"mirror sphere\")"),
+            vec![Effect::StartQuery]
+        );
         assert!(!app.takes_keys());
         finish_query(&mut app);
         let overlay = app.query.overlay.clone().expect("an overlay");
@@ -302,7 +311,9 @@ mod tests {
         assert!(!overlay.matches.is_empty());
         let message = app.message.clone().unwrap();
         assert!(
-            message.text.starts_with(&format!("{} pixels match", overlay.matches.len())),
+            message
+                .text
+                .starts_with(&format!("{} pixels match", overlay.matches.len())),
             "{message:?}"
         );
 
@@ -310,12 +321,19 @@ mod tests {
         update(&mut app, Action::NextMatch);
         assert_eq!(app.cursor, overlay.matches[0]);
         assert!(app.tracing.is_some(), "the match is traced");
-        assert_eq!(app.message.as_ref().unwrap().text, format!("match 1 of {}", overlay.matches.len()));
+        assert_eq!(
+            app.message.as_ref().unwrap().text,
+            format!("match 1 of {}", overlay.matches.len())
+        );
         update(&mut app, Action::NextMatch);
         assert_eq!(app.cursor, overlay.matches[1]);
         update(&mut app, Action::PreviousMatch);
         update(&mut app, Action::PreviousMatch);
-        assert_eq!(app.cursor, *overlay.matches.last().unwrap(), "N wraps to the last");
+        assert_eq!(
+            app.cursor,
+            *overlay.matches.last().unwrap(),
+            "N wraps to the last"
+        );
 
         // Esc cancels the trace, then clears the overlay, then quits.
         update(&mut app, Action::Cancel);
@@ -340,10 +358,18 @@ mod tests {
             app.query.prompt.as_ref().map(LineInput::text),
             Some("tir and hit(\"mirorr sphere\")")
         );
-        update(&mut app, Action::InputKey(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE)));
+        update(
+            &mut app,
+            Action::InputKey(KeyEvent::new(KeyCode::Esc, KeyModifiers::NONE)),
+        );
         assert!(app.query.prompt.is_none());
         update(&mut app, Action::NextMatch);
-        assert!(app.message.as_ref().unwrap().text.contains("press : to run one"));
+        assert!(app
+            .message
+            .as_ref()
+            .unwrap()
+            .text
+            .contains("press : to run one"));
     }
 
     #[test]

@@ -366,7 +366,8 @@ fn spawn_input_thread(events: Sender<Event>) -> io::Result<()> {
 /// Writes a what-if change into a scene file, provided the file still holds the text the
 /// scene was compiled from (an edit made since is never overwritten).
 fn write_scene(path: &Path, original: &str, contents: &str) -> Result<(), String> {
-    let on_disk = std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let on_disk =
+        std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     if on_disk != original.as_bytes() {
         return Err(format!(
             "{} changed on disk since it was loaded; reload (r) and try again",

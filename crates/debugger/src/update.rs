@@ -173,7 +173,11 @@ fn step_match(app: &mut App, backward: bool) {
         app.set_message(format!("no pixel matches {}", overlay.text), false);
         return;
     };
-    let index = overlay.matches.iter().position(|&m| m == pixel).unwrap_or(0);
+    let index = overlay
+        .matches
+        .iter()
+        .position(|&m| m == pixel)
+        .unwrap_or(0);
     let count = overlay.matches.len();
     app.cursor = pixel;
     keep_cursor_in_view(app);

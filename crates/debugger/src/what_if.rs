@@ -45,11 +45,17 @@ impl Param {
             Param::MaxDepth | Param::MinWeight | Param::Epsilon => "settings".to_string(),
             Param::Ior(h) | Param::Reflective(h) | Param::Transmissive(h) => {
                 let name = scene.materials.get(h).and_then(|m| m.name.clone());
-                format!("material {}", name.unwrap_or_else(|| format!("#{}", h.index())))
+                format!(
+                    "material {}",
+                    name.unwrap_or_else(|| format!("#{}", h.index()))
+                )
             }
             Param::LightColor(h) => {
                 let name = scene.lights.get(h).and_then(|l| l.name.clone());
-                format!("light {}", name.unwrap_or_else(|| format!("#{}", h.index())))
+                format!(
+                    "light {}",
+                    name.unwrap_or_else(|| format!("#{}", h.index()))
+                )
             }
         }
     }
@@ -214,9 +220,7 @@ fn number(text: &str) -> Option<f64> {
     let plain = text
         .chars()
         .all(|c| c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e' | 'E'));
-    text.parse::<f64>()
-        .ok()
-        .filter(|x| plain && x.is_finite())
+    text.parse::<f64>().ok().filter(|x| plain && x.is_finite())
 }
 
 /// A grey (`0.5`), three numbers (`1 0.5 0`) or `rgb(1, 0.5, 0)`.
@@ -279,7 +283,11 @@ mod tests {
                 "light sun color = 1",
             ]
         );
-        assert_eq!(params(&scene, None).len(), 4, "no material rows without a hit");
+        assert_eq!(
+            params(&scene, None).len(),
+            4,
+            "no material rows without a hit"
+        );
     }
 
     #[test]

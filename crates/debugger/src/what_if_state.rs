@@ -428,8 +428,15 @@ mod tests {
         let (x, y) = GLASS_PIXEL;
         let expected = trace_pixel(&prepared, &edited, &options, x, y, SampleChoice::All).unwrap();
         assert_eq!(outcome.tree.color, expected.color, "bit for bit");
-        assert_eq!(outcome.diff.color, [glass_pixel_tree().color, expected.color]);
-        assert_ne!(expected.color, glass_pixel_tree().color, "the ior matters here");
+        assert_eq!(
+            outcome.diff.color,
+            [glass_pixel_tree().color, expected.color]
+        );
+        assert_ne!(
+            expected.color,
+            glass_pixel_tree().color,
+            "the ior matters here"
+        );
         let first = outcome.diff.divergences.first().expect("a divergence");
         assert_eq!(first.what, "ior of material glass (at glass sphere)");
         assert_eq!(first.values, ["1.5".to_string(), "1".to_string()]);
@@ -477,7 +484,12 @@ mod tests {
     fn w_writes_the_change_on_its_line_or_says_what_to_add() {
         let mut what_if = popup();
         assert!(what_if.handle_key(key(KeyCode::Char('W'))).1.is_empty());
-        assert!(what_if.note.as_ref().unwrap().text.contains("change a value first"));
+        assert!(what_if
+            .note
+            .as_ref()
+            .unwrap()
+            .text
+            .contains("change a value first"));
         change_to(&mut what_if, "1.0");
         let (_, effects) = what_if.handle_key(key(KeyCode::Char('W')));
         let [Effect::WriteScene {
@@ -492,10 +504,7 @@ mod tests {
         assert_eq!(path, &PathBuf::from("scenes/whitted.scene"));
         assert_eq!(original.as_str(), SCENE_TEXT);
         assert_eq!(*line, 15);
-        assert_eq!(
-            contents.as_str(),
-            SCENE_TEXT.replace("ior 1.5", "ior 1")
-        );
+        assert_eq!(contents.as_str(), SCENE_TEXT.replace("ior 1.5", "ior 1"));
         what_if.apply_write(Ok((path.clone(), 15)));
         assert_eq!(
             what_if.note.as_ref().unwrap().text,

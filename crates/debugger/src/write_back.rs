@@ -65,6 +65,9 @@ pub fn write_back(scene: &Scene, param: Param, value_text: &str) -> WriteBack {
     let Some(file) = writable_file(scene, block) else {
         return Refused(format!("{owner} was not written in a scene file"));
     };
+    if is_course_scene(file) {
+        return Refused(course_scene(file));
+    }
     let Some(body) = block_body(&file.text, block.start as usize) else {
         return Refused(format!(
             "cannot find the block of {owner} at {}",
@@ -77,7 +80,11 @@ pub fn write_back(scene: &Scene, param: Param, value_text: &str) -> WriteBack {
             line_to_add: format!("{property} {value_text}"),
             place: format!(
                 "inside {owner} at {}",
-                scene.sources.location(Span::new(block.file, block.start as usize, block.start as usize))
+                scene.sources.location(Span::new(
+                    block.file,
+                    block.start as usize,
+                    block.start as usize
+                ))
             ),
         },
         [value] => edit(file, value.clone(), value_text),
@@ -102,6 +109,9 @@ fn settings_write_back(scene: &Scene, property: &str, value_text: &str) -> Write
         }
         if file.path.starts_with('<') {
             continue;
+        }
+        if is_course_scene(file) {
+            return Refused(course_scene(file));
         }
         for at in words_at_top_level(&file.text, "settings") {
             if let Some(body) = block_body(&file.text, at) {
@@ -150,6 +160,23 @@ fn settings_write_back(scene: &Scene, property: &str, value_text: &str) -> Write
             found.len()
         )),
     }
+}
+
+/// Whether the file is a MIT 6.837 scene, which this edit cannot write: the scene language's
+/// keywords are lower case, and a 6.837 file starts with a capitalised one (`Group`, ...).
+fn is_course_scene(file: &SourceFile) -> bool {
+    file.text
+        .trim_start()
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_uppercase())
+}
+
+fn course_scene(file: &SourceFile) -> String {
+    format!(
+        "{} is a MIT 6.837 scene: only scene-language files are written back; change it by hand",
+        file.path
+    )
 }
 
 fn set_on_command_line(file: &SourceFile, property: &str) -> bool {
@@ -452,8 +479,7 @@ mod tests {
     #[test]
     fn settings_and_light_colours_are_replaced_whole_even_when_the_value_is_a_word() {
         let scene = whitted_scene();
-        let WriteBack::Edit { contents, line, .. } =
-            write_back(&scene, Param::MaxDepth, "9")
+        let WriteBack::Edit { contents, line, .. } = write_back(&scene, Param::MaxDepth, "9")
         else {
             panic!("an edit");
         };
@@ -499,6 +525,24 @@ mod tests {
     }
 
     #[test]
+    fn a_course_scene_is_never_written_with_scene_language_words() {
+        let mut scene = whitted_scene().into_inner();
+        let mut sources = whitted_ir::SourceMap::new();
+        sources.add(SourceFile::new(
+            "spheres.txt",
+            "OrthographicCamera { center 0 0 10 }\nMaterials { numMaterials 1 }\n",
+        ));
+        scene.sources = sources;
+        let glass = material(&scene, "glass");
+        for param in [Param::Ior(glass), Param::MaxDepth] {
+            let WriteBack::Refused(why) = write_back(&scene, param, "1") else {
+                panic!("refused");
+            };
+            assert!(why.contains("spheres.txt is a MIT 6.837 scene"), "{why}");
+        }
+    }
+
+    #[test]
     fn value_extents_cover_expressions_and_stop_at_the_next_property_or_comment() {
         let text = "m { ior 1.5 * k + f(2, 3) // note\n reflective rgb(0.1, 0.2, 0.3) kt -0.5e-3 }";
         let body = block_body(text, 0).unwrap();
@@ -521,6 +565,9 @@ mod tests {
         assert_eq!(at, [28]);
         let body = block_body(text, at[0]).unwrap();
         let found = properties_in(text, body, "max_depth");
-        assert_eq!(found.iter().map(|r| &text[r.clone()]).collect::<Vec<_>>(), ["2"]);
+        assert_eq!(
+            found.iter().map(|r| &text[r.clone()]).collect::<Vec<_>>(),
+            ["2"]
+        );
     }
 }

@@ -32,7 +32,7 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let mut title = vec![Span::raw(format!(" Image {width}×{height} · {zoom} "))];
     if let Some(overlay) = &app.query.overlay {
         title.push(Span::styled(
-            format!("· {}: {} px ", overlay.text, overlay.matches.len()),
+            format!("· query: {} px ", overlay.matches.len()),
             Style::new().fg(QUERY_COLOR),
         ));
     }
@@ -56,7 +56,11 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         Some(map) if app.overlay.is_some() => map,
         _ => &app.image,
     };
-    let tinted = app.query.overlay.as_ref().map(|overlay| QueryTint { base, overlay });
+    let tinted = app
+        .query
+        .overlay
+        .as_ref()
+        .map(|overlay| QueryTint { base, overlay });
     let source: &dyn PixelSource = match &tinted {
         Some(tinted) => tinted,
         None => base,

@@ -142,7 +142,10 @@ fn draw_prompt(prompt: &LineInput, area: Rect, buf: &mut Buffer) {
     let mut rest = after.chars();
     let under = rest.next().map_or(" ".to_string(), String::from);
     Line::from(vec![
-        Span::styled(" query: ", Style::new().fg(QUERY_COLOR).add_modifier(Modifier::BOLD)),
+        Span::styled(
+            " query: ",
+            Style::new().fg(QUERY_COLOR).add_modifier(Modifier::BOLD),
+        ),
         Span::raw(before.to_string()),
         Span::styled(under, Style::new().add_modifier(Modifier::REVERSED)),
         Span::raw(rest.as_str().to_string()),

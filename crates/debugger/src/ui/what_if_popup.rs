@@ -92,7 +92,10 @@ pub fn lines(what_if: &WhatIf, depth: ColorDepth, width: u16, rows: usize) -> Ve
                     before.to_string(),
                     Style::new().add_modifier(Modifier::BOLD),
                 ));
-                spans.push(Span::styled(under, Style::new().add_modifier(Modifier::REVERSED)));
+                spans.push(Span::styled(
+                    under,
+                    Style::new().add_modifier(Modifier::REVERSED),
+                ));
                 spans.push(Span::styled(
                     rest.as_str().to_string(),
                     Style::new().add_modifier(Modifier::BOLD),
@@ -108,7 +111,9 @@ pub fn lines(what_if: &WhatIf, depth: ColorDepth, width: u16, rows: usize) -> Ve
                 if let Some(outcome) = what_if.outcome.as_ref().filter(|o| o.param == *param) {
                     spans.push(Span::styled(
                         format!(" → {}", outcome.text),
-                        Style::new().fg(Color::LightCyan).add_modifier(Modifier::BOLD),
+                        Style::new()
+                            .fg(Color::LightCyan)
+                            .add_modifier(Modifier::BOLD),
                     ));
                 }
             }
@@ -124,7 +129,9 @@ pub fn lines(what_if: &WhatIf, depth: ColorDepth, width: u16, rows: usize) -> Ve
     lines.push(Line::raw(""));
     if let Some(note) = &what_if.note {
         let style = if note.is_error {
-            Style::new().fg(Color::LightRed).add_modifier(Modifier::BOLD)
+            Style::new()
+                .fg(Color::LightRed)
+                .add_modifier(Modifier::BOLD)
         } else {
             Style::new().fg(Color::LightGreen)
         };

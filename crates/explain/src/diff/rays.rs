@@ -40,7 +40,13 @@ pub enum Change {
 pub fn ray_changes(a: &RayTree, b: &RayTree) -> Vec<RayChange> {
     let mut out = Vec::new();
     for (sa, sb) in a.samples.iter().zip(&b.samples) {
-        walk(sa.index, &sa.root, &sb.root, &mut vec![RayKind::Camera], &mut out);
+        walk(
+            sa.index,
+            &sa.root,
+            &sb.root,
+            &mut vec![RayKind::Camera],
+            &mut out,
+        );
     }
     for (side, extra) in [(0, &a.samples), (1, &b.samples)] {
         let shorter = a.samples.len().min(b.samples.len());
