@@ -289,6 +289,9 @@ pub fn run(prepared: &PreparedScene, options: &RenderOptions, query: &Query) -> 
     })
 }
 
+/// One pixel's answer while running: whether it matches, its witness, its deepest ray.
+type PixelAnswer = (bool, Option<Witness>, u32);
+
 /// How a caller that waits on [`run_with`] (the debugger) steers it: a flag that stops it
 /// between rows, and a call after each finished row (for progress).
 pub struct RunControl<'a> {
@@ -305,7 +308,7 @@ pub fn run_with(
 ) -> Option<QueryResult> {
     let (width, height) = (options.width, options.height);
     let positive = query.positive();
-    let rows: Option<Vec<Vec<(bool, Option<Witness>, u32)>>> = (0..height)
+    let rows: Option<Vec<Vec<PixelAnswer>>> = (0..height)
         .into_par_iter()
         .map(|y| {
             if control.cancel.load(Ordering::Relaxed) {
