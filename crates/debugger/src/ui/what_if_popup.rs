@@ -135,7 +135,9 @@ pub fn lines(what_if: &WhatIf, depth: ColorDepth, width: u16, rows: usize) -> Ve
         } else {
             Style::new().fg(Color::LightGreen)
         };
-        lines.push(Line::styled(note.text.clone(), style));
+        for part in wrapped(&note.text, usize::from(width)) {
+            lines.push(Line::styled(part, style));
+        }
     }
     if what_if.running.is_some() {
         lines.push(Line::styled(
@@ -178,10 +180,12 @@ pub fn lines(what_if: &WhatIf, depth: ColorDepth, width: u16, rows: usize) -> Ve
         ),
         None => "the two ray trees are the same, ray by ray".to_string(),
     };
-    lines.push(Line::raw(format!(
-        "{} rays → {} rays; {cause}",
-        diff.rays[0], diff.rays[1]
-    )));
+    let summary = format!("{} rays → {} rays; {cause}", diff.rays[0], diff.rays[1]);
+    lines.extend(
+        wrapped(&summary, usize::from(width))
+            .into_iter()
+            .map(Line::raw),
+    );
     let room = rows.saturating_sub(lines.len());
     let shown = if outcome.rays.len() <= room {
         outcome.rays.len()
@@ -263,11 +267,42 @@ fn ray_line(change: &RayChange, depth: ColorDepth, wide: bool) -> Line<'static> 
     Line::from(spans)
 }
 
+/// `text` in lines of at most `width` columns, broken at spaces (a longer word is cut).
+fn wrapped(text: &str, width: usize) -> Vec<String> {
+    let width = width.max(8);
+    let mut lines = Vec::new();
+    let mut line = String::new();
+    for word in text.split(' ') {
+        let needed = line.chars().count() + usize::from(!line.is_empty()) + word.chars().count();
+        if needed > width && !line.is_empty() {
+            lines.push(std::mem::take(&mut line));
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    }
+    lines.push(line);
+    lines
+}
+
 /// A grey as one number, any other colour as three.
 fn compact(c: [f32; 3]) -> String {
     if c[0] == c[1] && c[1] == c[2] {
         number(c[0])
     } else {
         rgb(c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn long_notes_wrap_at_spaces() {
+        assert_eq!(
+            super::wrapped("add `ior 1.3` inside material mirror", 16),
+            ["add `ior 1.3`", "inside material", "mirror"]
+        );
+        assert_eq!(super::wrapped("short", 16), ["short"]);
     }
 }
