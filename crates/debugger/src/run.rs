@@ -288,6 +288,8 @@ fn handle(app: &mut App, event: Event) -> Vec<Effect> {
                 None => Vec::new(),
             }
         }
+        // An open popup or prompt has the input: the mouse waits until it closes.
+        Event::Mouse(_) if app.takes_keys() => Vec::new(),
         Event::Mouse(mouse) => match action_for_mouse(mouse) {
             Some(action) => update(app, action),
             None => Vec::new(),
