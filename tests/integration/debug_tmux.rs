@@ -69,6 +69,12 @@ impl Tmux {
         }
     }
 
+    /// Types `text` as it is (no key names).
+    fn type_text(&self, text: &str) {
+        let output = self.run(&["send-keys", "-t", &self.session, "-l", text]);
+        assert!(output.status.success(), "send-keys -l {text}");
+    }
+
     fn screen(&self) -> String {
         let output = self.run(&["capture-pane", "-p", "-t", &self.session]);
         String::from_utf8_lossy(&output.stdout).into_owned()
@@ -721,6 +727,178 @@ fn a_new_user_at_80x24_finds_the_glass_sphere_s_transmitted_ray_and_reads_it() {
     });
     tmux.keys(&["q"]);
     tmux.wait_for("the shell after q", |s| {
+        s.contains("debugger exited with 0")
+    });
+}
+
+/// The colour `whitted trace` gives a pixel of a scene file, as the debugger writes colours
+/// (three decimals): the oracle for what the what-if popup shows.
+fn traced_color(dir: &Path, scene: &str, pixel: &str) -> String {
+    let output = Command::new(whitted())
+        .current_dir(dir)
+        .args(["trace", scene, "--pixel", pixel, "--json"])
+        .output()
+        .expect("whitted trace runs");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let tree: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+    let color: Vec<String> = (0..3)
+        .map(|i| format!("{:.3}", tree["color"][i].as_f64().expect("a colour")))
+        .collect();
+    color.join(" ")
+}
+
+/// What-if (issue 13, item 5): pick the glass sphere, open what-if, change the glass's ior
+/// from 1.5 to 1; the popup shows the old and new colours (the new one as `whitted trace`
+/// gives it for a copy of the scene edited by hand) and the tree diff; W writes the change
+/// to the scene file on its line, and the debugger reloads it.
+#[test]
+fn what_if_changes_the_glass_ior_shows_the_diff_and_writes_it_back() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let original = std::fs::read_to_string(repository().join("scenes/whitted.scene"))
+        .expect("the scene is readable");
+    std::fs::write(dir.path().join("scene.scene"), &original).expect("writable");
+    let edited = original.replace("ior 1.5", "ior 1.0");
+    assert_ne!(edited, original);
+    std::fs::write(dir.path().join("by-hand.scene"), &edited).expect("writable");
+    let old_color = traced_color(dir.path(), "scene.scene", "400,270");
+    let new_color = traced_color(dir.path(), "by-hand.scene", "400,270");
+    assert_ne!(old_color, new_color, "the ior changes the pixel");
+
+    let command = format!("'{}' debug scene.scene --pixel 400,270", whitted());
+    let tmux = Tmux::start("whatif", dir.path(), &command, 120, 40);
+    tmux.wait_for("the picked pixel", |s| {
+        s.contains("Ray tree of (400, 270)") && s.contains("rendered in")
+    });
+    tmux.keys(&["w"]);
+    let screen = tmux.wait_for("the what-if popup", |s| {
+        s.contains("What if · pixel (400, 270)")
+    });
+    assert!(
+        line_with(&screen, "▶").contains("material glass  ior          1.5"),
+        "the glass's ior is listed and selected:\n{screen}"
+    );
+    tmux.keys(&["Enter", "BSpace", "BSpace", "BSpace"]);
+    tmux.type_text("1.0");
+    tmux.keys(&["Enter"]);
+    let screen = tmux.wait_for("the re-traced colour", |s| s.contains("   new ██"));
+    let colours = line_with(&screen, "   new ██");
+    assert!(
+        colours.contains(&format!("old ██ {old_color}")),
+        "old colour {old_color}:\n{screen}"
+    );
+    assert!(
+        colours.contains(&format!("new ██ {new_color}")),
+        "new colour {new_color} (whitted trace of the scene edited by hand):\n{screen}"
+    );
+    assert!(
+        screen.contains("first difference: ior of material glass (at glass sphere): 1.5 → 1"),
+        "{screen}"
+    );
+    assert!(
+        line_with(&screen, "~   transmitted").contains("glass sphere"),
+        "the changed transmitted ray is listed:\n{screen}"
+    );
+
+    tmux.keys(&["W"]);
+    tmux.wait_for("the write and the reload", |s| {
+        s.contains("wrote scene.scene:15") && s.contains("reloaded scene.scene")
+    });
+    let written = std::fs::read_to_string(dir.path().join("scene.scene")).expect("readable");
+    assert_eq!(written, original.replace("ior 1.5", "ior 1"));
+    tmux.keys(&["Escape"]);
+    // The reloaded scene renders the new colour (once its render reaches the pixel).
+    tmux.wait_for("the popup closed and the new colour rendered", |s| {
+        !s.contains("What if") && line_with(s, "(400, 270) ██").contains(&new_color)
+    });
+    tmux.keys(&["q"]);
+    tmux.wait_for("the shell after quitting", |s| {
+        s.contains("debugger exited with 0")
+    });
+}
+
+/// Queries in the debugger (issue 13, item 6): `:` runs a predicate over the image, the
+/// status line counts the matches as `whitted query` does, and `n` goes from the cursor to the
+/// next match in row order and traces it.
+#[test]
+fn a_query_marks_its_pixels_and_n_goes_to_the_first() {
+    let expr = "hit(\"mirror sphere\") and depth >= 3";
+    let output = Command::new(whitted())
+        .current_dir(repository())
+        .args([
+            "query",
+            "scenes/whitted.scene",
+            expr,
+            "--json",
+            "--limit",
+            "1000000",
+        ])
+        .output()
+        .expect("whitted query runs");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let answer: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+    let count = answer["count"].as_u64().expect("a count");
+    // The cursor starts at (320, 240): the next match in row order is the oracle.
+    let pixels: Vec<(u64, u64)> = answer["pixels"]
+        .as_array()
+        .expect("the matches")
+        .iter()
+        .map(|p| {
+            (
+                p["pixel"][0].as_u64().unwrap(),
+                p["pixel"][1].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(pixels.len() as u64, count);
+    let index = pixels
+        .iter()
+        .position(|&(x, y)| (y, x) > (240, 320))
+        .expect("a match below the middle");
+    let (x, y) = pixels[index];
+    let first = format!("({x}, {y})");
+
+    let command = format!("'{}' debug scenes/whitted.scene", whitted());
+    let tmux = Tmux::start("query", &repository(), &command, 120, 40);
+    tmux.wait_for("the finished image", |s| s.contains("rendered in"));
+    tmux.keys(&[":"]);
+    tmux.wait_for("the prompt", |s| s.contains(" query: "));
+    tmux.type_text(expr);
+    tmux.keys(&["Enter"]);
+    let screen = tmux.wait_for("the query's answer", |s| s.contains("pixels match"));
+    assert!(
+        screen.contains(&format!("{count} pixels match {expr}")),
+        "{count} pixels, as whitted query says:\n{screen}"
+    );
+    assert!(
+        screen.contains(&format!("· query: {count} px")),
+        "the overlay is named in the image's title:\n{screen}"
+    );
+    tmux.keys(&["n"]);
+    let screen = tmux.wait_for("the first match traced", |s| {
+        s.contains(&format!("Ray tree of {first}"))
+    });
+    assert!(
+        screen.contains(&format!("match {} of {count}", index + 1)),
+        "{screen}"
+    );
+    assert!(
+        screen.contains(&format!("{first} ██")),
+        "the status line shows the cursor on {first}:\n{screen}"
+    );
+    tmux.keys(&["Escape"]);
+    tmux.wait_for("the overlay cleared", |s| {
+        s.contains("cleared the query's matches")
+    });
+    tmux.keys(&["q"]);
+    tmux.wait_for("the shell after quitting", |s| {
         s.contains("debugger exited with 0")
     });
 }

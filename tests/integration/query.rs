@@ -265,3 +265,48 @@ fn a_query_that_cannot_be_read_is_located_with_a_caret() {
         assert!(output.stdout.is_empty());
     }
 }
+
+/// The debugger's query overlay (`:` in `whitted debug`) marks exactly the pixels that
+/// `whitted query --mask` paints white, on the same scene.
+#[test]
+fn the_debuggers_query_overlay_is_the_mask_of_whitted_query() {
+    use whitted_debugger::app::LoadedScene;
+    use whitted_debugger::query_job::QueryState;
+
+    let expr = "hit(\"mirror sphere\") and depth >= 3";
+    let dir = tempfile::tempdir().unwrap();
+    let mask = dir.path().join("mask.png");
+    let output = run(&[
+        "query",
+        "scenes/whitted.scene",
+        expr,
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--mask",
+        mask.to_str().unwrap(),
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let image = image::open(&mask).unwrap().to_rgb8();
+
+    let loaded = load("scenes/whitted.scene");
+    let scene = LoadedScene::new(loaded.scene);
+    let mut options = RenderOptions::from_settings(&scene.scene.settings);
+    (options.width, options.height) = (160, 120);
+    let mut state = QueryState::default();
+    state
+        .start(expr, &scene, &options, &scene.scene)
+        .expect("the query compiles");
+    let job = state.take_job().expect("a job");
+    let overlay = job.run(&|| {}).expect("no crash").expect("not cancelled");
+    let painted: Vec<bool> = image.pixels().map(|p| p.0 == [255, 255, 255]).collect();
+    assert_eq!(overlay.mask, painted);
+    let count = painted.iter().filter(|&&m| m).count();
+    assert!(count > 0, "the query matches somewhere");
+    assert_eq!(overlay.matches.len(), count);
+}

@@ -78,6 +78,7 @@ const REQUIRED: &[(&str, &str)] = &[
     ("whitted-mit6837", "whitted-ir"),
     ("whitted-tracer", "whitted-ir"),
     ("whitted-debugger", "whitted-tracer"),
+    ("whitted-debugger", "whitted-explain"),
     ("whitted-explain", "whitted-tracer"),
     // The debugger explains the picked pixel (`x`) with the explain library.
     ("whitted-debugger", "whitted-explain"),

@@ -129,6 +129,13 @@ pub enum Action {
         column: u16,
         row: u16,
     },
+    /// Opens the what-if popup on the picked pixel.
+    WhatIf,
+    /// Opens the query prompt on the status line.
+    QueryPrompt,
+    /// Moves the cursor to the next (or previous) pixel the query matched, and traces it.
+    NextMatch,
+    PreviousMatch,
 }
 
 /// The keys `?` lists: (section, keys, what they do). Every binding in
@@ -141,6 +148,7 @@ pub const KEY_HELP: &[(&str, &str, &str)] = &[
     ("Image", "Ctrl/Alt+arrows", "pan the view"),
     ("Image", "f", "fit the image to the pane"),
     ("Image", "o / d", "overlay: rays / deepest level"),
+    ("Image", "n / N", "next / previous query match"),
     ("Image", "s", "mark the selected hit point"),
     ("Image", "v", "3D ray view (keys in its title)"),
     ("Ray tree", "↑↓ jk", "previous / next ray"),
@@ -160,10 +168,12 @@ pub const KEY_HELP: &[(&str, &str, &str)] = &[
     ("Anywhere", "Tab Shift+Tab", "next / previous pane"),
     ("Anywhere", "z", "zoom the pane (Tab: next pane)"),
     ("Anywhere", "/", "search rays: kind, object, light"),
+    ("Anywhere", "w", "what-if: change a value"),
+    ("Anywhere", ":", "query: mark matching pixels"),
     ("Anywhere", "r", "reload (automatic on save)"),
     ("Anywhere", "e", "export the tree (JSON, by scene)"),
     ("Anywhere", "?", "this help"),
-    ("Anywhere", "Esc", "close, leave zoom/search, cancel"),
+    ("Anywhere", "Esc", "close, leave a mode, cancel"),
     ("Anywhere", "q", "quit"),
 ];
 
@@ -225,6 +235,8 @@ pub fn action_for_key(
         KeyCode::Char('v') => Some(Action::ToggleRayView),
         KeyCode::Char('z') => Some(Action::ToggleZoom),
         KeyCode::Char('/') => Some(Action::StartSearch),
+        KeyCode::Char('w') => Some(Action::WhatIf),
+        KeyCode::Char(':') => Some(Action::QueryPrompt),
         _ => None,
     };
     if global.is_some() {
@@ -263,6 +275,8 @@ fn image_key(code: KeyCode, shift: bool) -> Option<Action> {
         KeyCode::Char('J') => return Some(Action::MoveCursor { dx: 0, dy: 1 }),
         KeyCode::Enter => return Some(Action::TraceCursor),
         KeyCode::Char('0') => return Some(Action::ResetRayView),
+        KeyCode::Char('n') => return Some(Action::NextMatch),
+        KeyCode::Char('N') => return Some(Action::PreviousMatch),
         _ => return None,
     };
     Some(if shift {
@@ -397,10 +411,10 @@ mod tests {
                 Some(Action::SearchStep { forward: false })
             );
         }
-        // n in the image is the what-if task's (next matching pixel).
+        // n in the image goes to the query's next matching pixel instead.
         assert_eq!(
             action_for_key(key(KeyCode::Char('n')), Focus::Image, false, false),
-            None
+            Some(Action::NextMatch)
         );
     }
 
@@ -506,6 +520,41 @@ mod tests {
         assert_eq!(
             action_for_key(key(KeyCode::Char('y')), Focus::Image, false, false),
             None
+        );
+    }
+
+    #[test]
+    fn what_if_query_and_match_keys() {
+        assert_eq!(
+            action_for_key(key(KeyCode::Char('w')), Focus::Tree, false, false),
+            Some(Action::WhatIf)
+        );
+        assert_eq!(
+            action_for_key(key(KeyCode::Char(':')), Focus::Inspector, false, false),
+            Some(Action::QueryPrompt)
+        );
+        assert_eq!(
+            action_for_key(key(KeyCode::Char('n')), Focus::Image, false, false),
+            Some(Action::NextMatch)
+        );
+        assert_eq!(
+            action_for_key(shifted(KeyCode::Char('N')), Focus::Image, false, false),
+            Some(Action::PreviousMatch)
+        );
+        // An open popup or prompt takes every key, `q` included; Ctrl+C still quits.
+        let q = key(KeyCode::Char('q'));
+        assert_eq!(
+            action_for_key(q, Focus::Image, false, true),
+            Some(Action::PromptKey(q))
+        );
+        assert_eq!(
+            action_for_key(
+                KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL),
+                Focus::Image,
+                false,
+                true
+            ),
+            Some(Action::Quit)
         );
     }
 

@@ -18,10 +18,12 @@ use crate::heat_map::{HeatMap, HeatMapKind};
 use crate::image_view::{ColorDepth, Viewport};
 use crate::layout::{self, Arrangement, Panes};
 use crate::line_input::LineInput;
+use crate::query_job::QueryState;
 use crate::ray_view_state::{BackdropJob, BackdropRendered, RayViewState};
 use crate::search::Search;
 use crate::trace_job::{Explained, TraceFailure, TraceJob, Traced};
 use crate::tree_view::TreeView;
+use crate::what_if_state::WhatIf;
 
 /// A scene ready to render and trace: the IR (names, spans, sources) and its prepared form.
 #[derive(Clone)]
@@ -132,6 +134,19 @@ pub enum Effect {
     Export { path: PathBuf, contents: String },
     /// Start the trace [`App::trace_job`] describes (on a worker thread).
     Trace,
+    /// Start the what-if popup's re-trace (on a worker thread).
+    WhatIfTrace,
+    /// Write a what-if change back to a scene file: `contents` replaces the file, provided
+    /// it still holds `original` (the text the scene was compiled from); then report
+    /// through [`App::apply_write_scene`].
+    WriteScene {
+        path: PathBuf,
+        original: Arc<String>,
+        contents: String,
+        line: u32,
+    },
+    /// Start the query [`App::query`] holds (on a worker thread).
+    StartQuery,
 }
 
 /// A trace under way on a worker thread.
@@ -201,6 +216,10 @@ pub struct App {
     pub source_focus: Option<(whitted_ir::Span, String)>,
     /// The 3D ray view, when the image pane shows it instead of the image (`v`).
     pub ray_view: Option<RayViewState>,
+    /// The what-if popup (`w`), when open.
+    pub what_if: Option<WhatIf>,
+    /// The query prompt, run and overlay (`:`).
+    pub query: QueryState,
 }
 
 impl App {
@@ -246,7 +265,14 @@ impl App {
             explain_selected: 0,
             source_focus: None,
             ray_view: None,
+            what_if: None,
+            query: QueryState::default(),
         }
+    }
+
+    /// Whether a popup or prompt is open and takes every key.
+    pub fn takes_keys(&self) -> bool {
+        self.what_if.is_some() || self.query.prompt.is_some() || self.search_prompt.is_some()
     }
 
     pub fn image_size(&self) -> (u32, u32) {
@@ -549,6 +575,9 @@ impl App {
                         self.picked.as_ref().map(|p| p.tree.tree()),
                     ));
                 }
+                // The matches were of the old scene.
+                self.query.cancel();
+                self.query.overlay = None;
                 let retrace = self.retrace_picked();
                 let note = match warnings {
                     0 => String::new(),
@@ -569,6 +598,19 @@ impl App {
         let [x, y] = self.picked.as_ref()?.tree.tree().pixel;
         self.request_trace((x, y), true);
         Some(Effect::Trace)
+    }
+
+    /// The result of writing a what-if change back to the scene file.
+    pub fn apply_write_scene(&mut self, result: Result<(PathBuf, u32), String>) {
+        match &mut self.what_if {
+            Some(what_if) => what_if.apply_write(result),
+            None => match result {
+                Ok((path, line)) => {
+                    self.set_message(format!("wrote {}:{line}", path.display()), false)
+                }
+                Err(error) => self.set_message(format!("not written: {error}"), true),
+            },
+        }
     }
 
     /// The result of writing an export.

@@ -36,6 +36,10 @@ pub enum Event {
     Explained(crate::trace_job::Explained),
     /// A backdrop of the 3D ray view, rendered off the UI thread (or cancelled).
     Backdrop(crate::ray_view_state::BackdropRendered),
+    /// A what-if re-trace's answer (the popup's `w`).
+    WhatIfTraced(crate::what_if_state::WhatIfTraced),
+    /// A query's progress or answer (`:`).
+    Query(crate::query_job::QueryNews),
     /// A watched scene file changed on disk.
     FileChanged,
     /// The loop's timer: nothing arrived before the next deadline.

@@ -22,6 +22,7 @@ pub mod line_input;
 pub mod orbit;
 pub mod palette;
 pub mod projection;
+pub mod query_job;
 pub mod ray_view;
 pub mod ray_view_state;
 mod reload;
@@ -36,6 +37,9 @@ pub mod tree_view;
 pub mod ui;
 pub mod update;
 mod watch;
+pub mod what_if;
+pub mod what_if_state;
+pub mod write_back;
 
 #[cfg(test)]
 mod test_provenance_scene;

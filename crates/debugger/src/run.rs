@@ -153,6 +153,34 @@ impl Runner {
                         }
                     }
                 }
+                Effect::WhatIfTrace => {
+                    let job = app.what_if.as_mut().and_then(|w| w.take_job());
+                    if let Some(job) = job {
+                        if let Err(error) = job.spawn(self.events.clone()) {
+                            if let Some(what_if) = &mut app.what_if {
+                                what_if.cancel();
+                            }
+                            app.set_message(format!("cannot start the re-trace: {error}"), true);
+                        }
+                    }
+                }
+                Effect::StartQuery => {
+                    if let Some(job) = app.query.take_job() {
+                        if let Err(error) = job.spawn(self.events.clone()) {
+                            app.query.cancel();
+                            app.set_message(format!("cannot start the query: {error}"), true);
+                        }
+                    }
+                }
+                Effect::WriteScene {
+                    path,
+                    original,
+                    contents,
+                    line,
+                } => {
+                    let written = write_scene(&path, &original, &contents).map(|()| (path, line));
+                    app.apply_write_scene(written);
+                }
                 Effect::Export { path, contents } => {
                     let written = write_atomically(&path, &contents).map(|()| path);
                     app.apply_export(written.map_err(|e| e.to_string()));
@@ -253,12 +281,12 @@ fn event_loop(
 /// Input and render events: the part of event handling that needs no worker handles.
 fn handle(app: &mut App, event: Event) -> Vec<Effect> {
     match event {
-        Event::Key(key) => {
-            match action_for_key(key, app.focus, app.help_open, app.search_prompt.is_some()) {
-                Some(action) => update(app, action),
-                None => Vec::new(),
-            }
-        }
+        Event::Key(key) => match action_for_key(key, app.focus, app.help_open, app.takes_keys()) {
+            Some(action) => update(app, action),
+            None => Vec::new(),
+        },
+        // An open popup or prompt has the input: the mouse waits until it closes.
+        Event::Mouse(_) if app.takes_keys() => Vec::new(),
         Event::Mouse(mouse) => match action_for_mouse(mouse) {
             Some(action) => update(app, action),
             None => Vec::new(),
@@ -302,6 +330,18 @@ fn handle(app: &mut App, event: Event) -> Vec<Effect> {
             );
             Vec::new()
         }
+        Event::WhatIfTraced(traced) => {
+            if let Some(what_if) = &mut app.what_if {
+                what_if.apply(traced);
+            }
+            Vec::new()
+        }
+        Event::Query(news) => {
+            if let Some((message, is_error)) = app.query.apply(news) {
+                app.set_message(message, is_error);
+            }
+            Vec::new()
+        }
         Event::InputFailed(_)
         | Event::FileChanged
         | Event::Tick
@@ -328,6 +368,20 @@ fn spawn_input_thread(events: Sender<Event>) -> io::Result<()> {
             }
         })?;
     Ok(())
+}
+
+/// Writes a what-if change into a scene file, provided the file still holds the text the
+/// scene was compiled from (an edit made since is never overwritten).
+fn write_scene(path: &Path, original: &str, contents: &str) -> Result<(), String> {
+    let on_disk =
+        std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    if on_disk != original.as_bytes() {
+        return Err(format!(
+            "{} changed on disk since it was loaded; reload (r) and try again",
+            path.display()
+        ));
+    }
+    write_atomically(path, contents).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
 
 /// Writes a file whole or not at all: a temporary file beside it, then a rename.

@@ -5,14 +5,16 @@
 use std::path::Path;
 
 use ratatui::crossterm::event::KeyEvent;
+use whitted_ir::Handle;
 
 use crate::action::{Action, Focus};
 use crate::app::{App, Effect, SourceTarget, View};
 use crate::follow_update;
 use crate::image_view::Viewport;
 use crate::layout;
-use crate::line_input::InputOutcome;
+use crate::line_input::{InputOutcome, LineInput};
 use crate::search::Search;
+use crate::what_if_state::WhatIf;
 
 /// Applies one action; returns what the event loop must do about it.
 pub fn update(app: &mut App, action: Action) -> Vec<Effect> {
@@ -89,7 +91,20 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
                 );
             }
         }
-        Action::PromptKey(key) => prompt_key(app, key),
+        // The search prompt, the query prompt and the what-if popup each take every key.
+        Action::PromptKey(key) => {
+            if app.search_prompt.is_some() {
+                prompt_key(app, key);
+            } else {
+                return input_key(app, key);
+            }
+        }
+        Action::WhatIf => open_what_if(app),
+        Action::QueryPrompt => {
+            app.query.prompt = Some(LineInput::new(&app.query.last_text));
+        }
+        Action::NextMatch => step_match(app, false),
+        Action::PreviousMatch => step_match(app, true),
         Action::SearchStep { forward } => search_step(app, forward),
         Action::ToggleOverlay(kind) => {
             app.overlay = if app.overlay == Some(kind) {
@@ -212,11 +227,101 @@ fn ray_view_action(app: &mut App, action: Action) -> bool {
     true
 }
 
+/// `w`: the what-if popup on the picked pixel, with the material of the selected ray (or,
+/// when it hit nothing, of the camera ray).
+fn open_what_if(app: &mut App) {
+    let Some(picked) = &app.picked else {
+        app.set_message("what-if needs a ray tree: pick a pixel first (Enter)", true);
+        return;
+    };
+    let tree = &picked.tree;
+    let material = tree
+        .selected_node()
+        .and_then(|n| n.hit.as_ref())
+        .or_else(|| tree.node(0).and_then(|n| n.hit.as_ref()))
+        .map(|hit| Handle::from_index(hit.material.handle as usize));
+    app.what_if = Some(WhatIf::open(
+        app.loaded.clone(),
+        tree.tree().clone(),
+        material,
+        app.node_budget,
+    ));
+}
+
+/// A key for the open popup (first) or the query prompt.
+fn input_key(app: &mut App, key: KeyEvent) -> Vec<Effect> {
+    if let Some(what_if) = &mut app.what_if {
+        let (close, effects) = what_if.handle_key(key);
+        if close {
+            app.what_if = None;
+        }
+        return effects;
+    }
+    let Some(prompt) = &mut app.query.prompt else {
+        return Vec::new();
+    };
+    match prompt.handle(key) {
+        InputOutcome::Edited | InputOutcome::Ignored => Vec::new(),
+        InputOutcome::Cancelled => {
+            app.query.prompt = None;
+            Vec::new()
+        }
+        InputOutcome::Submitted => {
+            let text = prompt.text().trim().to_string();
+            app.query.prompt = None;
+            if text.is_empty() {
+                app.query.overlay = None;
+                return Vec::new();
+            }
+            // Kept even when wrong, so that `:` brings it back to be fixed.
+            app.query.last_text = text.clone();
+            let scene = std::sync::Arc::clone(&app.loaded.scene);
+            match app.query.start(&text, &app.loaded, &app.options, &scene) {
+                Ok(()) => {
+                    app.set_message(format!("querying {text}, Esc cancels"), false);
+                    vec![Effect::StartQuery]
+                }
+                Err(message) => {
+                    app.set_message(message, true);
+                    Vec::new()
+                }
+            }
+        }
+    }
+}
+
+/// `n` / `N`: the cursor to the next or previous matching pixel (row order), traced.
+fn step_match(app: &mut App, backward: bool) {
+    let Some(overlay) = &app.query.overlay else {
+        app.set_message("no query to step through: press : to run one", false);
+        return;
+    };
+    let Some(pixel) = overlay.step(app.cursor, backward) else {
+        app.set_message(format!("no pixel matches {}", overlay.text), false);
+        return;
+    };
+    let index = overlay
+        .matches
+        .iter()
+        .position(|&m| m == pixel)
+        .unwrap_or(0);
+    let count = overlay.matches.len();
+    app.cursor = pixel;
+    keep_cursor_in_view(app);
+    app.trace_cursor();
+    app.set_message(format!("match {} of {count}", index + 1), false);
+}
+
 /// Esc leaves whatever the user is in, one thing at a time, and never quits (`q` does, as
-/// in gitui and lazygit): a trace under way, the zoomed pane, the 3D view, the search.
+/// in gitui and lazygit): a trace under way, a query under way, the query's matches, the
+/// zoomed pane, the 3D view, the search.
 fn cancel(app: &mut App) {
     if app.cancel_trace() {
         app.set_message("cancelled the trace", false);
+    } else if app.query.cancel() {
+        app.set_message("cancelled the query", false);
+    } else if app.query.overlay.take().is_some() {
+        app.set_message("cleared the query's matches", false);
     } else if app.zoomed {
         app.zoomed = false;
     } else if app.ray_view.take().is_some() {

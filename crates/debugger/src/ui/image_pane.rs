@@ -13,6 +13,8 @@ use crate::image_view::{draw_image, PixelSource, Viewport};
 use crate::layout::inner;
 
 use super::pane_block;
+use super::status::QUERY_COLOR;
+use crate::query_job::QueryOverlay;
 
 const CURSOR_COLOR: Color = Color::Rgb(255, 0, 255);
 const HIT_POINT_COLOR: Color = Color::Rgb(0, 255, 128);
@@ -28,6 +30,12 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         }
     };
     let mut title = vec![Span::raw(format!(" Image {width}×{height} · {zoom} "))];
+    if let Some(overlay) = &app.query.overlay {
+        title.push(Span::styled(
+            format!("· query: {} px ", overlay.matches.len()),
+            Style::new().fg(QUERY_COLOR),
+        ));
+    }
     if let Some(kind) = app.overlay {
         let legend = match &app.heat_map {
             Some(map) => format!("· {} {}–{} ", kind.title(), map.min, map.max),
@@ -44,9 +52,18 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let area = block.inner(pane);
     block.render(pane, buf);
 
-    let source: &dyn PixelSource = match &app.heat_map {
+    let base: &dyn PixelSource = match &app.heat_map {
         Some(map) if app.overlay.is_some() => map,
         _ => &app.image,
+    };
+    let tinted = app
+        .query
+        .overlay
+        .as_ref()
+        .map(|overlay| QueryTint { base, overlay });
+    let source: &dyn PixelSource = match &tinted {
+        Some(tinted) => tinted,
+        None => base,
     };
     // Mark the pixel each marked cell samples, so the mark shows at any zoom.
     let sampled = |(x, y): (u32, u32)| -> Option<(u32, u32)> {
@@ -67,6 +84,29 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     }
     draw_image(source, &viewport, app.color_depth, &marked, area, buf);
     draw_rulers(app, &viewport, pane, area, buf);
+}
+
+/// The picture with a query's matches marked: matching pixels tinted towards the query's
+/// colour, the others dimmed, so that the matches stand out whatever the picture.
+struct QueryTint<'a> {
+    base: &'a dyn PixelSource,
+    overlay: &'a QueryOverlay,
+}
+
+impl PixelSource for QueryTint<'_> {
+    fn size(&self) -> (u32, u32) {
+        self.base.size()
+    }
+
+    fn srgb(&self, x: u32, y: u32) -> Option<[u8; 3]> {
+        let pixel = self.base.srgb(x, y)?;
+        Some(if self.overlay.matches_pixel(x, y) {
+            let tint = [0u16, 230, 255];
+            std::array::from_fn(|i| ((u16::from(pixel[i]) + tint[i]) / 2) as u8)
+        } else {
+            pixel.map(|c| (u16::from(c) * 2 / 5) as u8)
+        })
+    }
 }
 
 /// Arrows on the bottom and left borders in line with the cursor, so it can be found at a

@@ -14,6 +14,7 @@ mod snapshot_tests;
 mod source_pane;
 mod status;
 mod tree_pane;
+mod what_if_popup;
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::{Alignment, Rect};
@@ -53,9 +54,9 @@ impl Widget for &App {
                 None => source_pane::draw(self, panes.source, buf),
             }
         }
-        match &self.search_prompt {
-            Some(prompt) => status::draw_prompt(prompt, panes.status, buf),
-            None => status::draw(self, panes.status, buf),
+        status::draw(self, panes.status, buf);
+        if let Some(what_if) = &self.what_if {
+            what_if_popup::draw(what_if, self.color_depth, area, buf);
         }
         if self.help_open {
             help::draw(area, self.help_scroll, buf);

@@ -385,3 +385,34 @@ fn help_at_120x40_and_scrolled_at_80x24() {
     update(&mut app, Action::HelpScroll(10));
     assert_snapshot!("help_scrolled_at_80x24", draw(&app).backend());
 }
+
+/// The what-if popup on the glass pixel after changing the glass's ior to 1.
+fn what_if_on_glass(width: u16, height: u16) -> App {
+    use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    let mut app = rendered_app(width, height);
+    pick_glass_pixel(&mut app);
+    update(&mut app, Action::WhatIf);
+    let key = |code| Action::PromptKey(KeyEvent::new(code, KeyModifiers::NONE));
+    update(&mut app, key(KeyCode::Enter));
+    for code in [KeyCode::Backspace, KeyCode::Char('0')] {
+        update(&mut app, key(code));
+    }
+    let effects = update(&mut app, key(KeyCode::Enter));
+    assert_eq!(effects, vec![crate::app::Effect::WhatIfTrace]);
+    let what_if = app.what_if.as_mut().expect("the popup");
+    let job = what_if.take_job().expect("a re-trace");
+    what_if.apply(job.run());
+    app
+}
+
+#[test]
+fn what_if_glass_ior_at_80x24() {
+    let app = what_if_on_glass(80, 24);
+    assert_snapshot!(draw(&app).backend());
+}
+
+#[test]
+fn what_if_glass_ior_at_120x40() {
+    let app = what_if_on_glass(120, 40);
+    assert_snapshot!(draw(&app).backend());
+}

@@ -20,6 +20,9 @@ struct Part {
 }
 
 pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
+    if draw_prompts(app, area, buf) {
+        return;
+    }
     let mut parts = Vec::new();
     parts.push(Part {
         rank: 4,
@@ -66,6 +69,26 @@ pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
         rank: 1,
         spans: cursor,
     });
+    if let Some(run) = &app.query.running {
+        let percent = (u64::from(run.rows_done) * 100)
+            .checked_div(u64::from(run.rows))
+            .unwrap_or(0);
+        parts.push(Part {
+            rank: 0,
+            spans: vec![Span::styled(
+                format!("query {percent}%, Esc cancels"),
+                Style::new().fg(Color::Yellow),
+            )],
+        });
+    } else if let Some(overlay) = &app.query.overlay {
+        parts.push(Part {
+            rank: 1,
+            spans: vec![Span::styled(
+                format!("{}: {} px", overlay.text, overlay.matches.len()),
+                Style::new().fg(QUERY_COLOR),
+            )],
+        });
+    }
     if let Some(tracing) = &app.tracing {
         let (x, y) = tracing.pixel;
         parts.push(Part {
@@ -114,25 +137,44 @@ pub fn draw(app: &App, area: Rect, buf: &mut Buffer) {
     Line::from(spans).render(area, buf);
 }
 
-/// The `/` prompt in place of the status line: what is typed, the cursor as a reversed
-/// cell, and what Enter and Esc do.
-pub fn draw_prompt(prompt: &LineInput, area: Rect, buf: &mut Buffer) {
+/// The colour the query's matches are marked in, here and over the image.
+pub const QUERY_COLOR: Color = Color::Rgb(0, 230, 255);
+
+/// The status line while a prompt is open: the search's (`/`) or the query's (`:`).
+pub fn draw_prompts(app: &App, area: Rect, buf: &mut Buffer) -> bool {
+    if let Some(prompt) = &app.search_prompt {
+        let label = Span::styled(" search rays /", Style::new().fg(Color::Yellow));
+        draw_prompt(label, prompt, "   Enter: find · Esc: cancel", area, buf);
+    } else if let Some(prompt) = &app.query.prompt {
+        let label = Span::styled(
+            " query: ",
+            Style::new().fg(QUERY_COLOR).add_modifier(Modifier::BOLD),
+        );
+        let hint = "   Enter runs it, Esc cancels; e.g. tir and not hit(\"floor\")";
+        draw_prompt(label, prompt, hint, area, buf);
+    } else {
+        return false;
+    }
+    true
+}
+
+/// A prompt in place of the status line: its label, what is typed with the cursor as a
+/// reversed cell, and a hint of what Enter and Esc do.
+fn draw_prompt(label: Span<'static>, prompt: &LineInput, hint: &str, area: Rect, buf: &mut Buffer) {
     let text = prompt.text();
-    let split = text
+    let at = text
         .char_indices()
         .nth(prompt.cursor())
         .map_or(text.len(), |(i, _)| i);
-    let (before, rest) = text.split_at(split);
-    let mut rest = rest.chars();
+    let (before, after) = text.split_at(at);
+    let mut rest = after.chars();
     let under_cursor = rest.next().map_or(" ".to_string(), String::from);
-    let after: String = rest.collect();
-    let hint = Style::new().fg(Color::DarkGray);
     Line::from(vec![
-        Span::styled(" search rays /", Style::new().fg(Color::Yellow)),
+        label,
         Span::raw(before.to_string()),
         Span::styled(under_cursor, Style::new().add_modifier(Modifier::REVERSED)),
-        Span::raw(after),
-        Span::styled("   Enter: find · Esc: cancel", hint),
+        Span::raw(rest.as_str().to_string()),
+        Span::styled(hint.to_string(), Style::new().fg(Color::DarkGray)),
     ])
     .render(area, buf);
 }

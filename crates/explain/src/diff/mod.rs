@@ -8,8 +8,10 @@
 //! lies below is its consequence. Each divergence says how much the rays concerned give the
 //! pixel in A and in B (their subtree's path weight times returned colour).
 
+mod rays;
 mod text;
 
+pub use rays::{ray_changes, Change, RayChange};
 pub use text::format_text;
 
 use serde::Serialize;

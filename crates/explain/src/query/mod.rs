@@ -15,6 +15,8 @@ mod watch;
 pub use parse::{parse, Compare, QueryError, PREDICATES};
 pub use watch::Witness;
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use rayon::prelude::*;
 use whitted_ir::{Handle, Object, Scene};
 use whitted_tracer::ray_tree::RayTree;
@@ -273,12 +275,46 @@ pub struct QueryResult {
 /// pool, each sample traced through the one code path with a recorder that keeps only what
 /// the predicates need. The result does not depend on the thread count.
 pub fn run(prepared: &PreparedScene, options: &RenderOptions, query: &Query) -> QueryResult {
+    let never = AtomicBool::new(false);
+    let control = RunControl {
+        cancel: &never,
+        row_done: &|| {},
+    };
+    // Nothing cancels it, so it always finishes.
+    run_with(prepared, options, query, &control).unwrap_or_else(|| QueryResult {
+        width: options.width,
+        height: options.height,
+        mask: Vec::new(),
+        matches: Vec::new(),
+    })
+}
+
+/// One pixel's answer while running: whether it matches, its witness, its deepest ray.
+type PixelAnswer = (bool, Option<Witness>, u32);
+
+/// How a caller that waits on [`run_with`] (the debugger) steers it: a flag that stops it
+/// between rows, and a call after each finished row (for progress).
+pub struct RunControl<'a> {
+    pub cancel: &'a AtomicBool,
+    pub row_done: &'a (dyn Fn() + Sync),
+}
+
+/// [`run`], stopping between rows when `control.cancel` is set (then `None`).
+pub fn run_with(
+    prepared: &PreparedScene,
+    options: &RenderOptions,
+    query: &Query,
+    control: &RunControl<'_>,
+) -> Option<QueryResult> {
     let (width, height) = (options.width, options.height);
     let positive = query.positive();
-    let rows: Vec<Vec<(bool, Option<Witness>, u32)>> = (0..height)
+    let rows: Option<Vec<Vec<PixelAnswer>>> = (0..height)
         .into_par_iter()
         .map(|y| {
-            (0..width)
+            if control.cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            let row = (0..width)
                 .map(|x| {
                     let (observed, witnesses) =
                         watch::observe_pixel(prepared, options, query, x, y);
@@ -288,9 +324,12 @@ pub fn run(prepared: &PreparedScene, options: &RenderOptions, query: &Query) -> 
                         .flatten();
                     (matched, witness, observed.deepest)
                 })
-                .collect()
+                .collect();
+            (control.row_done)();
+            Some(row)
         })
         .collect();
+    let rows = rows?;
     let mut mask = Vec::with_capacity((width * height) as usize);
     let mut matches = Vec::new();
     for (y, row) in rows.into_iter().enumerate() {
@@ -305,12 +344,12 @@ pub fn run(prepared: &PreparedScene, options: &RenderOptions, query: &Query) -> 
             }
         }
     }
-    QueryResult {
+    Some(QueryResult {
         width,
         height,
         mask,
         matches,
-    }
+    })
 }
 
 /// What a witness shows, in words: `tir: sample 0, transmitted ray at depth 3 in glass`.
