@@ -16,7 +16,7 @@ use crate::app::{App, ExplanationState};
 use crate::explain_view::{entries, Entry};
 use crate::image_view::ColorDepth;
 
-use super::format::{self, swatch};
+use super::format::{self, swatch, wrap_words};
 use super::pane_block;
 
 pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
@@ -162,7 +162,7 @@ fn rows(explanation: &Explanation, selected: usize, width: usize, depth: ColorDe
                         ),
                     ]),
                 });
-                for text in wrap(&f.message, width.saturating_sub(3)) {
+                for text in wrap_words(&f.message, width.saturating_sub(3)) {
                     rows.push(Row {
                         entry: Some(index),
                         line: Line::from(format!("   {text}")),
@@ -178,47 +178,4 @@ fn rows(explanation: &Explanation, selected: usize, width: usize, depth: ColorDe
         });
     }
     rows
-}
-
-/// `text` in lines of at most `width` characters, broken between words (a word longer than
-/// a line is cut).
-fn wrap(text: &str, width: usize) -> Vec<String> {
-    let width = width.max(1);
-    let mut lines = Vec::new();
-    let mut line = String::new();
-    for word in text.split_whitespace() {
-        let needed = line.chars().count() + usize::from(!line.is_empty()) + word.chars().count();
-        if needed > width && !line.is_empty() {
-            lines.push(std::mem::take(&mut line));
-        }
-        if !line.is_empty() {
-            line.push(' ');
-        }
-        line.push_str(word);
-        while line.chars().count() > width {
-            let head: String = line.chars().take(width).collect();
-            let tail: String = line.chars().skip(width).collect();
-            lines.push(head);
-            line = tail;
-        }
-    }
-    if !line.is_empty() {
-        lines.push(line);
-    }
-    lines
-}
-
-#[cfg(test)]
-mod tests {
-    use super::wrap;
-
-    #[test]
-    fn wrapping_breaks_between_words_and_cuts_long_words() {
-        assert_eq!(
-            wrap("a light behind the surface", 10),
-            ["a light", "behind the", "surface"]
-        );
-        assert_eq!(wrap("abcdefghij", 4), ["abcd", "efgh", "ij"]);
-        assert!(wrap("", 5).is_empty());
-    }
 }

@@ -66,6 +66,43 @@ pub fn truncate(text: &str, width: usize) -> String {
     out
 }
 
+/// A popup of `width` x `height` (at most the area's) centred in `area`.
+pub fn centered(area: ratatui::layout::Rect, width: u16, height: u16) -> ratatui::layout::Rect {
+    let (width, height) = (width.min(area.width), height.min(area.height));
+    ratatui::layout::Rect::new(
+        area.x + (area.width - width) / 2,
+        area.y + (area.height - height) / 2,
+        width,
+        height,
+    )
+}
+
+/// `text` in lines of at most `width` characters, broken between words; a word longer than a
+/// line is cut, and an empty text is one empty line (so a message always has a row).
+pub fn wrap_words(text: &str, width: usize) -> Vec<String> {
+    let width = width.max(1);
+    let mut lines = Vec::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        let needed = line.chars().count() + usize::from(!line.is_empty()) + word.chars().count();
+        if needed > width && !line.is_empty() {
+            lines.push(std::mem::take(&mut line));
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+        while line.chars().count() > width {
+            lines.push(line.chars().take(width).collect());
+            line = line.chars().skip(width).collect();
+        }
+    }
+    if !line.is_empty() || lines.is_empty() {
+        lines.push(line);
+    }
+    lines
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -85,5 +122,20 @@ mod tests {
         assert_eq!(truncate("glass sphere", 20), "glass sphere");
         assert_eq!(truncate("glass sphere", 6), "glass…");
         assert_eq!(truncate("glass", 0), "");
+    }
+
+    #[test]
+    fn wrapping_breaks_between_words_and_cuts_long_words() {
+        assert_eq!(
+            wrap_words("a light behind the surface", 10),
+            ["a light", "behind the", "surface"]
+        );
+        assert_eq!(
+            wrap_words("add `ior 1.3` inside material mirror", 16),
+            ["add `ior 1.3`", "inside material", "mirror"]
+        );
+        assert_eq!(wrap_words("abcdefghij", 4), ["abcd", "efgh", "ij"]);
+        assert_eq!(wrap_words("short", 16), ["short"]);
+        assert_eq!(wrap_words("", 5), [""]);
     }
 }

@@ -17,12 +17,7 @@ pub fn draw(area: Rect, scroll: u16, buf: &mut Buffer) {
     let content_width = lines.iter().map(Line::width).max().unwrap_or(0) as u16;
     let width = (content_width + 4).min(area.width);
     let height = (lines.len() as u16 + 2).min(area.height);
-    let popup = Rect::new(
-        area.x + (area.width - width) / 2,
-        area.y + (area.height - height) / 2,
-        width,
-        height,
-    );
+    let popup = super::format::centered(area, width, height);
     Clear.render(popup, buf);
     let inner_rows = height.saturating_sub(2);
     let hidden = (lines.len() as u16).saturating_sub(inner_rows);

@@ -12,19 +12,14 @@ use whitted_explain::diff::{Change, RayChange};
 use crate::image_view::ColorDepth;
 use crate::what_if_state::WhatIf;
 
-use super::format::{number, rgb, swatch};
+use super::format::{number, rgb, swatch, wrap_words};
 
 const KEY_STYLE: Style = Style::new().fg(Color::Yellow);
 
 pub fn draw(what_if: &WhatIf, depth: ColorDepth, area: Rect, buf: &mut Buffer) {
     let width = area.width.saturating_sub(4).min(100);
     let height = area.height.saturating_sub(2);
-    let popup = Rect::new(
-        area.x + (area.width - width) / 2,
-        area.y + (area.height - height) / 2,
-        width,
-        height,
-    );
+    let popup = super::format::centered(area, width, height);
     Clear.render(popup, buf);
     let (x, y) = what_if.pixel;
     let block = Block::bordered()
@@ -135,7 +130,7 @@ pub fn lines(what_if: &WhatIf, depth: ColorDepth, width: u16, rows: usize) -> Ve
         } else {
             Style::new().fg(Color::LightGreen)
         };
-        for part in wrapped(&note.text, usize::from(width)) {
+        for part in wrap_words(&note.text, usize::from(width).max(8)) {
             lines.push(Line::styled(part, style));
         }
     }
@@ -182,7 +177,7 @@ pub fn lines(what_if: &WhatIf, depth: ColorDepth, width: u16, rows: usize) -> Ve
     };
     let summary = format!("{} rays → {} rays; {cause}", diff.rays[0], diff.rays[1]);
     lines.extend(
-        wrapped(&summary, usize::from(width))
+        wrap_words(&summary, usize::from(width).max(8))
             .into_iter()
             .map(Line::raw),
     );
@@ -267,42 +262,11 @@ fn ray_line(change: &RayChange, depth: ColorDepth, wide: bool) -> Line<'static> 
     Line::from(spans)
 }
 
-/// `text` in lines of at most `width` columns, broken at spaces (a longer word is cut).
-fn wrapped(text: &str, width: usize) -> Vec<String> {
-    let width = width.max(8);
-    let mut lines = Vec::new();
-    let mut line = String::new();
-    for word in text.split(' ') {
-        let needed = line.chars().count() + usize::from(!line.is_empty()) + word.chars().count();
-        if needed > width && !line.is_empty() {
-            lines.push(std::mem::take(&mut line));
-        }
-        if !line.is_empty() {
-            line.push(' ');
-        }
-        line.push_str(word);
-    }
-    lines.push(line);
-    lines
-}
-
 /// A grey as one number, any other colour as three.
 fn compact(c: [f32; 3]) -> String {
     if c[0] == c[1] && c[1] == c[2] {
         number(c[0])
     } else {
         rgb(c)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn long_notes_wrap_at_spaces() {
-        assert_eq!(
-            super::wrapped("add `ior 1.3` inside material mirror", 16),
-            ["add `ior 1.3`", "inside material", "mirror"]
-        );
-        assert_eq!(super::wrapped("short", 16), ["short"]);
     }
 }
