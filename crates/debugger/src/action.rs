@@ -13,6 +13,8 @@ pub enum Focus {
     Image,
     Tree,
     Inspector,
+    /// The source pane (or the scene's errors): scrolls, and zooms with `z`.
+    Source,
 }
 
 impl Focus {
@@ -20,15 +22,17 @@ impl Focus {
         match self {
             Focus::Image => Focus::Tree,
             Focus::Tree => Focus::Inspector,
-            Focus::Inspector => Focus::Image,
+            Focus::Inspector => Focus::Source,
+            Focus::Source => Focus::Image,
         }
     }
 
     pub fn previous(self) -> Focus {
         match self {
-            Focus::Image => Focus::Inspector,
+            Focus::Image => Focus::Source,
             Focus::Tree => Focus::Image,
             Focus::Inspector => Focus::Tree,
+            Focus::Source => Focus::Inspector,
         }
     }
 }
@@ -102,6 +106,13 @@ pub enum Action {
     ToggleHitPoint,
     /// Shows the material's definition in the source pane instead of the object's, or back.
     ToggleSourceTarget,
+    /// Scrolls the source pane by lines and columns from where the definition shows.
+    SourceScroll {
+        lines: i32,
+        columns: i32,
+    },
+    /// The source pane back at the definition.
+    SourceScrollHome,
     Reload,
     Export,
     /// `a`: shows the light rays of the tree, or collapses them again.
@@ -165,6 +176,7 @@ pub const KEY_HELP: &[(&str, &str, &str)] = &[
     ("Inspector", "←→ hl", "scroll sideways"),
     ("Inspector", "x", "explain the pixel (Enter: go)"),
     ("Source", "m", "material / object definition"),
+    ("Source", "↑↓ ←→ PgUp/Dn", "scroll (Home: back)"),
     ("Anywhere", "Tab Shift+Tab", "next / previous pane"),
     ("Anywhere", "z", "zoom the pane (Tab: next pane)"),
     ("Anywhere", "/", "search rays: kind, object, light"),
@@ -246,6 +258,7 @@ pub fn action_for_key(
         Focus::Image => image_key(key.code, shift),
         Focus::Tree => tree_key(key.code),
         Focus::Inspector => inspector_key(key.code),
+        Focus::Source => source_key(key.code),
     }
 }
 
@@ -317,6 +330,20 @@ fn inspector_key(code: KeyCode) -> Option<Action> {
         KeyCode::Char('N') => Action::SearchStep { forward: false },
         _ => return None,
     })
+}
+
+fn source_key(code: KeyCode) -> Option<Action> {
+    let (lines, columns) = match code {
+        KeyCode::Up | KeyCode::Char('k') => (-1, 0),
+        KeyCode::Down | KeyCode::Char('j') => (1, 0),
+        KeyCode::PageUp => (-10, 0),
+        KeyCode::PageDown => (10, 0),
+        KeyCode::Left | KeyCode::Char('h') => (0, -8),
+        KeyCode::Right | KeyCode::Char('l') => (0, 8),
+        KeyCode::Home => return Some(Action::SourceScrollHome),
+        _ => return None,
+    };
+    Some(Action::SourceScroll { lines, columns })
 }
 
 /// The action for a mouse event: left clicks and the wheel; everything else is ignored.

@@ -110,6 +110,15 @@ pub enum SourceTarget {
     Material,
 }
 
+/// The source pane's scroll: lines and columns away from where the definition `span` is
+/// shown. It belongs to that definition: another one shown starts unscrolled.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SourceScroll {
+    pub span: Option<whitted_ir::Span>,
+    pub lines: i32,
+    pub columns: u16,
+}
+
 /// How the image pane maps pixels to cells: fitted to the pane, or a zoomed/panned view.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum View {
@@ -178,6 +187,8 @@ pub struct App {
     pub focus: Focus,
     pub picked: Option<Picked>,
     pub source_target: SourceTarget,
+    /// How far the user scrolled the source pane from where it shows the definition.
+    pub source_scroll: SourceScroll,
     pub inspector_scroll: u16,
     /// How many columns the inspector is scrolled sideways.
     pub inspector_columns: u16,
@@ -242,6 +253,7 @@ impl App {
             focus: Focus::Image,
             picked: None,
             source_target: SourceTarget::Object,
+            source_scroll: SourceScroll::default(),
             inspector_scroll: 0,
             inspector_columns: 0,
             help_open: false,

@@ -68,7 +68,7 @@ pub fn panes(area: Rect, image_size: (u32, u32), arrangement: Arrangement) -> Op
             image: only(Focus::Image),
             tree: only(Focus::Tree),
             inspector: only(Focus::Inspector),
-            source: hidden,
+            source: only(Focus::Source),
             status,
         });
     }
@@ -78,7 +78,7 @@ pub fn panes(area: Rect, image_size: (u32, u32), arrangement: Arrangement) -> Op
     let left_width = match (compact, focus) {
         (false, _) => area.width / 2,
         (true, Focus::Image | Focus::Tree) => area.width * 3 / 5,
-        (true, Focus::Inspector) => area.width * 2 / 5,
+        (true, Focus::Inspector | Focus::Source) => area.width * 2 / 5,
     };
     let right_width = area.width - left_width;
 
@@ -109,6 +109,9 @@ pub fn panes(area: Rect, image_size: (u32, u32), arrangement: Arrangement) -> Op
     } else if compact && focus == Focus::Inspector {
         // Three lines of source: the definition and one line either side.
         body_height / 4
+    } else if compact && focus == Focus::Source {
+        // The source has the keyboard: most of its column.
+        body_height * 3 / 5
     } else {
         body_height * 7 / 20
     }
@@ -160,7 +163,7 @@ mod tests {
         }
     }
 
-    const FOCUSES: [Focus; 3] = [Focus::Image, Focus::Tree, Focus::Inspector];
+    const FOCUSES: [Focus; 4] = [Focus::Image, Focus::Tree, Focus::Inspector, Focus::Source];
 
     #[test]
     fn the_panes_tile_the_usual_sizes() {
@@ -191,7 +194,7 @@ mod tests {
 
     /// The 80x24: the focused pane is 48 columns wide, the focused tree shows 13
     /// rays (14 rows inside its border, one for the header: the glass pixel's whole tree),
-    /// the focused inspector 16 lines, and the source pane keeps 3 lines.
+    /// the focused inspector 16 lines (the source pane keeps 3), the focused source 11.
     #[test]
     fn at_80x24_the_focused_pane_gets_the_room() {
         let area = Rect::new(0, 0, 80, 24);
@@ -207,6 +210,10 @@ mod tests {
             .unwrap()
             .image;
         assert_eq!((image.width, image.height), (48, 16));
+        let source = panes(area, (640, 480), arranged(Focus::Source))
+            .unwrap()
+            .source;
+        assert_eq!((source.width, inner(source).height), (48, 11));
     }
 
     #[test]
@@ -228,6 +235,7 @@ mod tests {
                 Focus::Image => p.image,
                 Focus::Tree => p.tree,
                 Focus::Inspector => p.inspector,
+                Focus::Source => p.source,
             };
             assert_eq!(focused, body);
         }

@@ -8,7 +8,7 @@ use ratatui::crossterm::event::KeyEvent;
 use whitted_ir::Handle;
 
 use crate::action::{Action, Focus};
-use crate::app::{App, Effect, SourceTarget, View};
+use crate::app::{App, Effect, SourceScroll, SourceTarget, View};
 use crate::follow_update;
 use crate::image_view::Viewport;
 use crate::layout;
@@ -25,6 +25,14 @@ pub fn update(app: &mut App, action: Action) -> Vec<Effect> {
     let mut effects = apply(app, action);
     if app.trace_requests != requests {
         effects.push(Effect::Trace);
+    }
+    // Another definition in the source pane starts unscrolled.
+    let shown = crate::ui::source_pane::target_span(app);
+    if app.source_scroll.span != shown {
+        app.source_scroll = SourceScroll {
+            span: shown,
+            ..SourceScroll::default()
+        };
     }
     // Focus and zoom change the tree pane's height: keep the selected ray in sight.
     let rows = app.tree_rows();
@@ -121,6 +129,13 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
             app.show_hit_point = !app.show_hit_point;
             let state = if app.show_hit_point { "on" } else { "off" };
             app.set_message(format!("hit-point mark {state}"), false);
+        }
+        Action::SourceScroll { lines, columns } => scroll_source(app, lines, columns),
+        Action::SourceScrollHome => {
+            app.source_scroll = SourceScroll {
+                span: app.source_scroll.span,
+                ..SourceScroll::default()
+            }
         }
         Action::ToggleSourceTarget => {
             app.source_target = match app.source_target {
@@ -312,6 +327,29 @@ fn step_match(app: &mut App, backward: bool) {
     app.set_message(format!("match {} of {count}", index + 1), false);
 }
 
+/// Scrolls the source pane, within its file: no further up than its first line, down than
+/// its last, or right than its longest line.
+fn scroll_source(app: &mut App, lines: i32, columns: i32) {
+    let shown = crate::ui::source_pane::target_span(app);
+    let Some(file) = shown.and_then(|span| app.loaded.scene.sources.get(span.file)) else {
+        app.set_message("no source to scroll: pick a ray that hit something", false);
+        return;
+    };
+    let line_count = i32::try_from(file.line_count()).unwrap_or(i32::MAX);
+    let longest = (1..=file.line_count())
+        .map(|n| file.line_text(n).chars().count())
+        .max()
+        .unwrap_or(0);
+    let scroll = &mut app.source_scroll;
+    scroll.span = shown;
+    scroll.lines = scroll
+        .lines
+        .saturating_add(lines)
+        .clamp(-line_count, line_count);
+    let columns = i64::from(scroll.columns) + i64::from(columns);
+    scroll.columns = columns.clamp(0, longest.min(usize::from(u16::MAX)) as i64) as u16;
+}
+
 /// Esc leaves whatever the user is in, one thing at a time, and never quits (`q` does, as
 /// in gitui and lazygit): a trace under way, a query under way, the query's matches, the
 /// zoomed pane, the 3D view, the search.
@@ -479,6 +517,8 @@ fn click(app: &mut App, column: u16, row: u16) {
         }
     } else if panes.inspector.contains(position) {
         app.focus = Focus::Inspector;
+    } else if panes.source.contains(position) {
+        app.focus = Focus::Source;
     }
 }
 
@@ -500,6 +540,8 @@ fn wheel(app: &mut App, column: u16, row: u16, lines: i32) {
         tree(app, |t| t.page(lines as isize));
     } else if panes.inspector.contains(position) {
         scroll_inspector(app, lines * 3);
+    } else if panes.source.contains(position) {
+        scroll_source(app, lines * 3, 0);
     }
 }
 
@@ -578,6 +620,84 @@ mod tests {
         assert_eq!(update(&mut app, Action::TraceCursor), vec![Effect::Trace]);
         crate::test_scene::finish_trace(&mut app);
         app
+    }
+
+    #[test]
+    fn the_source_pane_scrolls_within_its_file_and_a_new_definition_starts_unscrolled() {
+        let mut app = picked_app();
+        let glass = crate::ui::source_pane::target_span(&app).expect("the glass sphere's line");
+        let up_down = |lines| Action::SourceScroll { lines, columns: 0 };
+        update(&mut app, up_down(2));
+        update(
+            &mut app,
+            Action::SourceScroll {
+                lines: 0,
+                columns: 8,
+            },
+        );
+        assert_eq!(
+            app.source_scroll,
+            SourceScroll {
+                span: Some(glass),
+                lines: 2,
+                columns: 8
+            }
+        );
+        // No further left than the first column, nor right than the longest line.
+        update(
+            &mut app,
+            Action::SourceScroll {
+                lines: 0,
+                columns: -100,
+            },
+        );
+        assert_eq!(app.source_scroll.columns, 0);
+        update(
+            &mut app,
+            Action::SourceScroll {
+                lines: 0,
+                columns: 10_000,
+            },
+        );
+        let file = app.loaded.scene.sources.get(glass.file).unwrap();
+        let longest = (1..=file.line_count())
+            .map(|n| file.line_text(n).chars().count())
+            .max()
+            .unwrap();
+        assert_eq!(usize::from(app.source_scroll.columns), longest);
+        update(&mut app, Action::SourceScrollHome);
+        assert_eq!((app.source_scroll.lines, app.source_scroll.columns), (0, 0));
+        // Another ray's definition (the floor, hit by the reflected ray) starts unscrolled.
+        update(&mut app, up_down(3));
+        app.focus = Focus::Tree;
+        for _ in 0..2 {
+            update(&mut app, Action::TreeDown);
+        }
+        let shown = crate::ui::source_pane::target_span(&app);
+        assert_ne!(shown, Some(glass));
+        assert_eq!(
+            app.source_scroll,
+            SourceScroll {
+                span: shown,
+                lines: 0,
+                columns: 0
+            }
+        );
+    }
+
+    #[test]
+    fn tab_reaches_the_source_pane_and_z_zooms_it() {
+        let mut app = picked_app();
+        for _ in 0..3 {
+            update(&mut app, Action::FocusNext);
+        }
+        assert_eq!(app.focus, Focus::Source);
+        update(&mut app, Action::ToggleZoom);
+        let panes = app.panes().expect("a layout");
+        assert_eq!(panes.source.width, 120);
+        assert!(panes.inspector.is_empty() && panes.image.is_empty());
+        update(&mut app, Action::FocusNext);
+        assert_eq!(app.focus, Focus::Image);
     }
 
     #[test]
@@ -744,9 +864,11 @@ mod tests {
         update(&mut app, Action::FocusNext);
         assert_eq!(app.focus, Focus::Inspector);
         update(&mut app, Action::FocusNext);
+        assert_eq!(app.focus, Focus::Source);
+        update(&mut app, Action::FocusNext);
         assert_eq!(app.focus, Focus::Image);
         update(&mut app, Action::FocusPrevious);
-        assert_eq!(app.focus, Focus::Inspector);
+        assert_eq!(app.focus, Focus::Source);
     }
 
     #[test]

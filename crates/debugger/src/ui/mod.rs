@@ -11,7 +11,7 @@ mod inspector;
 mod ray_view_pane;
 #[cfg(test)]
 mod snapshot_tests;
-mod source_pane;
+pub(crate) mod source_pane;
 mod status;
 mod tree_pane;
 mod what_if_popup;

@@ -333,13 +333,13 @@ fn transmitted_ray_found(width: u16, height: u16) -> App {
 fn every_pane_focused_and_zoomed_at_80x24_and_120x40() {
     for (width, height) in [(80, 24), (120, 40)] {
         let mut app = transmitted_ray_found(width, height);
-        for focus in [Focus::Tree, Focus::Inspector, Focus::Image] {
+        for focus in [Focus::Tree, Focus::Inspector, Focus::Source, Focus::Image] {
             app.focus = focus;
             let name = format!("{focus:?}_focused_at_{width}x{height}").to_lowercase();
             assert_snapshot!(name, draw(&app).backend());
         }
         update(&mut app, Action::ToggleZoom);
-        for focus in [Focus::Image, Focus::Tree, Focus::Inspector] {
+        for focus in [Focus::Image, Focus::Tree, Focus::Inspector, Focus::Source] {
             assert_eq!(app.focus, focus, "Tab cycles the zoomed pane");
             let name = format!("{focus:?}_zoomed_at_{width}x{height}").to_lowercase();
             assert_snapshot!(name, draw(&app).backend());

@@ -1,6 +1,8 @@
 //! The source pane: the scene text around the definition of the selected ray's object (or,
 //! with `m`, its material), the definition highlighted, titled with its file:line; under it,
 //! for an object made inside a loop, a call or an imported file, its instantiation stack.
+//! Focused (Tab), it scrolls the file by lines and columns; the scroll belongs to the
+//! definition shown, so another ray's starts unscrolled.
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -10,7 +12,8 @@ use ratatui::widgets::{Paragraph, Widget, Wrap};
 use whitted_ir::{SourceMap, Span as SourceSpan};
 use whitted_tracer::ray_tree::{ShadowOutcome, StackStep};
 
-use crate::app::{App, SourceTarget};
+use crate::action::Focus;
+use crate::app::{App, SourceScroll, SourceTarget};
 
 use super::pane_block;
 
@@ -23,9 +26,10 @@ struct Target<'a> {
 }
 
 pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
+    let focused = app.focus == Focus::Source;
     let (target, note) = target(app);
     let Some(target) = target else {
-        let block = pane_block(Line::from(" Source "), false);
+        let block = pane_block(Line::from(" Source "), focused);
         Paragraph::new(Line::from(note))
             .style(Style::new().fg(Color::Gray))
             .wrap(Wrap { trim: true })
@@ -36,7 +40,7 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let sources = &app.loaded.scene.sources;
     let location = sources.location(target.span);
     let title = format!(" Source · {location} · {} ", target.what);
-    let block = pane_block(Line::from(title), false);
+    let block = pane_block(Line::from(title), focused);
     let mut area = block.inner(pane);
     block.render(pane, buf);
     // The stack goes under the excerpt, which keeps at least a third of the pane.
@@ -51,7 +55,11 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         area.height -= stack_height;
         Paragraph::new(stack).render(below, buf);
     }
-    let lines = excerpt(sources, target.span, area.height);
+    // The user's scroll belongs to the definition it was made on.
+    let scroll = Some(app.source_scroll)
+        .filter(|s| s.span == Some(target.span))
+        .unwrap_or_default();
+    let lines = excerpt(sources, target.span, area.height, scroll);
     match lines {
         Some(lines) => Paragraph::new(lines).render(area, buf),
         None => Paragraph::new(format!("{} was not written in a scene file.", target.what))
@@ -59,6 +67,11 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
             .wrap(Wrap { trim: true })
             .render(area, buf),
     }
+}
+
+/// The definition the pane shows now, if any: what its scroll belongs to.
+pub fn target_span(app: &App) -> Option<SourceSpan> {
+    target(app).0.map(|t| t.span)
 }
 
 /// The definition to show for the selected ray, or a note saying why there is none.
@@ -138,19 +151,24 @@ fn stack_lines(made_by: &[StackStep]) -> Vec<Line<'static>> {
     lines
 }
 
-/// Up to `height` numbered lines around `span`, its text highlighted; `None` when the span
-/// points into no file (a built-in default).
-fn excerpt(sources: &SourceMap, span: SourceSpan, height: u16) -> Option<Vec<Line<'static>>> {
+/// Up to `height` numbered lines around `span`, its text highlighted, moved by the user's
+/// `scroll` (lines within the file; columns of text, the line numbers staying); `None` when
+/// the span points into no file (a built-in default).
+fn excerpt(
+    sources: &SourceMap,
+    span: SourceSpan,
+    height: u16,
+    scroll: SourceScroll,
+) -> Option<Vec<Line<'static>>> {
     let file = sources.get(span.file)?;
     let start = file.line_col(span.start);
     let end = file.line_col(span.end);
     let height = u32::from(height.max(1));
     // The definition's first line a third of the way down, when the file allows.
-    let first = start
-        .line
-        .saturating_sub(height / 3)
-        .max(1)
-        .min(file.line_count().saturating_sub(height - 1).max(1));
+    let last_first = file.line_count().saturating_sub(height - 1).max(1);
+    let first = start.line.saturating_sub(height / 3).max(1).min(last_first);
+    let first = (i64::from(first) + i64::from(scroll.lines)).clamp(1, i64::from(last_first)) as u32;
+    let skip = usize::from(scroll.columns);
     let last = (first + height - 1).min(file.line_count());
     let gutter = last.to_string().len();
     let highlight = Style::new().fg(Color::Yellow).add_modifier(Modifier::BOLD);
@@ -162,15 +180,16 @@ fn excerpt(sources: &SourceMap, span: SourceSpan, height: u16) -> Option<Vec<Lin
             Style::new().fg(Color::DarkGray),
         )];
         let in_span = number >= start.line && number <= end.line;
+        let text: String = text.chars().skip(skip).collect();
         if in_span {
             // Columns are 1-based characters; the end column is exclusive.
             let from = if number == start.line {
-                start.column as usize - 1
+                (start.column as usize - 1).saturating_sub(skip)
             } else {
                 0
             };
             let to = if number == end.line {
-                end.column as usize - 1
+                (end.column as usize - 1).saturating_sub(skip)
             } else {
                 usize::MAX
             };
@@ -203,7 +222,8 @@ mod tests {
         let file = sources.add(SourceFile::new("x.scene", text));
         let start = text.find("sphere").unwrap();
         let end = text.find("}").unwrap() + 1;
-        let lines = excerpt(&sources, whitted_ir::Span::new(file, start, end), 4).unwrap();
+        let span = whitted_ir::Span::new(file, start, end);
+        let lines = excerpt(&sources, span, 4, SourceScroll::default()).unwrap();
         let rendered: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
         assert_eq!(
             rendered,
@@ -213,6 +233,12 @@ mod tests {
         assert_eq!(lines[1].spans[2].content, "sphere \"s\" {");
         assert_eq!(lines[1].spans[2].style.fg, Some(Color::Yellow));
         assert_eq!(lines[0].spans.len(), 2, "line 2 is outside the span");
-        assert!(excerpt(&sources, whitted_ir::Span::detached(), 4).is_none());
+        assert!(excerpt(
+            &sources,
+            whitted_ir::Span::detached(),
+            4,
+            SourceScroll::default()
+        )
+        .is_none());
     }
 }
