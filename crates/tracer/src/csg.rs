@@ -15,7 +15,7 @@
 //! (for a difference, the first child and the subtracted ones it touches), in source order,
 //! which is exactly what the plain loop computes, since an untouched child adds no span.
 
-use glam::UVec2;
+use glam::{UVec2, Vec3A};
 use obvhs::aabb::Aabb;
 use whitted_ir::CsgOp;
 
@@ -161,6 +161,11 @@ pub struct CsgScratch {
     /// Child positions touched by the ray, one run per accelerated node on the stack.
     touched: Vec<u32>,
     bvh_stack: Vec<UVec2>,
+    /// The stack of the walk for an accelerated union's nearest child crossing.
+    nearest_stack: Vec<UVec2>,
+    /// The child positions that walk looked at, ascending, for evaluating the window up
+    /// to the crossing it found.
+    preset: Vec<u32>,
     /// A solid mesh's crossings along the ray, before they are paired into spans.
     mesh_hits: Vec<(f32, Part, bool)>,
 }
@@ -185,6 +190,9 @@ impl CsgTree {
     }
 
     /// The nearest boundary of the whole solid strictly inside `(tmin, tmax)`.
+    ///
+    /// An accelerated union first looks for its nearest child crossing, as a group would,
+    /// and evaluates only the window up to it (see [`CsgTree::nearest_child_crossing`]).
     pub fn first_hit(
         &self,
         ray: &Ray,
@@ -192,14 +200,154 @@ impl CsgTree {
         tmax: f32,
         scratch: &mut CsgScratch,
     ) -> Option<Boundary> {
+        if let Some(nearest) = self.nearest_child_crossing(ray, tmin, tmax, scratch) {
+            let end = nearest?.next_up();
+            if end < tmax {
+                self.evaluate_from(self.root(), true, ray, tmin, end, scratch);
+                if let Some(boundary) = first_boundary(&scratch.spans, tmin, end) {
+                    return Some(boundary);
+                }
+            }
+        }
         self.evaluate(ray, tmin, tmax, scratch);
         first_boundary(&scratch.spans, tmin, tmax)
+    }
+
+    /// For a tree whose root is an accelerated union: `Some(None)` when no child crosses
+    /// the ray inside `(tmin, tmax)`, else `Some(Some(t))` with `t` no farther than the
+    /// union's first boundary there; `None` for any other tree.
+    ///
+    /// Why this is exact: every boundary of a union is a boundary of one of its children,
+    /// so the union's first boundary is at or beyond the nearest child crossing `t`, and
+    /// is at `t` exactly when the union has a boundary there. Spans are exact inside any
+    /// window (see [`CsgTree::evaluate`]), so evaluating the window `(tmin, next_up(t))`
+    /// finds that boundary, with the leaf, part and flip the whole evaluation gives it; if
+    /// it finds none (the ray started inside the union, or `t` was only a lower bound),
+    /// [`CsgTree::first_hit`] evaluates the whole window. The window touches only the
+    /// children whose boxes lie before `t`, as a group's nearest-hit walk does.
+    fn nearest_child_crossing(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut CsgScratch,
+    ) -> Option<Option<f32>> {
+        let CsgNode::Op {
+            op: CsgOp::Union,
+            first_child,
+            child_count,
+            bound,
+            accel,
+        } = self.nodes.last()?
+        else {
+            return None;
+        };
+        let accel = self.accels.get(*accel as usize)?;
+        let inv_direction = inverse_direction(ray.direction);
+        if *child_count == 0 || !bound.admits(ray, inv_direction, tmin, tmax) {
+            return Some(None);
+        }
+        let child_at = |position: u32| self.children.get((*first_child + position) as usize);
+        let mut nearest: Option<f32> = None;
+        // Every child the walk looks at: a superset of those whose boxes touch the window
+        // up to the nearest crossing, since the walk's limit never falls below it.
+        let mut visited = std::mem::take(&mut scratch.preset);
+        visited.clear();
+        for &position in &accel.always {
+            let Some(&child) = child_at(position) else {
+                continue;
+            };
+            visited.push(position);
+            let limit = nearest.unwrap_or(tmax);
+            match self.child_crossing(child, ray, inv_direction, tmin, limit, scratch) {
+                Some(t) if nearest.is_none_or(|n| t < n) => nearest = Some(t),
+                _ => {}
+            }
+        }
+        // The walk's own stack, apart from the one that evaluating a child may use.
+        let mut stack = std::mem::take(&mut scratch.nearest_stack);
+        accel.bvh.traverse(
+            ray,
+            tmin,
+            nearest.unwrap_or(tmax),
+            &mut stack,
+            |id, limit| {
+                let Some(&position) = accel.positions.get(id as usize) else {
+                    return Step::Continue;
+                };
+                let Some(&child) = child_at(position) else {
+                    return Step::Continue;
+                };
+                visited.push(position);
+                match self.child_crossing(child, ray, inv_direction, tmin, limit, scratch) {
+                    Some(t) if nearest.is_none_or(|n| t < n) => {
+                        nearest = Some(t);
+                        Step::Shrink(t)
+                    }
+                    _ => Step::Continue,
+                }
+            },
+        );
+        scratch.nearest_stack = stack;
+        visited.sort_unstable();
+        scratch.preset = visited;
+        Some(nearest)
+    }
+
+    /// The first crossing of node `child` strictly inside `(tmin, limit)`, or for a mesh
+    /// where the ray enters its box (a lower bound); `None` when it has none there.
+    fn child_crossing(
+        &self,
+        child: u32,
+        ray: &Ray,
+        inv_direction: Vec3A,
+        tmin: f32,
+        limit: f32,
+        scratch: &mut CsgScratch,
+    ) -> Option<f32> {
+        match self.nodes.get(child as usize)? {
+            CsgNode::Leaf { leaf, bound } => match &self.leaves.get(*leaf as usize)?.geometry {
+                Geometry::Mesh(_) => bound.entry(ray, inv_direction, tmin, limit),
+                geometry => {
+                    if !bound.admits(ray, inv_direction, tmin, limit) {
+                        return None;
+                    }
+                    geometry
+                        .spans(ray)
+                        .first_boundary(tmin, limit)
+                        .map(|(t, _)| t)
+                }
+            },
+            CsgNode::Op { bound, .. } => {
+                if !bound.admits(ray, inv_direction, tmin, limit) {
+                    return None;
+                }
+                self.evaluate_from(child, false, ray, tmin, limit, scratch);
+                first_boundary(&scratch.spans, tmin, limit).map(|b| b.t)
+            }
+        }
     }
 
     /// Leaves the solid's spans along the ray in `scratch.spans`. Spans are exact inside
     /// the window `(tmin, tmax)`; children whose bound the window misses are skipped, so
     /// outside the window the list may be incomplete (nothing looks there).
     fn evaluate(&self, ray: &Ray, tmin: f32, tmax: f32, scratch: &mut CsgScratch) {
+        self.evaluate_from(self.root(), false, ray, tmin, tmax, scratch);
+    }
+
+    /// [`CsgTree::evaluate`] for the subtree whose root is node `root`. With
+    /// `preset_root`, an accelerated root evaluates the child positions in
+    /// `scratch.preset` (ascending, and including every child whose box the window
+    /// touches) instead of walking its BVH for them.
+    fn evaluate_from(
+        &self,
+        root: u32,
+        preset_root: bool,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut CsgScratch,
+    ) {
         let inv_direction = inverse_direction(ray.direction);
         scratch.spans.clear();
         scratch.stack.clear();
@@ -207,7 +355,7 @@ impl CsgTree {
         if self.nodes.is_empty() {
             return;
         }
-        scratch.stack.push(Frame::new(self.root()));
+        scratch.stack.push(Frame::new(root));
         while let Some(&frame) = scratch.stack.last() {
             let top = scratch.stack.len() - 1;
             match &self.nodes[frame.node as usize] {
@@ -260,13 +408,17 @@ impl CsgTree {
                         scratch.stack[top].start = len;
                         if let Some(accel) = accel {
                             let touched_start = scratch.touched.len();
-                            accel.touched(
-                                ray,
-                                tmin,
-                                tmax,
-                                &mut scratch.bvh_stack,
-                                &mut scratch.touched,
-                            );
+                            if preset_root && frame.node == root {
+                                scratch.touched.extend_from_slice(&scratch.preset);
+                            } else {
+                                accel.touched(
+                                    ray,
+                                    tmin,
+                                    tmax,
+                                    &mut scratch.bvh_stack,
+                                    &mut scratch.touched,
+                                );
+                            }
                             scratch.stack[top].touched_start = touched_start as u32;
                             scratch.stack[top].touched_len =
                                 (scratch.touched.len() - touched_start) as u32;
