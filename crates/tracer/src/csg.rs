@@ -185,6 +185,27 @@ impl CsgTree {
         plain
     }
 
+    /// The same tree evaluated by brute force: every child of every operation, with no
+    /// bound to skip any: the oracle for bounds and acceleration together.
+    #[cfg(test)]
+    pub fn brute_force(&self) -> CsgTree {
+        let mut plain = self.without_acceleration();
+        for node in &mut plain.nodes {
+            match node {
+                CsgNode::Leaf { bound, .. } | CsgNode::Op { bound, .. } => {
+                    *bound = Bound::Infinite;
+                }
+            }
+        }
+        plain
+    }
+
+    #[cfg(test)]
+    pub fn evaluate_whole(&self, ray: &Ray, tmin: f32, tmax: f32, scratch: &mut CsgScratch) -> Option<Boundary> {
+        self.evaluate(ray, tmin, tmax, scratch);
+        first_boundary(&scratch.spans, tmin, tmax)
+    }
+
     fn root(&self) -> u32 {
         self.nodes.len().saturating_sub(1) as u32
     }
@@ -380,11 +401,17 @@ impl CsgTree {
                                 let CsgScratch {
                                     spans, mesh_hits, ..
                                 } = scratch;
-                                mesh.push_spans(ray, mesh_hits, |raw| spans.push(to_span(&raw)));
+                                mesh.push_spans(ray, mesh_hits, |raw| {
+                                    if is_proper(&raw) {
+                                        spans.push(to_span(&raw));
+                                    }
+                                });
                             }
                             geometry => {
                                 for raw in geometry.spans(ray).as_slice() {
-                                    scratch.spans.push(to_span(raw));
+                                    if is_proper(raw) {
+                                        scratch.spans.push(to_span(raw));
+                                    }
                                 }
                             }
                         }
@@ -467,6 +494,16 @@ impl Frame {
             touched_len: 0,
         }
     }
+}
+
+/// Whether a leaf's span has length: a ray that only touches a solid (a tangent, an edge)
+/// is never inside it. Combining drops empty results anyway; dropping them at the leaves
+/// too means an empty span counts the same whether or not its node has other children
+/// with spans along the ray, so that skipping children (bounds, the BVH over them, the
+/// union's window) cannot change a result.
+#[inline]
+fn is_proper(raw: &RawSpan) -> bool {
+    raw.t_in < raw.t_out
 }
 
 /// Replaces `spans[start..]` (accumulator `[start, middle)` and child `[middle, ..)`) by
