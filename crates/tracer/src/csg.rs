@@ -14,6 +14,9 @@
 //! ([`ChildAccel`]): a ray then evaluates only the children whose boxes its window touches
 //! (for a difference, the first child and the subtracted ones it touches), in source order,
 //! which is exactly what the plain loop computes, since an untouched child adds no span.
+//! An accelerated union at the root goes further for its first hit: it walks that BVH for
+//! the nearest crossing of any child, as a group's nearest-hit query would, and evaluates
+//! only the window up to it ([`CsgTree::first_hit`]).
 
 use glam::{UVec2, Vec3A};
 use obvhs::aabb::Aabb;
@@ -200,12 +203,6 @@ impl CsgTree {
         plain
     }
 
-    #[cfg(test)]
-    pub fn evaluate_whole(&self, ray: &Ray, tmin: f32, tmax: f32, scratch: &mut CsgScratch) -> Option<Boundary> {
-        self.evaluate(ray, tmin, tmax, scratch);
-        first_boundary(&scratch.spans, tmin, tmax)
-    }
-
     fn root(&self) -> u32 {
         self.nodes.len().saturating_sub(1) as u32
     }
@@ -333,10 +330,18 @@ impl CsgTree {
                     if !bound.admits(ray, inv_direction, tmin, limit) {
                         return None;
                     }
-                    geometry
-                        .spans(ray)
-                        .first_boundary(tmin, limit)
-                        .map(|(t, _)| t)
+                    // The first end of a span the evaluation keeps.
+                    let spans = geometry.spans(ray);
+                    let span = spans
+                        .as_slice()
+                        .iter()
+                        .find(|raw| is_proper(raw) && raw.t_out > tmin)?;
+                    let t = if span.t_in > tmin {
+                        span.t_in
+                    } else {
+                        span.t_out
+                    };
+                    (t < limit).then_some(t)
                 }
             },
             CsgNode::Op { bound, .. } => {
