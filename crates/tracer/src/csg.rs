@@ -226,9 +226,72 @@ impl CsgTree {
                     return Some(boundary);
                 }
             }
+        } else if let Some(minuend) = self.minuend_crossings(ray, tmin, tmax) {
+            let (first, last) = minuend?;
+            let end = first.next_up();
+            if end < tmax {
+                self.evaluate(ray, tmin, end, scratch);
+                let found = first_boundary(&scratch.spans, tmin, end);
+                // Nothing of the difference lies beyond its first child's last exit.
+                if found.is_some() || last < end {
+                    return found;
+                }
+            }
         }
         self.evaluate(ray, tmin, tmax, scratch);
         first_boundary(&scratch.spans, tmin, tmax)
+    }
+
+    /// For a difference whose first child is a plain leaf: `Some(None)` when that child
+    /// has no crossing inside `(tmin, tmax)`, else `Some(Some((first, last)))`, its first
+    /// crossing there and its last exit along the whole line; `None` for any other tree.
+    ///
+    /// A difference is inside its first child, so its boundaries lie between that child's
+    /// crossings: the first is no nearer than `first` when the ray starts outside the
+    /// child (its entry), often exactly there (a ray meeting the solid's outer face), and
+    /// none is beyond `last`. [`CsgTree::first_hit`] evaluates the window up to `first`;
+    /// only the rays that enter through a cut go on to the whole window.
+    fn minuend_crossings(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Option<(f32, f32)>> {
+        let CsgNode::Op {
+            op: CsgOp::Difference,
+            first_child,
+            child_count,
+            ..
+        } = self.nodes.last()?
+        else {
+            return None;
+        };
+        if *child_count == 0 {
+            return None;
+        }
+        let CsgNode::Leaf { leaf, bound } = self
+            .nodes
+            .get(*self.children.get(*first_child as usize)? as usize)?
+        else {
+            return None;
+        };
+        let geometry = &self.leaves.get(*leaf as usize)?.geometry;
+        if matches!(geometry, Geometry::Mesh(_)) {
+            return None;
+        }
+        if !bound.admits(ray, inverse_direction(ray.direction), tmin, tmax) {
+            return Some(None);
+        }
+        let spans = geometry.spans(ray);
+        let mut proper = spans.as_slice().iter().filter(|raw| is_proper(raw));
+        let Some(span) = proper.clone().find(|raw| raw.t_out > tmin) else {
+            return Some(None);
+        };
+        let first = if span.t_in > tmin {
+            span.t_in
+        } else {
+            span.t_out
+        };
+        if first >= tmax {
+            return Some(None);
+        }
+        let last = proper.next_back().map_or(span.t_out, |raw| raw.t_out);
+        Some(Some((first, last)))
     }
 
     /// For a tree whose root is an accelerated union: `Some(None)` when no child crosses
