@@ -203,6 +203,21 @@ impl CsgTree {
         plain
     }
 
+    /// The first boundary from evaluating the whole window, with none of the narrower
+    /// windows [`CsgTree::first_hit`] tries first: with [`CsgTree::brute_force`], the
+    /// oracle.
+    #[cfg(test)]
+    pub fn first_hit_in_whole_window(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut CsgScratch,
+    ) -> Option<Boundary> {
+        self.evaluate(ray, tmin, tmax, scratch);
+        first_boundary(&scratch.spans, tmin, tmax)
+    }
+
     fn root(&self) -> u32 {
         self.nodes.len().saturating_sub(1) as u32
     }
@@ -242,9 +257,10 @@ impl CsgTree {
         first_boundary(&scratch.spans, tmin, tmax)
     }
 
-    /// For a difference whose first child is a plain leaf: `Some(None)` when that child
-    /// has no crossing inside `(tmin, tmax)`, else `Some(Some((first, last)))`, its first
-    /// crossing there and its last exit along the whole line; `None` for any other tree.
+    /// For a difference whose first child is a plain leaf: `Some(None)` when the ray is
+    /// outside that child all along `(tmin, tmax)`, else `Some(Some((first, last)))`, its
+    /// first crossing there and its last exit along the whole line; `None` for any other
+    /// tree, or when the window lies inside the child.
     ///
     /// A difference is inside its first child, so its boundaries lie between that child's
     /// crossings: the first is no nearer than `first` when the ray starts outside the
@@ -282,13 +298,12 @@ impl CsgTree {
         let Some(span) = proper.clone().find(|raw| raw.t_out > tmin) else {
             return Some(None);
         };
-        let first = if span.t_in > tmin {
-            span.t_in
-        } else {
-            span.t_out
-        };
+        let outside = span.t_in > tmin;
+        let first = if outside { span.t_in } else { span.t_out };
         if first >= tmax {
-            return Some(None);
+            // Outside the first child all along the window, the difference is too; inside
+            // it, the cuts may still cross the window.
+            return outside.then_some(None);
         }
         let last = proper.next_back().map_or(span.t_out, |raw| raw.t_out);
         Some(Some((first, last)))

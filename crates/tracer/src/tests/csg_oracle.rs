@@ -230,10 +230,15 @@ fn compare(
         let mut from = 0.0;
         for _ in 0..8 {
             let fast = tree.first_hit(ray, from, limit, scratch);
-            let slow = oracle.first_hit(ray, from, limit, scratch);
+            let slow = oracle.first_hit_in_whole_window(ray, from, limit, scratch);
             if bits(fast) != bits(slow) {
+                let whole = tree.first_hit_in_whole_window(ray, from, limit, scratch);
+                let plain = tree
+                    .without_acceleration()
+                    .first_hit_in_whole_window(ray, from, limit, scratch);
+                let top = tree.nodes.last().cloned();
                 return Err(format!(
-                    "window ({from}, {limit}): accelerated {fast:?}, brute force {slow:?}"
+                    "window ({from}, {limit}): accelerated {fast:?}, brute force {slow:?}\nwhole {whole:?}\nplain {plain:?}\n{top:?}"
                 ));
             }
             let Some(hit) = fast else { break };
@@ -441,7 +446,7 @@ fn scenes_of_csg_solids_match_brute_force() {
             let mut expected: Option<f32> = None;
             for oracle in oracles.iter().flatten() {
                 let limit = expected.unwrap_or(f32::INFINITY);
-                if let Some(hit) = oracle.first_hit(&ray, 0.0, limit, &mut csg) {
+                if let Some(hit) = oracle.first_hit_in_whole_window(&ray, 0.0, limit, &mut csg) {
                     expected = Some(hit.t);
                 }
             }
