@@ -140,6 +140,24 @@ pub struct CsgTree {
     pub accels: Vec<ChildAccel>,
 }
 
+/// What an accelerated union's nearest child crossing says about its first boundary.
+#[derive(Clone, Copy, Debug)]
+enum Nearest {
+    /// No child crosses the window: neither does the union.
+    Nothing,
+    /// The ray starts outside every child: the union's first boundary is this entry.
+    Exact(Boundary),
+    /// The union's first boundary is no nearer than this.
+    AtLeast(f32),
+}
+
+/// A child's first crossing inside a window, and whether the ray starts inside it.
+#[derive(Clone, Copy, Debug)]
+struct Crossing {
+    first: Option<Boundary>,
+    inside: bool,
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Frame {
     node: u32,
@@ -234,7 +252,11 @@ impl CsgTree {
         scratch: &mut CsgScratch,
     ) -> Option<Boundary> {
         if let Some(nearest) = self.nearest_child_crossing(ray, tmin, tmax, scratch) {
-            let end = nearest?.next_up();
+            let end = match nearest {
+                Nearest::Nothing => return None,
+                Nearest::Exact(boundary) => return Some(boundary),
+                Nearest::AtLeast(t) => t.next_up(),
+            };
             if end < tmax {
                 self.evaluate_from(self.root(), true, ray, tmin, end, scratch);
                 if let Some(boundary) = first_boundary(&scratch.spans, tmin, end) {
@@ -309,25 +331,25 @@ impl CsgTree {
         Some(Some((first, last)))
     }
 
-    /// For a tree whose root is an accelerated union: `Some(None)` when no child crosses
-    /// the ray inside `(tmin, tmax)`, else `Some(Some(t))` with `t` no farther than the
-    /// union's first boundary there; `None` for any other tree.
+    /// For a tree whose root is an accelerated union, what its nearest child crossing
+    /// tells about its first boundary inside `(tmin, tmax)`; `None` for any other tree.
     ///
     /// Why this is exact: every boundary of a union is a boundary of one of its children,
-    /// so the union's first boundary is at or beyond the nearest child crossing `t`, and
-    /// is at `t` exactly when the union has a boundary there. Spans are exact inside any
-    /// window (see [`CsgTree::evaluate`]), so evaluating the window `(tmin, next_up(t))`
-    /// finds that boundary, with the leaf, part and flip the whole evaluation gives it; if
-    /// it finds none (the ray started inside the union, or `t` was only a lower bound),
-    /// [`CsgTree::first_hit`] evaluates the whole window. The window touches only the
-    /// children whose boxes lie before `t`, as a group's nearest-hit walk does.
+    /// so with no child crossing there the union has none. A child whose box the segment
+    /// misses cannot contain the ray's start, and the walk's limit never falls below the
+    /// nearest crossing, so the walk sees every child that could be inside at `tmin`. If
+    /// none is, the ray starts outside the union and its first boundary is the nearest
+    /// child entry; at a tie, the child first in source order, as the sweep takes the
+    /// earlier list first at equal entries. Otherwise the nearest crossing is only a lower
+    /// bound, and [`CsgTree::first_hit`] evaluates the window up to it, with the children
+    /// the walk visited (spans are exact inside any window, see [`CsgTree::evaluate`]).
     fn nearest_child_crossing(
         &self,
         ray: &Ray,
         tmin: f32,
         tmax: f32,
         scratch: &mut CsgScratch,
-    ) -> Option<Option<f32>> {
+    ) -> Option<Nearest> {
         let CsgNode::Op {
             op: CsgOp::Union,
             first_child,
@@ -341,57 +363,68 @@ impl CsgTree {
         let accel = self.accels.get(*accel as usize)?;
         let inv_direction = inverse_direction(ray.direction);
         if *child_count == 0 || !bound.admits(ray, inv_direction, tmin, tmax) {
-            return Some(None);
+            return Some(Nearest::Nothing);
         }
         let child_at = |position: u32| self.children.get((*first_child + position) as usize);
-        let mut nearest: Option<f32> = None;
+        // The nearest crossing so far and the position of its child.
+        let mut nearest: Option<(Boundary, u32)> = None;
+        let mut started_inside = false;
         // Every child the walk looks at: a superset of those whose boxes touch the window
-        // up to the nearest crossing, since the walk's limit never falls below it.
+        // up to the nearest crossing.
         let mut visited = std::mem::take(&mut scratch.preset);
         visited.clear();
-        for &position in &accel.always {
-            let Some(&child) = child_at(position) else {
-                continue;
-            };
+        let mut consider = |position: u32, scratch: &mut CsgScratch| -> Option<f32> {
+            let &child = child_at(position)?;
             visited.push(position);
-            let limit = nearest.unwrap_or(tmax);
-            match self.child_crossing(child, ray, inv_direction, tmin, limit, scratch) {
-                Some(t) if nearest.is_none_or(|n| t < n) => nearest = Some(t),
-                _ => {}
+            // Up to and including the nearest so far, for ties.
+            let limit = nearest.map_or(tmax, |(b, _)| b.t.next_up().min(tmax));
+            let crossing = self.child_crossing(child, ray, inv_direction, tmin, limit, scratch);
+            started_inside |= crossing.inside;
+            let found = crossing.first?;
+            let nearer = match nearest {
+                None => true,
+                Some((best, best_position)) => {
+                    found.t < best.t || (found.t == best.t && position < best_position)
+                }
+            };
+            if nearer {
+                nearest = Some((found, position));
+            }
+            nearer.then_some(found.t)
+        };
+        let mut start_limit = tmax;
+        for &position in &accel.always {
+            if let Some(t) = consider(position, scratch) {
+                start_limit = t;
             }
         }
         // The walk's own stack, apart from the one that evaluating a child may use.
         let mut stack = std::mem::take(&mut scratch.nearest_stack);
-        accel.bvh.traverse(
-            ray,
-            tmin,
-            nearest.unwrap_or(tmax),
-            &mut stack,
-            |id, limit| {
-                let Some(&position) = accel.positions.get(id as usize) else {
-                    return Step::Continue;
-                };
-                let Some(&child) = child_at(position) else {
-                    return Step::Continue;
-                };
-                visited.push(position);
-                match self.child_crossing(child, ray, inv_direction, tmin, limit, scratch) {
-                    Some(t) if nearest.is_none_or(|n| t < n) => {
-                        nearest = Some(t);
-                        Step::Shrink(t)
-                    }
-                    _ => Step::Continue,
+        accel
+            .bvh
+            .traverse(ray, tmin, start_limit, &mut stack, |id, _| {
+                match accel
+                    .positions
+                    .get(id as usize)
+                    .and_then(|&position| consider(position, scratch))
+                {
+                    Some(t) => Step::Shrink(t),
+                    None => Step::Continue,
                 }
-            },
-        );
+            });
         scratch.nearest_stack = stack;
         visited.sort_unstable();
         scratch.preset = visited;
-        Some(nearest)
+        Some(match nearest {
+            None => Nearest::Nothing,
+            Some((boundary, _)) if !started_inside => Nearest::Exact(boundary),
+            Some((boundary, _)) => Nearest::AtLeast(boundary.t),
+        })
     }
 
-    /// The first crossing of node `child` strictly inside `(tmin, limit)`, or for a mesh
-    /// where the ray enters its box (a lower bound); `None` when it has none there.
+    /// The first crossing of node `child` strictly inside `(tmin, limit)`, and whether the
+    /// ray is inside it just after `tmin`. A mesh reports where the ray enters its box (a
+    /// lower bound) and counts as inside (unknown), so that the window is evaluated.
     fn child_crossing(
         &self,
         child: u32,
@@ -400,35 +433,72 @@ impl CsgTree {
         tmin: f32,
         limit: f32,
         scratch: &mut CsgScratch,
-    ) -> Option<f32> {
-        match self.nodes.get(child as usize)? {
-            CsgNode::Leaf { leaf, bound } => match &self.leaves.get(*leaf as usize)?.geometry {
-                Geometry::Mesh(_) => bound.entry(ray, inv_direction, tmin, limit),
-                geometry => {
-                    if !bound.admits(ray, inv_direction, tmin, limit) {
-                        return None;
-                    }
-                    // The first end of a span the evaluation keeps.
-                    let spans = geometry.spans(ray);
-                    let span = spans
-                        .as_slice()
-                        .iter()
-                        .find(|raw| is_proper(raw) && raw.t_out > tmin)?;
-                    let t = if span.t_in > tmin {
-                        span.t_in
-                    } else {
-                        span.t_out
+    ) -> Crossing {
+        const NONE: Crossing = Crossing {
+            first: None,
+            inside: false,
+        };
+        match self.nodes.get(child as usize) {
+            Some(CsgNode::Leaf { leaf, bound }) => {
+                let Some(geometry) = self.leaves.get(*leaf as usize).map(|l| &l.geometry) else {
+                    return NONE;
+                };
+                if let Geometry::Mesh(_) = geometry {
+                    let first = bound
+                        .entry(ray, inv_direction, tmin, limit)
+                        .map(|t| Boundary {
+                            t,
+                            leaf: *leaf,
+                            part: 0,
+                            flip: false,
+                        });
+                    return Crossing {
+                        inside: first.is_some(),
+                        first,
                     };
-                    (t < limit).then_some(t)
                 }
-            },
-            CsgNode::Op { bound, .. } => {
                 if !bound.admits(ray, inv_direction, tmin, limit) {
-                    return None;
+                    return NONE;
+                }
+                // The first end of a span the evaluation keeps.
+                let spans = geometry.spans(ray);
+                let Some(span) = spans
+                    .as_slice()
+                    .iter()
+                    .find(|raw| is_proper(raw) && raw.t_out > tmin)
+                else {
+                    return NONE;
+                };
+                let inside = span.t_in <= tmin;
+                let (t, part) = if inside {
+                    (span.t_out, span.part_out)
+                } else {
+                    (span.t_in, span.part_in)
+                };
+                Crossing {
+                    first: (t < limit).then_some(Boundary {
+                        t,
+                        leaf: *leaf,
+                        part,
+                        flip: false,
+                    }),
+                    inside,
+                }
+            }
+            Some(CsgNode::Op { bound, .. }) => {
+                if !bound.admits(ray, inv_direction, tmin, limit) {
+                    return NONE;
                 }
                 self.evaluate_from(child, false, ray, tmin, limit, scratch);
-                first_boundary(&scratch.spans, tmin, limit).map(|b| b.t)
+                Crossing {
+                    first: first_boundary(&scratch.spans, tmin, limit),
+                    inside: scratch
+                        .spans
+                        .iter()
+                        .any(|span| span.enter.t <= tmin && span.exit.t > tmin),
+                }
             }
+            None => NONE,
         }
     }
 
