@@ -14,9 +14,9 @@
 //! ([`ChildAccel`]): a ray then evaluates only the children whose boxes its window touches
 //! (for a difference, the first child and the subtracted ones it touches), in source order,
 //! which is exactly what the plain loop computes, since an untouched child adds no span.
-//! An accelerated union at the root goes further for its first hit: it walks that BVH for
-//! the nearest crossing of any child, as a group's nearest-hit query would, and evaluates
-//! only the window up to it ([`CsgTree::first_hit`]).
+//! At the root, the first hit narrows the window further ([`CsgTree::first_hit`]): an
+//! accelerated union walks that BVH for the nearest crossing of any child, as a group's
+//! nearest-hit query would, and a difference looks at its first child's first crossing.
 
 use glam::{UVec2, Vec3A};
 use obvhs::aabb::Aabb;
@@ -243,7 +243,10 @@ impl CsgTree {
     /// The nearest boundary of the whole solid strictly inside `(tmin, tmax)`.
     ///
     /// An accelerated union first looks for its nearest child crossing, as a group would,
-    /// and evaluates only the window up to it (see [`CsgTree::nearest_child_crossing`]).
+    /// which is the hit when the ray starts outside every child and otherwise bounds a
+    /// narrower window to evaluate first ([`CsgTree::nearest_child_crossing`]); a difference
+    /// evaluates first the window up to its first child's first crossing
+    /// ([`CsgTree::minuend_crossings`]). Either way the whole window is the last resort.
     pub fn first_hit(
         &self,
         ray: &Ray,

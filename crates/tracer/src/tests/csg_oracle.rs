@@ -378,7 +378,7 @@ fn csg_nodes_are_bounded_by_the_rule_of_their_operation() {
     };
     let close = |bound: Bound, lo: f32, hi: f32| match bound {
         Bound::Finite(aabb) => {
-            let (min, max) = (Vec3A::from(aabb.min), Vec3A::from(aabb.max));
+            let (min, max) = (aabb.min, aabb.max);
             min.abs_diff_eq(Vec3A::splat(lo), 1e-4) && max.abs_diff_eq(Vec3A::splat(hi), 1e-4)
         }
         _ => false,
