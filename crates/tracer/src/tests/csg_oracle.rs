@@ -1,6 +1,7 @@
 //! Accelerated CSG against brute force: node bounds, the BVH over a union's or a
-//! difference's children and the union's nearest-crossing window must give exactly the hit
-//! (distance bit for bit, leaf, part, flip) of evaluating every child of every node with no
+//! difference's children and the narrower windows of a first hit (a union's nearest child
+//! crossing, a difference's first child) must give exactly the hit (distance bit for bit,
+//! leaf, part, flip) of evaluating the whole window with every child of every node and no
 //! bound at all, for generated trees and rays of every awkward kind.
 //!
 //! Trees mix spheres, boxes on a unit grid (so faces touch and coincide), capped cylinders,
