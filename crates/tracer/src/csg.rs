@@ -184,8 +184,8 @@ pub struct CsgScratch {
     bvh_stack: Vec<UVec2>,
     /// The stack of the walk for an accelerated union's nearest child crossing.
     nearest_stack: Vec<UVec2>,
-    /// The child positions that walk looked at, ascending, for evaluating the window up
-    /// to the crossing it found.
+    /// The child positions that walk looked at, for evaluating the window up to the
+    /// crossing it found (sorted before that).
     preset: Vec<u32>,
     /// A solid mesh's crossings along the ray, before they are paired into spans.
     mesh_hits: Vec<(f32, Part, bool)>,
@@ -258,7 +258,10 @@ impl CsgTree {
             let end = match nearest {
                 Nearest::Nothing => return None,
                 Nearest::Exact(boundary) => return Some(boundary),
-                Nearest::AtLeast(t) => t.next_up(),
+                Nearest::AtLeast(t) => {
+                    scratch.preset.sort_unstable();
+                    t.next_up()
+                }
             };
             if end < tmax {
                 self.evaluate_from(self.root(), true, ray, tmin, end, scratch);
@@ -416,7 +419,7 @@ impl CsgTree {
                 }
             });
         scratch.nearest_stack = stack;
-        visited.sort_unstable();
+        // Sorted into source order only if the window is evaluated (`AtLeast`).
         scratch.preset = visited;
         Some(match nearest {
             None => Nearest::Nothing,
