@@ -7,6 +7,7 @@
 
 mod allocator;
 mod cli;
+mod cpu_time;
 mod debug_cmd;
 mod diff_cmd;
 mod explain_cmd;

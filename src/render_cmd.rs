@@ -254,6 +254,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         bar
     });
     let observer = ProgressObserver { bar };
+    let cpu_before = crate::cpu_time::pool_cpu_seconds(&pool);
     // Per-pixel statistics are gathered only when asked for: the plain render records nothing.
     let rendered = pool.install(|| match &args.stats_image {
         Some(_) => whitted_tracer::render_with_pixel_stats(&prepared, &options, &observer)
@@ -261,6 +262,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         None => whitted_tracer::render(&prepared, &options, &observer)
             .map(|(image, stats)| (image, stats, None)),
     });
+    let render_cpu_seconds = crate::cpu_time::pool_cpu_seconds(&pool) - cpu_before;
     if let Some(bar) = &observer.bar {
         bar.finish_and_clear();
     }
@@ -305,7 +307,9 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         compile_seconds,
         build_seconds: prepared.build_seconds(),
         stats: &stats,
+        render_cpu_seconds,
         wall_seconds: started.elapsed().as_secs_f64(),
+        peak_memory_kib: crate::cpu_time::peak_memory_kib(),
     };
     match args.stats {
         Some(StatsFormat::Text) => write_stdout(&summary.text())?,
@@ -334,7 +338,12 @@ struct Summary<'a> {
     compile_seconds: f64,
     build_seconds: f64,
     stats: &'a RenderStats,
+    /// The CPU time the render's threads spent on it, summed over the threads (each
+    /// thread's own clock, so time other programs took on the machine is not counted).
+    render_cpu_seconds: f64,
     wall_seconds: f64,
+    /// The process's peak resident memory, when the system reports it.
+    peak_memory_kib: Option<u64>,
 }
 
 impl Summary<'_> {
@@ -365,7 +374,16 @@ impl Summary<'_> {
                 "speed            {mrays:.2} Mrays/s ({:.2} per thread)",
                 mrays / self.threads as f64
             ),
+            format!(
+                "render cpu       {:.3} s over all threads, {:.2} Mrays per cpu-second",
+                self.render_cpu_seconds,
+                self.rays_per_cpu_second() / 1e6
+            ),
             format!("wall             {:.3} s", self.wall_seconds),
+            match self.peak_memory_kib {
+                Some(kib) => format!("peak memory      {:.1} MiB", kib as f64 / 1024.0),
+                None => "peak memory      unknown".to_string(),
+            },
         ]
         .join("\n")
             + "\n"
@@ -392,8 +410,20 @@ impl Summary<'_> {
             "transmitted_rays": s.transmitted_rays,
             "total_rays": s.total_rays(),
             "rays_per_second": self.stats.rays_per_second(),
+            "render_cpu_seconds": self.render_cpu_seconds,
+            "rays_per_cpu_second": self.rays_per_cpu_second(),
             "wall_seconds": self.wall_seconds,
+            "peak_memory_kib": self.peak_memory_kib,
         })
+    }
+
+    /// Rays per second of the render threads' CPU time (0 when none was measured).
+    fn rays_per_cpu_second(&self) -> f64 {
+        if self.render_cpu_seconds > 0.0 {
+            self.stats.total_rays() as f64 / self.render_cpu_seconds
+        } else {
+            0.0
+        }
     }
 }
 

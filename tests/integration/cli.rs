@@ -311,6 +311,15 @@ fn stats_report_ray_counts_as_text_and_json() {
         stats["transmitted_rays"].as_u64().unwrap() > 0,
         "the glass sphere refracts"
     );
+    // The render threads' own CPU time, and what it gives per ray; the process's peak.
+    let cpu = stats["render_cpu_seconds"].as_f64().unwrap();
+    assert!(cpu > 0.0, "render_cpu_seconds {cpu}");
+    let per_cpu = stats["rays_per_cpu_second"].as_f64().unwrap();
+    assert!(
+        (per_cpu * cpu - total as f64).abs() < 1.0,
+        "{per_cpu} rays per cpu-second over {cpu} s"
+    );
+    assert!(stats["peak_memory_kib"].as_u64().unwrap() > 0);
 
     let output = run(&[
         "render",

@@ -90,6 +90,19 @@ impl Bound {
     }
 }
 
+impl Bound {
+    /// Where the ray's segment `[tmin, tmax]` first meets what this bounds (`tmin` for an
+    /// unbounded solid), or `None` when it cannot: a lower bound on any crossing there.
+    #[inline]
+    pub fn entry(&self, ray: &Ray, inv_direction: Vec3A, tmin: f32, tmax: f32) -> Option<f32> {
+        match self {
+            Bound::Empty => None,
+            Bound::Infinite => (tmin <= tmax).then_some(tmin),
+            Bound::Finite(aabb) => segment_entry(aabb, ray, inv_direction, tmin, tmax),
+        }
+    }
+}
+
 /// The slab test, with a reciprocal direction from [`inverse_direction`] (always finite, so
 /// no `0 · ∞` NaN can arise for a ray lying in a slab's plane).
 #[inline]
@@ -107,6 +120,26 @@ pub fn segment_touches_box(
     let enter = near.x.max(near.y).max(near.z).max(tmin);
     let exit = far.x.min(far.y).min(far.z).min(tmax);
     enter <= exit
+}
+
+/// Where the ray's segment `[tmin, tmax]` first touches the box (`tmin` when it starts
+/// inside), or `None` when it does not touch it: the same slab test as
+/// [`segment_touches_box`].
+#[inline]
+pub fn segment_entry(
+    aabb: &Aabb,
+    ray: &Ray,
+    inv_direction: Vec3A,
+    tmin: f32,
+    tmax: f32,
+) -> Option<f32> {
+    let t1 = (aabb.min - ray.origin) * inv_direction;
+    let t2 = (aabb.max - ray.origin) * inv_direction;
+    let near = t1.min(t2);
+    let far = t1.max(t2);
+    let enter = near.x.max(near.y).max(near.z).max(tmin);
+    let exit = far.x.min(far.y).min(far.z).min(tmax);
+    (enter <= exit).then_some(enter)
 }
 
 /// Component-wise reciprocal, clamped like obvhs's `safe_inverse`: a component too small to

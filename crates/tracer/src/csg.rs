@@ -14,8 +14,11 @@
 //! ([`ChildAccel`]): a ray then evaluates only the children whose boxes its window touches
 //! (for a difference, the first child and the subtracted ones it touches), in source order,
 //! which is exactly what the plain loop computes, since an untouched child adds no span.
+//! At the root, the first hit narrows the window further ([`CsgTree::first_hit`]): an
+//! accelerated union walks that BVH for the nearest crossing of any child, as a group's
+//! nearest-hit query would, and a difference looks at its first child's first crossing.
 
-use glam::UVec2;
+use glam::{UVec2, Vec3A};
 use obvhs::aabb::Aabb;
 use whitted_ir::CsgOp;
 
@@ -137,6 +140,24 @@ pub struct CsgTree {
     pub accels: Vec<ChildAccel>,
 }
 
+/// What an accelerated union's nearest child crossing says about its first boundary.
+#[derive(Clone, Copy, Debug)]
+enum Nearest {
+    /// No child crosses the window: neither does the union.
+    Nothing,
+    /// The ray starts outside every child: the union's first boundary is this entry.
+    Exact(Boundary),
+    /// The union's first boundary is no nearer than this.
+    AtLeast(f32),
+}
+
+/// A child's first crossing inside a window, and whether the ray starts inside it.
+#[derive(Clone, Copy, Debug)]
+struct Crossing {
+    first: Option<Boundary>,
+    inside: bool,
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Frame {
     node: u32,
@@ -161,6 +182,11 @@ pub struct CsgScratch {
     /// Child positions touched by the ray, one run per accelerated node on the stack.
     touched: Vec<u32>,
     bvh_stack: Vec<UVec2>,
+    /// The stack of the walk for an accelerated union's nearest child crossing.
+    nearest_stack: Vec<UVec2>,
+    /// The child positions that walk looked at, for evaluating the window up to the
+    /// crossing it found (sorted before that).
+    preset: Vec<u32>,
     /// A solid mesh's crossings along the ray, before they are paired into spans.
     mesh_hits: Vec<(f32, Part, bool)>,
 }
@@ -180,12 +206,26 @@ impl CsgTree {
         plain
     }
 
-    fn root(&self) -> u32 {
-        self.nodes.len().saturating_sub(1) as u32
+    /// The same tree evaluated by brute force: every child of every operation, with no
+    /// bound to skip any: the oracle for bounds and acceleration together.
+    #[cfg(test)]
+    pub fn brute_force(&self) -> CsgTree {
+        let mut plain = self.without_acceleration();
+        for node in &mut plain.nodes {
+            match node {
+                CsgNode::Leaf { bound, .. } | CsgNode::Op { bound, .. } => {
+                    *bound = Bound::Infinite;
+                }
+            }
+        }
+        plain
     }
 
-    /// The nearest boundary of the whole solid strictly inside `(tmin, tmax)`.
-    pub fn first_hit(
+    /// The first boundary from evaluating the whole window, with none of the narrower
+    /// windows [`CsgTree::first_hit`] tries first: with [`CsgTree::brute_force`], the
+    /// oracle.
+    #[cfg(test)]
+    pub fn first_hit_in_whole_window(
         &self,
         ray: &Ray,
         tmin: f32,
@@ -196,10 +236,298 @@ impl CsgTree {
         first_boundary(&scratch.spans, tmin, tmax)
     }
 
+    fn root(&self) -> u32 {
+        self.nodes.len().saturating_sub(1) as u32
+    }
+
+    /// The nearest boundary of the whole solid strictly inside `(tmin, tmax)`.
+    ///
+    /// An accelerated union first looks for its nearest child crossing, as a group would,
+    /// which is the hit when the ray starts outside every child and otherwise bounds a
+    /// narrower window to evaluate first ([`CsgTree::nearest_child_crossing`]); a difference
+    /// evaluates first the window up to its first child's first crossing
+    /// ([`CsgTree::minuend_crossings`]). Either way the whole window is the last resort.
+    pub fn first_hit(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut CsgScratch,
+    ) -> Option<Boundary> {
+        if let Some(nearest) = self.nearest_child_crossing(ray, tmin, tmax, scratch) {
+            let end = match nearest {
+                Nearest::Nothing => return None,
+                Nearest::Exact(boundary) => return Some(boundary),
+                Nearest::AtLeast(t) => {
+                    scratch.preset.sort_unstable();
+                    t.next_up()
+                }
+            };
+            if end < tmax {
+                self.evaluate_from(self.root(), true, ray, tmin, end, scratch);
+                if let Some(boundary) = first_boundary(&scratch.spans, tmin, end) {
+                    return Some(boundary);
+                }
+            }
+        } else if let Some(minuend) = self.minuend_crossings(ray, tmin, tmax) {
+            let (first, last) = minuend?;
+            let end = first.next_up();
+            if end < tmax {
+                self.evaluate(ray, tmin, end, scratch);
+                let found = first_boundary(&scratch.spans, tmin, end);
+                // Nothing of the difference lies beyond its first child's last exit.
+                if found.is_some() || last < end {
+                    return found;
+                }
+            }
+        }
+        self.evaluate(ray, tmin, tmax, scratch);
+        first_boundary(&scratch.spans, tmin, tmax)
+    }
+
+    /// For a difference whose first child is a plain leaf: `Some(None)` when the ray is
+    /// outside that child all along `(tmin, tmax)`, else `Some(Some((first, last)))`, its
+    /// first crossing there and its last exit along the whole line; `None` for any other
+    /// tree, or when the window lies inside the child.
+    ///
+    /// A difference is inside its first child, so its boundaries lie between that child's
+    /// crossings: the first is no nearer than `first` when the ray starts outside the
+    /// child (its entry), often exactly there (a ray meeting the solid's outer face), and
+    /// none is beyond `last`. [`CsgTree::first_hit`] evaluates the window up to `first`;
+    /// only the rays that enter through a cut go on to the whole window.
+    fn minuend_crossings(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<Option<(f32, f32)>> {
+        let CsgNode::Op {
+            op: CsgOp::Difference,
+            first_child,
+            child_count,
+            ..
+        } = self.nodes.last()?
+        else {
+            return None;
+        };
+        if *child_count == 0 {
+            return None;
+        }
+        let CsgNode::Leaf { leaf, bound } = self
+            .nodes
+            .get(*self.children.get(*first_child as usize)? as usize)?
+        else {
+            return None;
+        };
+        let geometry = &self.leaves.get(*leaf as usize)?.geometry;
+        if matches!(geometry, Geometry::Mesh(_)) {
+            return None;
+        }
+        if !bound.admits(ray, inverse_direction(ray.direction), tmin, tmax) {
+            return Some(None);
+        }
+        let spans = geometry.spans(ray);
+        let mut proper = spans.as_slice().iter().filter(|raw| is_proper(raw));
+        let Some(span) = proper.clone().find(|raw| raw.t_out > tmin) else {
+            return Some(None);
+        };
+        let outside = span.t_in > tmin;
+        let first = if outside { span.t_in } else { span.t_out };
+        if first >= tmax {
+            // Outside the first child all along the window, the difference is too; inside
+            // it, the cuts may still cross the window.
+            return outside.then_some(None);
+        }
+        let last = proper.next_back().map_or(span.t_out, |raw| raw.t_out);
+        Some(Some((first, last)))
+    }
+
+    /// For a tree whose root is an accelerated union, what its nearest child crossing
+    /// tells about its first boundary inside `(tmin, tmax)`; `None` for any other tree.
+    ///
+    /// Why this is exact: every boundary of a union is a boundary of one of its children,
+    /// so with no child crossing there the union has none. A child whose box the segment
+    /// misses cannot contain the ray's start, and the walk's limit never falls below the
+    /// nearest crossing, so the walk sees every child that could be inside at `tmin`. If
+    /// none is, the ray starts outside the union and its first boundary is the nearest
+    /// child entry; at a tie, the child first in source order, as the sweep takes the
+    /// earlier list first at equal entries. Otherwise the nearest crossing is only a lower
+    /// bound, and [`CsgTree::first_hit`] evaluates the window up to it, with the children
+    /// the walk visited (spans are exact inside any window, see [`CsgTree::evaluate`]).
+    fn nearest_child_crossing(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut CsgScratch,
+    ) -> Option<Nearest> {
+        let CsgNode::Op {
+            op: CsgOp::Union,
+            first_child,
+            child_count,
+            bound,
+            accel,
+        } = self.nodes.last()?
+        else {
+            return None;
+        };
+        let accel = self.accels.get(*accel as usize)?;
+        let inv_direction = inverse_direction(ray.direction);
+        if *child_count == 0 || !bound.admits(ray, inv_direction, tmin, tmax) {
+            return Some(Nearest::Nothing);
+        }
+        let child_at = |position: u32| self.children.get((*first_child + position) as usize);
+        // The nearest crossing so far and the position of its child.
+        let mut nearest: Option<(Boundary, u32)> = None;
+        let mut started_inside = false;
+        // Every child the walk looks at: a superset of those whose boxes touch the window
+        // up to the nearest crossing.
+        let mut visited = std::mem::take(&mut scratch.preset);
+        visited.clear();
+        let mut consider = |position: u32, scratch: &mut CsgScratch| -> Option<f32> {
+            let &child = child_at(position)?;
+            visited.push(position);
+            // Up to and including the nearest so far, for ties.
+            let limit = nearest.map_or(tmax, |(b, _)| b.t.next_up().min(tmax));
+            let crossing = self.child_crossing(child, ray, inv_direction, tmin, limit, scratch);
+            started_inside |= crossing.inside;
+            let found = crossing.first?;
+            let nearer = match nearest {
+                None => true,
+                Some((best, best_position)) => {
+                    found.t < best.t || (found.t == best.t && position < best_position)
+                }
+            };
+            if nearer {
+                nearest = Some((found, position));
+            }
+            nearer.then_some(found.t)
+        };
+        let mut start_limit = tmax;
+        for &position in &accel.always {
+            if let Some(t) = consider(position, scratch) {
+                start_limit = t;
+            }
+        }
+        // The walk's own stack, apart from the one that evaluating a child may use.
+        let mut stack = std::mem::take(&mut scratch.nearest_stack);
+        accel
+            .bvh
+            .traverse(ray, tmin, start_limit, &mut stack, |id, _| {
+                match accel
+                    .positions
+                    .get(id as usize)
+                    .and_then(|&position| consider(position, scratch))
+                {
+                    Some(t) => Step::Shrink(t),
+                    None => Step::Continue,
+                }
+            });
+        scratch.nearest_stack = stack;
+        // Sorted into source order only if the window is evaluated (`AtLeast`).
+        scratch.preset = visited;
+        Some(match nearest {
+            None => Nearest::Nothing,
+            Some((boundary, _)) if !started_inside => Nearest::Exact(boundary),
+            Some((boundary, _)) => Nearest::AtLeast(boundary.t),
+        })
+    }
+
+    /// The first crossing of node `child` strictly inside `(tmin, limit)`, and whether the
+    /// ray is inside it just after `tmin`. A mesh reports where the ray enters its box (a
+    /// lower bound) and counts as inside (unknown), so that the window is evaluated.
+    fn child_crossing(
+        &self,
+        child: u32,
+        ray: &Ray,
+        inv_direction: Vec3A,
+        tmin: f32,
+        limit: f32,
+        scratch: &mut CsgScratch,
+    ) -> Crossing {
+        const NONE: Crossing = Crossing {
+            first: None,
+            inside: false,
+        };
+        match self.nodes.get(child as usize) {
+            Some(CsgNode::Leaf { leaf, bound }) => {
+                let Some(geometry) = self.leaves.get(*leaf as usize).map(|l| &l.geometry) else {
+                    return NONE;
+                };
+                if let Geometry::Mesh(_) = geometry {
+                    let first = bound
+                        .entry(ray, inv_direction, tmin, limit)
+                        .map(|t| Boundary {
+                            t,
+                            leaf: *leaf,
+                            part: 0,
+                            flip: false,
+                        });
+                    return Crossing {
+                        inside: first.is_some(),
+                        first,
+                    };
+                }
+                if !bound.admits(ray, inv_direction, tmin, limit) {
+                    return NONE;
+                }
+                // The first end of a span the evaluation keeps.
+                let spans = geometry.spans(ray);
+                let Some(span) = spans
+                    .as_slice()
+                    .iter()
+                    .find(|raw| is_proper(raw) && raw.t_out > tmin)
+                else {
+                    return NONE;
+                };
+                let inside = span.t_in <= tmin;
+                let (t, part) = if inside {
+                    (span.t_out, span.part_out)
+                } else {
+                    (span.t_in, span.part_in)
+                };
+                Crossing {
+                    first: (t < limit).then_some(Boundary {
+                        t,
+                        leaf: *leaf,
+                        part,
+                        flip: false,
+                    }),
+                    inside,
+                }
+            }
+            Some(CsgNode::Op { bound, .. }) => {
+                if !bound.admits(ray, inv_direction, tmin, limit) {
+                    return NONE;
+                }
+                self.evaluate_from(child, false, ray, tmin, limit, scratch);
+                Crossing {
+                    first: first_boundary(&scratch.spans, tmin, limit),
+                    inside: scratch
+                        .spans
+                        .iter()
+                        .any(|span| span.enter.t <= tmin && span.exit.t > tmin),
+                }
+            }
+            None => NONE,
+        }
+    }
+
     /// Leaves the solid's spans along the ray in `scratch.spans`. Spans are exact inside
     /// the window `(tmin, tmax)`; children whose bound the window misses are skipped, so
     /// outside the window the list may be incomplete (nothing looks there).
     fn evaluate(&self, ray: &Ray, tmin: f32, tmax: f32, scratch: &mut CsgScratch) {
+        self.evaluate_from(self.root(), false, ray, tmin, tmax, scratch);
+    }
+
+    /// [`CsgTree::evaluate`] for the subtree whose root is node `root`. With
+    /// `preset_root`, an accelerated root evaluates the child positions in
+    /// `scratch.preset` (ascending, and including every child whose box the window
+    /// touches) instead of walking its BVH for them.
+    fn evaluate_from(
+        &self,
+        root: u32,
+        preset_root: bool,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut CsgScratch,
+    ) {
         let inv_direction = inverse_direction(ray.direction);
         scratch.spans.clear();
         scratch.stack.clear();
@@ -207,7 +535,7 @@ impl CsgTree {
         if self.nodes.is_empty() {
             return;
         }
-        scratch.stack.push(Frame::new(self.root()));
+        scratch.stack.push(Frame::new(root));
         while let Some(&frame) = scratch.stack.last() {
             let top = scratch.stack.len() - 1;
             match &self.nodes[frame.node as usize] {
@@ -232,11 +560,17 @@ impl CsgTree {
                                 let CsgScratch {
                                     spans, mesh_hits, ..
                                 } = scratch;
-                                mesh.push_spans(ray, mesh_hits, |raw| spans.push(to_span(&raw)));
+                                mesh.push_spans(ray, mesh_hits, |raw| {
+                                    if is_proper(&raw) {
+                                        spans.push(to_span(&raw));
+                                    }
+                                });
                             }
                             geometry => {
                                 for raw in geometry.spans(ray).as_slice() {
-                                    scratch.spans.push(to_span(raw));
+                                    if is_proper(raw) {
+                                        scratch.spans.push(to_span(raw));
+                                    }
                                 }
                             }
                         }
@@ -260,13 +594,17 @@ impl CsgTree {
                         scratch.stack[top].start = len;
                         if let Some(accel) = accel {
                             let touched_start = scratch.touched.len();
-                            accel.touched(
-                                ray,
-                                tmin,
-                                tmax,
-                                &mut scratch.bvh_stack,
-                                &mut scratch.touched,
-                            );
+                            if preset_root && frame.node == root {
+                                scratch.touched.extend_from_slice(&scratch.preset);
+                            } else {
+                                accel.touched(
+                                    ray,
+                                    tmin,
+                                    tmax,
+                                    &mut scratch.bvh_stack,
+                                    &mut scratch.touched,
+                                );
+                            }
                             scratch.stack[top].touched_start = touched_start as u32;
                             scratch.stack[top].touched_len =
                                 (scratch.touched.len() - touched_start) as u32;
@@ -315,6 +653,16 @@ impl Frame {
             touched_len: 0,
         }
     }
+}
+
+/// Whether a leaf's span has length: a ray that only touches a solid (a tangent, an edge)
+/// is never inside it. Combining drops empty results anyway; dropping them at the leaves
+/// too means an empty span counts the same whether or not its node has other children
+/// with spans along the ray, so that skipping children (bounds, the BVH over them, the
+/// union's window) cannot change a result.
+#[inline]
+fn is_proper(raw: &RawSpan) -> bool {
+    raw.t_in < raw.t_out
 }
 
 /// Replaces `spans[start..]` (accumulator `[start, middle)` and child `[middle, ..)`) by

@@ -105,6 +105,13 @@ impl SceneBuilder {
         handle
     }
 
+    /// Puts an object (back) at the top level.
+    pub fn promote(&mut self, handle: Handle<Object>) {
+        if !self.scene.roots.contains(&handle) {
+            self.scene.roots.push(handle);
+        }
+    }
+
     /// Removes an object from the top level (it became a child).
     pub fn demote(&mut self, handle: Handle<Object>) {
         self.scene.roots.retain(|&root| root != handle);

@@ -53,6 +53,35 @@ const RENDERS: &[Case] = &[
     },
 ];
 
+/// CSG against the same shapes without it (issue 14): a union should cost about what a
+/// group of its children costs, and bounded CSG should cost nothing to rays that miss it.
+const CSG_RENDERS: &[Case] = &[
+    Case {
+        label: "union of 10,000 spheres",
+        scene: "scenes/bench/union10k.scene",
+        defines: &[],
+        pov: None,
+    },
+    Case {
+        label: "group of the same spheres",
+        scene: "scenes/bench/union10k.scene",
+        defines: &["UNION=0"],
+        pov: None,
+    },
+    Case {
+        label: "Menger sponge, level 3",
+        scene: "scenes/bench/menger.scene",
+        defines: &[],
+        pov: None,
+    },
+    Case {
+        label: "1,000 box-and-plane crystals",
+        scene: "scenes/bench/crystals.scene",
+        defines: &[],
+        pov: None,
+    },
+];
+
 const COMPILES: &[Case] = &[
     Case {
         label: "grid N=316 (99,856 spheres)",
@@ -78,7 +107,10 @@ struct Stats {
     compile_seconds: f64,
     build_seconds: f64,
     render_seconds: f64,
+    /// The render threads' own CPU time, summed (`CLOCK_THREAD_CPUTIME_ID`).
+    render_cpu_seconds: f64,
     total_rays: u64,
+    peak_memory_kib: Option<u64>,
 }
 
 pub fn run(args: &[String]) -> anyhow::Result<()> {
@@ -86,6 +118,7 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     let mut height = 480;
     let mut only_programs = false;
     let mut only_mesh = false;
+    let mut only_csg = false;
     let mut iter = args.iter();
     while let Some(arg) = iter.next() {
         match arg.as_str() {
@@ -99,8 +132,11 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
             }
             "--programs" => only_programs = true,
             "--mesh" => only_mesh = true,
+            "--csg" => only_csg = true,
             other => {
-                bail!("unknown bench option `{other}` (known: --size WxH, --programs, --mesh)")
+                bail!(
+                    "unknown bench option `{other}` (known: --size WxH, --programs, --mesh, --csg)"
+                )
             }
         }
     }
@@ -113,6 +149,9 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     if only_programs {
         return programs::run(&exe, &out_dir, RUNS);
     }
+    if only_csg {
+        return render_table(&exe, &out_dir, CSG_RENDERS, width, height, cores);
+    }
     let started = Instant::now();
     mesh::write(&out_dir)?;
     println!(
@@ -120,87 +159,12 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         out_dir.display(),
         started.elapsed().as_secs_f64()
     );
-
-    println!(
-        "\nrenders ({width}x{height}, max depth 5, 1 spp; release build; best of {RUNS} runs)"
-    );
-    println!(
-        "{:<26} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>10} {:>9}",
-        "scene", "threads", "objects", "compile", "bvh", "render", "wall", "rays", "Mrays/s/core"
-    );
-    let renders = RENDERS
+    let renders: Vec<&Case> = RENDERS
         .iter()
-        .filter(|case| !only_mesh || case.scene.ends_with("mesh1m.scene"));
-    for case in renders {
-        for threads in [1, cores] {
-            let output = out_dir.join(format!("{}.png", case.scene.replace(['/', '.'], "_")));
-            let mut command = Command::new(&exe);
-            command.arg("render").arg(root.join(case.scene));
-            for define in case.defines {
-                command.args(["-D", define]);
-            }
-            command
-                .args([
-                    "--width",
-                    &width.to_string(),
-                    "--height",
-                    &height.to_string(),
-                ])
-                .args([
-                    "--max-depth",
-                    "5",
-                    "--spp",
-                    "1",
-                    "--threads",
-                    &threads.to_string(),
-                ])
-                .args(["--stats=json", "--quiet", "-o"])
-                .arg(&output);
-            // Best of RUNS: single-shot timings on a shared machine are noisy, and the
-            // fastest run is the one least disturbed by other work.
-            let mut best: Option<(Stats, f64)> = None;
-            for _ in 0..RUNS {
-                let started = Instant::now();
-                let result = command
-                    .output()
-                    .with_context(|| format!("cannot run {}", exe.display()))?;
-                let wall = started.elapsed().as_secs_f64();
-                if !result.status.success() {
-                    bail!(
-                        "{} failed:\n{}",
-                        case.scene,
-                        String::from_utf8_lossy(&result.stderr)
-                    );
-                }
-                let stats: Stats = serde_json::from_slice(&result.stdout)
-                    .with_context(|| format!("cannot read the stats of {}", case.scene))?;
-                if best
-                    .as_ref()
-                    .is_none_or(|(b, _)| stats.render_seconds < b.render_seconds)
-                {
-                    best = Some((stats, wall));
-                }
-            }
-            let Some((stats, wall)) = best else {
-                bail!("no run of {}", case.scene);
-            };
-            let per_core =
-                stats.total_rays as f64 / stats.render_seconds.max(1e-9) / threads as f64 / 1e6;
-            println!(
-                "{:<26} {:>7} {:>9} {:>7.3}s {:>7.3}s {:>7.3}s {:>7.3}s {:>10} {:>9.2}",
-                case.label,
-                threads,
-                stats.objects,
-                stats.compile_seconds,
-                stats.build_seconds,
-                stats.render_seconds,
-                wall,
-                stats.total_rays,
-                per_core
-            );
-            debug_assert!(stats.width == width && stats.height == height && stats.max_depth == 5);
-        }
-    }
+        .chain(CSG_RENDERS)
+        .filter(|case| !only_mesh || case.scene.ends_with("mesh1m.scene"))
+        .collect();
+    render_table(&exe, &out_dir, renders, width, height, cores)?;
     if only_mesh {
         return Ok(());
     }
@@ -285,6 +249,148 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         println!("{:<34} {:>7.3}s {:>12}", case.label, wall, memory);
     }
     programs::run(&exe, &out_dir, RUNS)
+}
+
+/// Renders each case RUNS times on one thread and on every core (at least two) and prints
+/// the best runs with the spread of the CPU times.
+///
+/// The honest per-core figure is rays per CPU-second of the render threads on one thread:
+/// a thread's own CPU clock does not count the time other programs take on a shared
+/// machine, where wall time does. Scaling is the best one-thread render time over the best
+/// many-thread one (by the clock, since that is what more threads buy, so it means
+/// something only on an otherwise idle machine). Peak memory is the process's, scene and
+/// image included.
+fn render_table<'c>(
+    exe: &Path,
+    out_dir: &Path,
+    cases: impl IntoIterator<Item = &'c Case>,
+    width: u32,
+    height: u32,
+    cores: usize,
+) -> anyhow::Result<()> {
+    let root = workspace_root();
+    println!(
+        "\nrenders ({width}x{height}, max depth 5, 1 spp; release build; best of {RUNS} runs: \
+         render and wall by the clock, cpu = the render threads' CPU time with its spread \
+         (most - least) / least, Mray/cpu = rays per CPU-second, scaling = best 1-thread \
+         render / best many-thread render)"
+    );
+    println!(
+        "{:<30} {:>3} {:>7} {:>7} {:>7} {:>7} {:>7} {:>6} {:>8} {:>10} {:>8} {:>7} {:>8}",
+        "scene",
+        "thr",
+        "objects",
+        "compile",
+        "bvh",
+        "render",
+        "cpu",
+        "spread",
+        "wall",
+        "rays",
+        "Mray/cpu",
+        "scaling",
+        "peak MiB"
+    );
+    for case in cases {
+        let mut one_thread_render = None;
+        for threads in [1, cores.max(2)] {
+            let output = out_dir.join(format!("{}.png", case.scene.replace(['/', '.'], "_")));
+            let mut command = Command::new(exe);
+            command.arg("render").arg(root.join(case.scene));
+            for define in case.defines {
+                command.args(["-D", define]);
+            }
+            command
+                .args([
+                    "--width",
+                    &width.to_string(),
+                    "--height",
+                    &height.to_string(),
+                ])
+                .args([
+                    "--max-depth",
+                    "5",
+                    "--spp",
+                    "1",
+                    "--threads",
+                    &threads.to_string(),
+                ])
+                .args(["--stats=json", "--quiet", "-o"])
+                .arg(&output);
+            // Best of RUNS: single-shot timings on a shared machine are noisy, and the
+            // fastest run is the one least disturbed by other work; the spread says how
+            // noisy they were.
+            let mut runs: Vec<(Stats, f64)> = Vec::with_capacity(RUNS);
+            for _ in 0..RUNS {
+                let started = Instant::now();
+                let result = command
+                    .output()
+                    .with_context(|| format!("cannot run {}", exe.display()))?;
+                let wall = started.elapsed().as_secs_f64();
+                if !result.status.success() {
+                    bail!(
+                        "{} failed:\n{}",
+                        case.scene,
+                        String::from_utf8_lossy(&result.stderr)
+                    );
+                }
+                let stats: Stats = serde_json::from_slice(&result.stdout)
+                    .with_context(|| format!("cannot read the stats of {}", case.scene))?;
+                debug_assert!(
+                    stats.width == width && stats.height == height && stats.max_depth == 5
+                );
+                runs.push((stats, wall));
+            }
+            // The CPU figures come from the run that used the least CPU time, the wall
+            // figures (what more threads buy) from the fastest run by the clock.
+            let cpu: Vec<f64> = runs.iter().map(|(s, _)| s.render_cpu_seconds).collect();
+            let least_cpu = cpu.iter().copied().fold(f64::INFINITY, f64::min);
+            let most_cpu = cpu.iter().copied().fold(0.0, f64::max);
+            let spread = (most_cpu - least_cpu) / least_cpu.max(1e-9);
+            let best_render = runs
+                .iter()
+                .map(|(s, _)| s.render_seconds)
+                .fold(f64::INFINITY, f64::min);
+            let best_wall = runs
+                .iter()
+                .map(|&(_, wall)| wall)
+                .fold(f64::INFINITY, f64::min);
+            let Some((stats, _)) = runs
+                .into_iter()
+                .min_by(|a, b| a.0.render_cpu_seconds.total_cmp(&b.0.render_cpu_seconds))
+            else {
+                bail!("no run of {}", case.scene);
+            };
+            let per_cpu = stats.total_rays as f64 / least_cpu.max(1e-9) / 1e6;
+            let scaling = match one_thread_render {
+                None => {
+                    one_thread_render = Some(best_render);
+                    String::new()
+                }
+                Some(one) => format!("{:.2}x", one / best_render.max(1e-9)),
+            };
+            let peak = stats
+                .peak_memory_kib
+                .map_or("n/a".to_string(), |k| format!("{:.0}", k as f64 / 1024.0));
+            println!(
+                "{:<30} {:>3} {:>7} {:>6.3}s {:>6.3}s {:>6.3}s {:>6.3}s {:>5.0}% {:>7.3}s {:>10} {:>8.2} {:>7} {:>8}",
+                case.label,
+                threads,
+                stats.objects,
+                stats.compile_seconds,
+                stats.build_seconds,
+                best_render,
+                least_cpu,
+                spread * 100.0,
+                best_wall,
+                stats.total_rays,
+                per_cpu,
+                scaling,
+                peak
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Wall seconds and, where /usr/bin/time exists, peak resident KiB of one `whitted ARGS SCENE`

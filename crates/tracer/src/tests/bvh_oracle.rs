@@ -18,14 +18,14 @@ use crate::shapes::Geometry;
 use crate::testing::{matte, plane_y, sphere, SceneBuilder};
 
 /// A small deterministic generator (xorshift64*), so that every case can be replayed.
-struct Rng(u64);
+pub(super) struct Rng(u64);
 
 impl Rng {
-    fn new(seed: u64) -> Rng {
+    pub(super) fn new(seed: u64) -> Rng {
         Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
     }
 
-    fn next(&mut self) -> u64 {
+    pub(super) fn next(&mut self) -> u64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
         self.0 ^= self.0 >> 27;
@@ -33,19 +33,19 @@ impl Rng {
     }
 
     /// Uniform in `[0, 1)`.
-    fn unit(&mut self) -> f64 {
+    pub(super) fn unit(&mut self) -> f64 {
         (self.next() >> 11) as f64 / (1u64 << 53) as f64
     }
 
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+    pub(super) fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.unit()
     }
 
-    fn below(&mut self, n: u64) -> u64 {
+    pub(super) fn below(&mut self, n: u64) -> u64 {
         self.next() % n
     }
 
-    fn point(&mut self, extent: f64) -> DVec3 {
+    pub(super) fn point(&mut self, extent: f64) -> DVec3 {
         DVec3::new(
             self.range(-extent, extent),
             self.range(-extent, extent),
@@ -53,7 +53,7 @@ impl Rng {
         )
     }
 
-    fn direction(&mut self) -> DVec3 {
+    pub(super) fn direction(&mut self) -> DVec3 {
         loop {
             let d = self.point(1.0);
             if d.length_squared() > 1e-6 && d.length_squared() <= 1.0 {

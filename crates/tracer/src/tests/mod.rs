@@ -3,6 +3,7 @@
 
 mod acne;
 mod bvh_oracle;
+mod csg_oracle;
 mod csg_scenes;
 mod emission;
 mod energy;
