@@ -141,5 +141,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         count = u64::from(grid_n) * u64::from(grid_n),
         nodes = grid.bvh_node_count(),
     );
+    // The steady-state figures too, as for the other scenes.
+    report(&format!("grid N={grid_n}"), &grid)?;
     Ok(())
 }
