@@ -157,7 +157,7 @@ pub enum Step {
 /// Our binary BVH (see `bvh_build`) converted by obvhs, with leaves of up to three
 /// primitives as `BvhBuildParams::medium_build()` would make them; the boxes it holds are
 /// in build space, `scale` times the world.
-fn build_cwbvh(aabbs: &[Aabb]) -> (CwBvh, BuildScale) {
+fn build_cwbvh(aabbs: impl Into<Vec<Aabb>>) -> (CwBvh, BuildScale) {
     let built = build_bvh2(aabbs);
     let cwbvh = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&built.bvh2, 3, true, false);
     (cwbvh, built.scale)
@@ -171,6 +171,12 @@ impl Bvh {
     /// obvhs convert it. Returns the BVH and `primitive_indices`: the input index of each
     /// BVH primitive id.
     pub fn build(aabbs: &[Aabb]) -> (Bvh, Vec<u32>) {
+        Self::build_from_vec(aabbs.to_vec())
+    }
+
+    /// [`Bvh::build`] that consumes the boxes: the build scales them in place and frees
+    /// them before obvhs's conversion, the peak of memory for a million objects.
+    pub fn build_from_vec(aabbs: Vec<Aabb>) -> (Bvh, Vec<u32>) {
         let (cwbvh, scale) = build_cwbvh(aabbs);
         Self::from_cwbvh(cwbvh, scale)
     }

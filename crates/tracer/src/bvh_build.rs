@@ -100,12 +100,16 @@ pub struct Built {
 }
 
 /// Builds the binary BVH over `aabbs` (one primitive per leaf, as obvhs's converter wants).
-pub fn build_bvh2(aabbs: &[Aabb]) -> Built {
-    let scale = BuildScale::for_boxes(aabbs);
-    let boxes: Vec<Aabb> = aabbs.iter().map(|b| scale.scale_box(b)).collect();
+/// The boxes are scaled in place, so that handing over a `Vec` costs no second copy.
+pub fn build_bvh2(aabbs: impl Into<Vec<Aabb>>) -> Built {
+    let mut boxes: Vec<Aabb> = aabbs.into();
+    let scale = BuildScale::for_boxes(&boxes);
+    for b in &mut boxes {
+        *b = scale.scale_box(b);
+    }
     let centroids: Vec<Vec3A> = boxes.iter().map(|b| (b.min + b.max) * 0.5).collect();
-    let mut prims: Vec<u32> = (0..aabbs.len() as u32).collect();
-    let mut nodes = vec![Bvh2Node::default(); (2 * aabbs.len()).saturating_sub(1)];
+    let mut prims: Vec<u32> = (0..boxes.len() as u32).collect();
+    let mut nodes = vec![Bvh2Node::default(); (2 * boxes.len()).saturating_sub(1)];
     let mut steps = 0;
     let mut depth = 0;
     if let Some((root, region)) = nodes.split_first_mut() {
