@@ -324,17 +324,17 @@ mod tests {
     fn coincident_and_regular_inputs_build_in_n_log_n() {
         let n = 40_000;
         let coincident = unit_boxes_at((0..n).map(|_| Vec3A::ZERO));
-        let built = build_bvh2(&coincident);
+        let built = build_bvh2(&coincident[..]);
         assert_n_log_n(&built, n);
         // The median split keeps coincident objects balanced: depth log2(n) exactly.
         assert!(built.depth <= 17, "{}", built.depth);
         let row = unit_boxes_at((0..n).map(|i| Vec3A::new(i as f32 * 3.0, 0.0, 0.0)));
-        assert_n_log_n(&build_bvh2(&row), n);
+        assert_n_log_n(&build_bvh2(&row[..]), n);
         let near = unit_boxes_at((0..n).map(|i| Vec3A::new(i as f32 * 1e-6, 0.0, 0.0)));
-        assert_n_log_n(&build_bvh2(&near), n);
+        assert_n_log_n(&build_bvh2(&near[..]), n);
         // Exponentially spaced objects, which make every SAH split peel off a few.
         let spread = unit_boxes_at((0..n).map(|i| Vec3A::splat(1.0005f32.powi(i as i32))));
-        assert_n_log_n(&build_bvh2(&spread), n);
+        assert_n_log_n(&build_bvh2(&spread[..]), n);
     }
 
     #[test]

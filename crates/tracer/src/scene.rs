@@ -325,7 +325,7 @@ fn prepare_leaf(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (
     let materials = shared.materials;
     let object = &scene.objects[handle];
     // Projective rows are ignored: the language only makes affine transforms.
-    let world_from_object = DAffine3::from_mat4(object.world_from_object);
+    let world_from_object = DAffine3::from_mat4(object.world_from_object.matrix());
     let (geometry, bound, snap) = match &object.kind {
         ObjectKind::Shape {
             shape: Shape::Mesh { mesh, smooth },
