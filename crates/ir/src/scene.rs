@@ -634,3 +634,48 @@ impl Scene {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A million objects placed by their own parameters carry no matrix at all.
+    #[test]
+    fn objects_without_a_transform_stay_small() {
+        assert_eq!(std::mem::size_of::<WorldFromObject>(), 8);
+        assert!(
+            std::mem::size_of::<Object>() <= 136,
+            "{}",
+            std::mem::size_of::<Object>()
+        );
+        assert!(WorldFromObject::new(DMat4::IDENTITY).0.is_none());
+    }
+
+    /// It reads, compares and serializes exactly as the matrix it stands for.
+    #[test]
+    fn it_stands_for_its_matrix() {
+        let matrices = [
+            DMat4::IDENTITY,
+            DMat4::from_translation(DVec3::new(1.0, -2.0, 0.5)),
+            DMat4::from_scale(DVec3::new(2.0, 3.0, 0.25))
+                * DMat4::from_rotation_y(0.3)
+                * DMat4::from_translation(DVec3::Z),
+        ];
+        for m in matrices {
+            let w = WorldFromObject::from(m);
+            assert_eq!(*w, m);
+            assert_eq!(w.matrix(), m);
+            assert_eq!(w, WorldFromObject::new(m));
+            assert_eq!(
+                serde_json::to_string(&w).ok(),
+                serde_json::to_string(&m).ok()
+            );
+        }
+        // Writing through the identity boxes it, and it still equals the identity.
+        let mut w = WorldFromObject::IDENTITY;
+        w.w_axis.x = 0.0;
+        assert_eq!(w, WorldFromObject::IDENTITY);
+        w.w_axis.x = 4.0;
+        assert_eq!(*w, DMat4::from_translation(DVec3::X * 4.0));
+    }
+}

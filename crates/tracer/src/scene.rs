@@ -492,6 +492,56 @@ fn permute(items: Vec<Item>, order: &[u32]) -> Result<Vec<Item>, Vec<Item>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::{render, NoObserver, RenderOptions};
+    use crate::testing::{sphere_grid, whitted_classic};
+
+    /// Dropping the IR before the BVH build changes nothing a render sees.
+    #[test]
+    fn releasing_the_ir_prepares_the_same_scene() {
+        for builder in [whitted_classic(), sphere_grid(12)] {
+            let valid = builder.build().expect("valid");
+            let kept = PreparedScene::new(&valid);
+            let mut options = RenderOptions::from_settings(&valid.scene().settings);
+            options.width = 48;
+            options.height = 36;
+            let released = PreparedScene::new_releasing_ir(valid);
+            assert_eq!(kept.object_count(), released.object_count());
+            assert_eq!(kept.bvh_node_count(), released.bvh_node_count());
+            let image =
+                |scene: &PreparedScene| render(scene, &options, &NoObserver).expect("done").0;
+            assert_eq!(image(&kept).pixels, image(&released).pixels);
+        }
+    }
+
+    fn numbered(n: u32) -> Vec<Item> {
+        let builder = sphere_grid(n);
+        let valid = builder.build().expect("valid");
+        let shapes = Shapes::new(valid.scene());
+        shapes.bounded
+    }
+
+    #[test]
+    fn permute_moves_items_into_the_given_order() {
+        let items = numbered(4);
+        let objects: Vec<_> = items.iter().map(Item::object).collect();
+        let order: Vec<u32> = (0..items.len() as u32).rev().collect();
+        let ordered = permute(items, &order).unwrap_or_else(|_| panic!("a permutation"));
+        let reordered: Vec<_> = ordered.iter().map(Item::object).collect();
+        let expected: Vec<_> = order.iter().map(|&i| objects[i as usize]).collect();
+        assert_eq!(reordered, expected);
+    }
+
+    #[test]
+    fn permute_refuses_what_is_not_a_permutation() {
+        let items = numbered(2);
+        let n = items.len() as u32;
+        // A repeated index, an index out of range, a short order: each returns the items
+        // untouched.
+        for order in [vec![0, 0, 1, 2], vec![0, 1, 2, n], vec![0, 1]] {
+            let back = permute(numbered(2), &order).err().expect("refused");
+            assert_eq!(back.len(), items.len());
+        }
+    }
 
     /// A million of these must stay cheap to build and to walk.
     #[test]
