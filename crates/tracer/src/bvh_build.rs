@@ -14,7 +14,7 @@
 //! 2^32 (rounded outwards, so every scaled box still contains its object's scaled box; the
 //! walk scales the planes back, see [`BuildScale`]): areas cannot overflow and tiny scenes
 //! keep their precision. The split of a range is the best of 16 bins per axis by the
-//! surface area heuristic (only the widest axis for ranges of [`ONE_AXIS_RANGE`] or more); when the centroids coincide, or no bin split separates them, or
+//! surface area heuristic; when the centroids coincide, or no bin split separates them, or
 //! the depth passes [`SAH_DEPTH_LIMIT`], the range is split at its median instead, so the
 //! depth stays below `SAH_DEPTH_LIMIT + log2(n) + 1` and every level costs O(n).
 
@@ -31,10 +31,6 @@ pub const SAH_DEPTH_LIMIT: u32 = 40;
 
 /// Ranges at least this large are split on two threads.
 const PARALLEL_RANGE: usize = 4096;
-
-/// Ranges at least this large are binned along their widest axis only. Scenes below it
-/// (every golden scene) get the same tree as a full three-axis build.
-pub const ONE_AXIS_RANGE: usize = 1 << 15;
 
 /// The power of two that boxes were multiplied by before the build: `2^exponent`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -223,8 +219,7 @@ impl Input<'_> {
         self.median_split(prims, axis)
     }
 
-    /// The cheapest bin boundary (over the three axes, or the widest for a large range),
-    /// applied; `None` when no boundary
+    /// The cheapest bin boundary over the three axes, applied; `None` when no boundary
     /// leaves both sides non-empty.
     fn sah_split(&self, prims: &mut [u32], lo: Vec3A, extent: Vec3A) -> Option<usize> {
         let bin_of = |c: Vec3A, axis: usize| -> usize {
@@ -232,32 +227,20 @@ impl Input<'_> {
             // `as` saturates, and NaN becomes 0.
             (x as usize).min(BINS - 1)
         };
+        // One pass bins every primitive on all three axes.
         let mut counts = [[0u32; BINS]; 3];
         let mut bin_boxes = [[Aabb::empty(); BINS]; 3];
-        // A large range is binned along its widest axis only (a third of the work; the
-        // other axes rarely win where the range is wide); a smaller one on all three.
-        let widest = extent.max_position();
-        let one_axis = prims.len() >= ONE_AXIS_RANGE;
-        if one_axis {
-            for &p in prims.iter() {
-                let (c, aabb) = (self.centroids[p as usize], &self.boxes[p as usize]);
-                let b = bin_of(c, widest);
-                counts[widest][b] += 1;
-                bin_boxes[widest][b] = bin_boxes[widest][b].union(aabb);
-            }
-        } else {
-            for &p in prims.iter() {
-                let (c, aabb) = (self.centroids[p as usize], &self.boxes[p as usize]);
-                for axis in 0..3 {
-                    let b = bin_of(c, axis);
-                    counts[axis][b] += 1;
-                    bin_boxes[axis][b] = bin_boxes[axis][b].union(aabb);
-                }
+        for &p in prims.iter() {
+            let (c, aabb) = (self.centroids[p as usize], &self.boxes[p as usize]);
+            for axis in 0..3 {
+                let b = bin_of(c, axis);
+                counts[axis][b] += 1;
+                bin_boxes[axis][b] = bin_boxes[axis][b].union(aabb);
             }
         }
         let mut best: Option<(f32, usize, usize)> = None;
         for axis in 0..3 {
-            if extent[axis] <= 0.0 || (one_axis && axis != widest) {
+            if extent[axis] <= 0.0 {
                 continue;
             }
             let (counts, boxes) = (&counts[axis], &bin_boxes[axis]);
@@ -354,8 +337,7 @@ mod tests {
         assert_n_log_n(&build_bvh2(&spread[..]), n);
     }
 
-    /// Boxes of a large, irregular scene: every range above [`ONE_AXIS_RANGE`] is binned on
-    /// one axis.
+    /// Boxes of a large, irregular scene (large enough for many levels of parallel splits).
     fn scattered(n: usize) -> Vec<Aabb> {
         (0..n as u32)
             .map(|i| {
@@ -371,7 +353,7 @@ mod tests {
     /// primitive's scaled box), and every primitive is in exactly one leaf.
     #[test]
     fn large_builds_are_valid_trees() {
-        let n = 3 * ONE_AXIS_RANGE / 2;
+        let n = 50_000;
         let aabbs = scattered(n);
         let built = build_bvh2(&aabbs[..]);
         assert_n_log_n(&built, n);
@@ -395,11 +377,11 @@ mod tests {
         assert!(seen.iter().all(|&s| s));
     }
 
-    /// The one-axis path must not depend on the thread count either (the image depends on
-    /// the tree through ties).
+    /// A large build must not depend on the thread count either (the image depends on the
+    /// tree through ties).
     #[test]
     fn large_builds_are_the_same_on_any_thread_count() {
-        let aabbs = scattered(3 * ONE_AXIS_RANGE / 2);
+        let aabbs = scattered(50_000);
         let build_on = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)

@@ -469,24 +469,35 @@ fn build_bvh(items: Vec<Item>, aabbs: Vec<Aabb>) -> (Vec<Item>, Option<Bvh>) {
     }
 }
 
-/// `items` reordered so that entry `i` is `items[order[i]]`, by moves; `Err(items)` (in the
+/// `items` reordered so that entry `i` is `items[order[i]]`, in place (by following the
+/// permutation's cycles with swaps: no second array of items); `Err(items)` (in the
 /// original order) when `order` is not a permutation of the indices.
-fn permute(items: Vec<Item>, order: &[u32]) -> Result<Vec<Item>, Vec<Item>> {
-    let mut seen = vec![false; items.len()];
+fn permute(mut items: Vec<Item>, order: &[u32]) -> Result<Vec<Item>, Vec<Item>> {
+    let mut done = vec![false; items.len()];
     let is_permutation = order.len() == items.len()
         && order.iter().all(|&i| {
-            seen.get_mut(i as usize)
-                .is_some_and(|s| !std::mem::replace(s, true))
+            done.get_mut(i as usize)
+                .is_some_and(|d| !std::mem::replace(d, true))
         });
-    drop(seen);
     if !is_permutation {
         return Err(items);
     }
-    let mut slots: Vec<Option<Item>> = items.into_iter().map(Some).collect();
-    Ok(order
-        .iter()
-        .filter_map(|&i| slots[i as usize].take())
-        .collect())
+    done.fill(false);
+    for start in 0..items.len() {
+        // Each cycle start -> order[start] -> ... -> start: position `i` takes the item
+        // at `order[i]`, which the swap brings from further along the same cycle.
+        let mut i = start;
+        while !done[i] {
+            done[i] = true;
+            let next = order[i] as usize;
+            if next == start {
+                break;
+            }
+            items.swap(i, next);
+            i = next;
+        }
+    }
+    Ok(items)
 }
 
 #[cfg(test)]
