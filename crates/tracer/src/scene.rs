@@ -533,13 +533,21 @@ mod tests {
 
     #[test]
     fn permute_moves_items_into_the_given_order() {
-        let items = numbered(4);
-        let objects: Vec<_> = items.iter().map(Item::object).collect();
-        let order: Vec<u32> = (0..items.len() as u32).rev().collect();
-        let ordered = permute(items, &order).unwrap_or_else(|_| panic!("a permutation"));
-        let reordered: Vec<_> = ordered.iter().map(Item::object).collect();
-        let expected: Vec<_> = order.iter().map(|&i| objects[i as usize]).collect();
-        assert_eq!(reordered, expected);
+        let objects: Vec<_> = numbered(4).iter().map(Item::object).collect();
+        let n = objects.len() as u32;
+        // Reversal (cycles of two), a rotation (one long cycle), and a mix of fixed points
+        // and cycles of several lengths.
+        let orders: [Vec<u32>; 3] = [
+            (0..n).rev().collect(),
+            (0..n).map(|i| (i + 3) % n).collect(),
+            (0..n).map(|i| (i * 5) % n).collect(),
+        ];
+        for order in orders {
+            let ordered = permute(numbered(4), &order).unwrap_or_else(|_| panic!("a permutation"));
+            let reordered: Vec<_> = ordered.iter().map(Item::object).collect();
+            let expected: Vec<_> = order.iter().map(|&i| objects[i as usize]).collect();
+            assert_eq!(reordered, expected, "{order:?}");
+        }
     }
 
     #[test]
