@@ -557,7 +557,7 @@ mod tests {
         // A repeated index, an index out of range, a short order: each returns the items
         // untouched.
         for order in [vec![0, 0, 1, 2], vec![0, 1, 2, n], vec![0, 1]] {
-            let back = permute(numbered(2), &order).err().expect("refused");
+            let back = permute(numbered(2), &order).expect_err("refused");
             assert_eq!(back.len(), items.len());
         }
     }
