@@ -233,12 +233,20 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         objects: loaded.scene.objects.len() as u64,
     };
     estimate.check()?;
-    let prepared = PreparedScene::new(&loaded.scene);
+    let objects = loaded.scene.objects.len();
     // A scene too big to lint by default is rendered without its lints (`check --lint`
     // has them): they would add about a second per million objects to the render.
-    if !args.quiet && !args.no_lint && whitted_explain::lint::lints_by_default(&loaded.scene) {
+    let lint =
+        !args.quiet && !args.no_lint && whitted_explain::lint::lints_by_default(&loaded.scene);
+    let prepared = if lint {
+        let prepared = PreparedScene::new(&loaded.scene);
         crate::scene_input::print_lints(&loaded, &prepared);
-    }
+        prepared
+    } else {
+        // Nothing below needs the IR (names, spans, provenance): it goes before the BVH
+        // build, the peak of memory for a large scene.
+        PreparedScene::new_releasing_ir(loaded.scene)
+    };
 
     let pool = thread_pool(args.threads)?;
 
@@ -303,7 +311,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         output: &output,
         options: &options,
         threads: pool.current_num_threads(),
-        objects: loaded.scene.objects.len(),
+        objects,
         compile_seconds,
         build_seconds: prepared.build_seconds(),
         stats: &stats,

@@ -225,7 +225,7 @@ mod tests {
                                 radius: 1e19,
                             },
                         },
-                        world_from_object: whitted_ir::DMat4::IDENTITY,
+                        world_from_object: whitted_ir::WorldFromObject::IDENTITY,
                         material,
                     },
                     span,

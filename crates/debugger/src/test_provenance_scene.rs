@@ -132,7 +132,7 @@ pub fn provenance_scene() -> ValidScene {
                             radius: 0.35,
                         },
                     },
-                    world_from_object,
+                    world_from_object: world_from_object.into(),
                     material: red,
                 },
                 bead_span,

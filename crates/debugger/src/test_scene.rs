@@ -146,7 +146,7 @@ pub fn whitted_scene() -> ValidScene {
             Object {
                 name: Some(name.into()),
                 kind: ObjectKind::Shape { shape },
-                world_from_object: DMat4::IDENTITY,
+                world_from_object: DMat4::IDENTITY.into(),
                 material,
             },
             item_span(file, start),
@@ -262,7 +262,7 @@ pub fn hall_of_mirrors() -> ValidScene {
                 kind: ObjectKind::Shape {
                     shape: Shape::Plane { normal, offset },
                 },
-                world_from_object: DMat4::IDENTITY,
+                world_from_object: DMat4::IDENTITY.into(),
                 material: mirror,
             },
             span,

@@ -25,7 +25,7 @@ pub use provenance::{ArgValue, FrameId, Provenance, Site, SiteId, SiteKind, Step
 pub use scene::{
     Attenuation, Camera, Color, CsgOp, Fresnel, Highlight, Light, LightKind, Material, Object,
     ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, Scene, Settings,
-    ShadowMode, Shape,
+    ShadowMode, Shape, WorldFromObject,
 };
 pub use source::{FileId, LineCol, SourceFile, SourceMap, Span};
 pub use validate::{validate, InvalidScene, ValidScene};

@@ -415,7 +415,7 @@ mod tests {
                         radius: 1.0,
                     },
                 },
-                world_from_object: DMat4::IDENTITY,
+                world_from_object: WorldFromObject::IDENTITY,
                 material,
             },
             span(1),
@@ -588,7 +588,7 @@ mod tests {
         // the ray's coordinates in the sphere's own space would square to infinity in f32.
         let mut scene = base();
         scene.objects[Handle::from_index(0)].world_from_object =
-            DMat4::from_scale(glam::DVec3::new(1e-4, 1e2, 1e2));
+            DMat4::from_scale(glam::DVec3::new(1e-4, 1e2, 1e2)).into();
         if let ObjectKind::Shape {
             shape: Shape::Sphere { radius, .. },
         } = &mut scene.objects[Handle::from_index(0)].kind
@@ -608,7 +608,7 @@ mod tests {
     fn world_space_extent_counts_after_the_transform() {
         let mut scene = base();
         scene.objects[Handle::from_index(0)].world_from_object =
-            DMat4::from_scale(glam::DVec3::splat(1e6));
+            DMat4::from_scale(glam::DVec3::splat(1e6)).into();
         if let ObjectKind::Shape {
             shape: Shape::Sphere { radius, .. },
         } = &mut scene.objects[Handle::from_index(0)].kind

@@ -503,9 +503,76 @@ pub struct Object {
     pub name: Option<String>,
     pub kind: ObjectKind,
     /// The full transform from this node's space to world space (parents already applied).
-    pub world_from_object: DMat4,
+    pub world_from_object: WorldFromObject,
     /// The material of this node's surfaces (a CSG hit uses the leaf's material).
     pub material: Handle<Material>,
+}
+
+/// An object's full transform to world space, stored compactly: most objects of a large
+/// scene (a sphere placed by its centre) have none, and a matrix inline would be 128 of an
+/// object's bytes. The identity takes no heap; any other matrix is boxed. It reads as a
+/// [`DMat4`] (`Deref`), and compares and serializes as one.
+#[derive(Clone, Default)]
+pub struct WorldFromObject(Option<Box<DMat4>>);
+
+/// What the identity derefs to.
+static IDENTITY: DMat4 = DMat4::IDENTITY;
+
+impl WorldFromObject {
+    pub const IDENTITY: WorldFromObject = WorldFromObject(None);
+
+    pub fn new(matrix: DMat4) -> WorldFromObject {
+        if matrix == DMat4::IDENTITY {
+            WorldFromObject(None)
+        } else {
+            WorldFromObject(Some(Box::new(matrix)))
+        }
+    }
+
+    /// The matrix, by value.
+    pub fn matrix(&self) -> DMat4 {
+        **self
+    }
+}
+
+impl From<DMat4> for WorldFromObject {
+    fn from(matrix: DMat4) -> WorldFromObject {
+        WorldFromObject::new(matrix)
+    }
+}
+
+impl std::ops::Deref for WorldFromObject {
+    type Target = DMat4;
+
+    fn deref(&self) -> &DMat4 {
+        self.0.as_deref().unwrap_or(&IDENTITY)
+    }
+}
+
+/// Writing through it boxes the identity first (only tests and transforms of whole
+/// subtrees write).
+impl std::ops::DerefMut for WorldFromObject {
+    fn deref_mut(&mut self) -> &mut DMat4 {
+        self.0.get_or_insert_with(|| Box::new(DMat4::IDENTITY))
+    }
+}
+
+impl PartialEq for WorldFromObject {
+    fn eq(&self, other: &WorldFromObject) -> bool {
+        **self == **other
+    }
+}
+
+impl std::fmt::Debug for WorldFromObject {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        (**self).fmt(f)
+    }
+}
+
+impl Serialize for WorldFromObject {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        (**self).serialize(serializer)
+    }
 }
 
 /// A whole scene: what one `.scene` file (with its imports) describes.
@@ -565,5 +632,50 @@ impl Scene {
             Some(name) => name.clone(),
             None => format!("material {handle}"),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A million objects placed by their own parameters carry no matrix at all.
+    #[test]
+    fn objects_without_a_transform_stay_small() {
+        assert_eq!(std::mem::size_of::<WorldFromObject>(), 8);
+        assert!(
+            std::mem::size_of::<Object>() <= 136,
+            "{}",
+            std::mem::size_of::<Object>()
+        );
+        assert!(WorldFromObject::new(DMat4::IDENTITY).0.is_none());
+    }
+
+    /// It reads, compares and serializes exactly as the matrix it stands for.
+    #[test]
+    fn it_stands_for_its_matrix() {
+        let matrices = [
+            DMat4::IDENTITY,
+            DMat4::from_translation(DVec3::new(1.0, -2.0, 0.5)),
+            DMat4::from_scale(DVec3::new(2.0, 3.0, 0.25))
+                * DMat4::from_rotation_y(0.3)
+                * DMat4::from_translation(DVec3::Z),
+        ];
+        for m in matrices {
+            let w = WorldFromObject::from(m);
+            assert_eq!(*w, m);
+            assert_eq!(w.matrix(), m);
+            assert_eq!(w, WorldFromObject::new(m));
+            assert_eq!(
+                serde_json::to_string(&w).ok(),
+                serde_json::to_string(&m).ok()
+            );
+        }
+        // Writing through the identity boxes it, and it still equals the identity.
+        let mut w = WorldFromObject::IDENTITY;
+        w.w_axis.x = 0.0;
+        assert_eq!(w, WorldFromObject::IDENTITY);
+        w.w_axis.x = 4.0;
+        assert_eq!(*w, DMat4::from_translation(DVec3::X * 4.0));
     }
 }

@@ -578,7 +578,7 @@ fn is_solid(scene: &Scene, handle: Handle<Object>) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Fresnel;
+    use crate::scene::{Fresnel, WorldFromObject};
     use crate::source::FileId;
 
     fn span(n: usize) -> Span {
@@ -592,7 +592,7 @@ mod tests {
             Object {
                 name: None,
                 kind: ObjectKind::Shape { shape },
-                world_from_object: DMat4::IDENTITY,
+                world_from_object: WorldFromObject::IDENTITY,
                 material,
             },
             span(1),
@@ -663,7 +663,7 @@ mod tests {
             radius: 1.0,
         });
         scene.objects[Handle::from_index(0)].world_from_object =
-            DMat4::from_scale(DVec3::new(1.0, 0.0, 1.0));
+            DMat4::from_scale(DVec3::new(1.0, 0.0, 1.0)).into();
         let m = &mut scene.materials[Handle::from_index(0)];
         m.ior = 0.0;
         m.diffuse = Color::new(-1.0, 0.0, 0.0);
@@ -691,7 +691,7 @@ mod tests {
                     op: crate::CsgOp::Union,
                     children: vec![disk],
                 },
-                world_from_object: DMat4::IDENTITY,
+                world_from_object: WorldFromObject::IDENTITY,
                 material,
             },
             span(2),
@@ -717,7 +717,7 @@ mod tests {
         });
         let mut m = DMat4::IDENTITY;
         m.x_axis.w = 0.5; // row 3, column 0
-        scene.objects[Handle::from_index(0)].world_from_object = m;
+        scene.objects[Handle::from_index(0)].world_from_object = m.into();
         let messages = errors(scene);
         assert_eq!(messages.len(), 1);
         assert!(messages[0].contains("projective"), "{messages:?}");

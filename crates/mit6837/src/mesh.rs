@@ -102,7 +102,7 @@ impl<'a> Converter<'a, '_> {
                         smooth: false,
                     },
                 },
-                world_from_object,
+                world_from_object: world_from_object.into(),
                 material,
             },
             span,

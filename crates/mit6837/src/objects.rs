@@ -186,7 +186,7 @@ impl<'a> Converter<'a, '_> {
             Object {
                 name: None,
                 kind: ObjectKind::Group { children },
-                world_from_object: world_from_parent,
+                world_from_object: world_from_parent.into(),
                 material,
             },
             span,
@@ -353,7 +353,7 @@ impl<'a> Converter<'a, '_> {
             Object {
                 name: None,
                 kind: ObjectKind::Shape { shape },
-                world_from_object,
+                world_from_object: world_from_object.into(),
                 material,
             },
             span,

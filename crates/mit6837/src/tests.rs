@@ -165,9 +165,9 @@ fn every_construct_becomes_the_ir_the_course_means() {
         objects[1].kind,
         ObjectKind::Shape { shape: Shape::Plane { normal, offset } } if normal == DVec3::Y && offset == -1.0
     ));
-    assert_eq!(objects[1].world_from_object, transform);
+    assert_eq!(objects[1].world_from_object.matrix(), transform);
     assert_eq!(objects[1].material.index(), 1);
-    assert_eq!(objects[3].world_from_object, transform);
+    assert_eq!(objects[3].world_from_object.matrix(), transform);
     // MaterialIndex holds past the inner group's end, as in the course's reader.
     assert_eq!(objects[4].material.index(), 1);
     assert_eq!(objects[0].material.index(), 0);
@@ -269,7 +269,7 @@ fn transforms_compose_as_the_course_multiplied_them() {
     let Some((_, sphere)) = scene.objects.iter().next() else {
         panic!("no objects");
     };
-    let m = sphere.world_from_object;
+    let m = sphere.world_from_object.matrix();
     // Each transform multiplies on the right, `Matrix` on the left (as the course's reader
     // did); the matrix is read row by row (it moves by (5, 6, 7)); braces around an
     // argument and the unnamed `Rotate { x y z degrees }` are read too. The outer block's
@@ -316,7 +316,7 @@ fn a_mesh_becomes_one_ir_mesh_instanced_by_its_triangle_mesh() {
             } => Some((
                 mesh,
                 smooth,
-                o.world_from_object,
+                o.world_from_object.matrix(),
                 scene.sources.location(span),
             )),
             _ => None,

@@ -157,7 +157,13 @@ pub enum Step {
 /// Our binary BVH (see `bvh_build`) converted by obvhs, with leaves of up to three
 /// primitives as `BvhBuildParams::medium_build()` would make them; the boxes it holds are
 /// in build space, `scale` times the world.
+#[cfg(test)]
 fn build_cwbvh(aabbs: &[Aabb]) -> (CwBvh, BuildScale) {
+    build_cwbvh_from_vec(aabbs.to_vec())
+}
+
+/// [`build_cwbvh`] consuming its boxes (scaled in place and freed before the conversion).
+fn build_cwbvh_from_vec(aabbs: Vec<Aabb>) -> (CwBvh, BuildScale) {
     let built = build_bvh2(aabbs);
     let cwbvh = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&built.bvh2, 3, true, false);
     (cwbvh, built.scale)
@@ -171,7 +177,13 @@ impl Bvh {
     /// obvhs convert it. Returns the BVH and `primitive_indices`: the input index of each
     /// BVH primitive id.
     pub fn build(aabbs: &[Aabb]) -> (Bvh, Vec<u32>) {
-        let (cwbvh, scale) = build_cwbvh(aabbs);
+        Self::build_from_vec(aabbs.to_vec())
+    }
+
+    /// [`Bvh::build`] that consumes the boxes: the build scales them in place and frees
+    /// them before obvhs's conversion, the peak of memory for a million objects.
+    pub fn build_from_vec(aabbs: Vec<Aabb>) -> (Bvh, Vec<u32>) {
+        let (cwbvh, scale) = build_cwbvh_from_vec(aabbs);
         Self::from_cwbvh(cwbvh, scale)
     }
 

@@ -100,12 +100,16 @@ pub struct Built {
 }
 
 /// Builds the binary BVH over `aabbs` (one primitive per leaf, as obvhs's converter wants).
-pub fn build_bvh2(aabbs: &[Aabb]) -> Built {
-    let scale = BuildScale::for_boxes(aabbs);
-    let boxes: Vec<Aabb> = aabbs.iter().map(|b| scale.scale_box(b)).collect();
+/// The boxes are scaled in place, so that handing over a `Vec` costs no second copy.
+pub fn build_bvh2(aabbs: impl Into<Vec<Aabb>>) -> Built {
+    let mut boxes: Vec<Aabb> = aabbs.into();
+    let scale = BuildScale::for_boxes(&boxes);
+    for b in &mut boxes {
+        *b = scale.scale_box(b);
+    }
     let centroids: Vec<Vec3A> = boxes.iter().map(|b| (b.min + b.max) * 0.5).collect();
-    let mut prims: Vec<u32> = (0..aabbs.len() as u32).collect();
-    let mut nodes = vec![Bvh2Node::default(); (2 * aabbs.len()).saturating_sub(1)];
+    let mut prims: Vec<u32> = (0..boxes.len() as u32).collect();
+    let mut nodes = vec![Bvh2Node::default(); (2 * boxes.len()).saturating_sub(1)];
     let mut steps = 0;
     let mut depth = 0;
     if let Some((root, region)) = nodes.split_first_mut() {
@@ -320,17 +324,91 @@ mod tests {
     fn coincident_and_regular_inputs_build_in_n_log_n() {
         let n = 40_000;
         let coincident = unit_boxes_at((0..n).map(|_| Vec3A::ZERO));
-        let built = build_bvh2(&coincident);
+        let built = build_bvh2(&coincident[..]);
         assert_n_log_n(&built, n);
         // The median split keeps coincident objects balanced: depth log2(n) exactly.
         assert!(built.depth <= 17, "{}", built.depth);
         let row = unit_boxes_at((0..n).map(|i| Vec3A::new(i as f32 * 3.0, 0.0, 0.0)));
-        assert_n_log_n(&build_bvh2(&row), n);
+        assert_n_log_n(&build_bvh2(&row[..]), n);
         let near = unit_boxes_at((0..n).map(|i| Vec3A::new(i as f32 * 1e-6, 0.0, 0.0)));
-        assert_n_log_n(&build_bvh2(&near), n);
+        assert_n_log_n(&build_bvh2(&near[..]), n);
         // Exponentially spaced objects, which make every SAH split peel off a few.
         let spread = unit_boxes_at((0..n).map(|i| Vec3A::splat(1.0005f32.powi(i as i32))));
-        assert_n_log_n(&build_bvh2(&spread), n);
+        assert_n_log_n(&build_bvh2(&spread[..]), n);
+    }
+
+    /// Boxes of a large, irregular scene (large enough for many levels of parallel splits).
+    fn scattered(n: usize) -> Vec<Aabb> {
+        (0..n as u32)
+            .map(|i| {
+                let h = |k: u32| (i.wrapping_mul(2_654_435_761).rotate_left(k) % 1000) as f32;
+                let c = Vec3A::new(h(0), h(11) * 0.3, h(22) * 2.0);
+                let r = 0.5 + (i % 3) as f32;
+                Aabb::new(c - r, c + r)
+            })
+            .collect()
+    }
+
+    /// A large build is a tree: each node's box holds its children's (and a leaf's its
+    /// primitive's scaled box), and every primitive is in exactly one leaf.
+    #[test]
+    fn large_builds_are_valid_trees() {
+        let n = 50_000;
+        let aabbs = scattered(n);
+        let built = build_bvh2(&aabbs[..]);
+        assert_n_log_n(&built, n);
+        let bvh2 = &built.bvh2;
+        let contains = |outer: &Aabb, inner: &Aabb| {
+            outer.min.cmple(inner.min).all() && outer.max.cmpge(inner.max).all()
+        };
+        let mut seen = vec![false; n];
+        for node in &bvh2.nodes {
+            if node.prim_count == 0 {
+                for child in [node.first_index, node.first_index + 1] {
+                    let child = &bvh2.nodes[child as usize];
+                    assert!(contains(node.aabb(), child.aabb()));
+                }
+            } else {
+                let prim = bvh2.primitive_indices[node.first_index as usize] as usize;
+                assert!(!std::mem::replace(&mut seen[prim], true), "{prim} twice");
+                assert!(contains(node.aabb(), &built.scale.scale_box(&aabbs[prim])));
+            }
+        }
+        assert!(seen.iter().all(|&s| s));
+    }
+
+    /// A large build must not depend on the thread count either (the image depends on the
+    /// tree through ties).
+    #[test]
+    fn large_builds_are_the_same_on_any_thread_count() {
+        let aabbs = scattered(50_000);
+        let build_on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap_or_else(|e| panic!("no pool: {e}"));
+            pool.install(|| build_bvh2(&aabbs[..])).bvh2
+        };
+        let one = build_on(1);
+        let three = build_on(3);
+        assert_eq!(one.primitive_indices, three.primitive_indices);
+        let key = |b: &Bvh2| -> Vec<_> {
+            b.nodes
+                .iter()
+                .map(|n| {
+                    (
+                        n.aabb().min.to_array(),
+                        n.aabb().max.to_array(),
+                        n.prim_count,
+                        n.first_index,
+                    )
+                })
+                .collect()
+        };
+        assert!(
+            key(&one) == key(&three),
+            "1 and 3 threads build different trees"
+        );
     }
 
     #[test]

@@ -107,79 +107,21 @@ impl PreparedScene {
     }
 
     /// Prepares a validated scene: converts shapes (in parallel on the current rayon pool)
-    /// and builds the BVH.
+    /// and builds the BVH. The IR stays with the caller (the debugger, `trace` and the
+    /// explanations need its names, spans and provenance).
     pub fn new(valid: &ValidScene) -> PreparedScene {
         let started = Instant::now();
-        let scene: &Scene = valid.scene();
-        let materials: Vec<PreparedMaterial> = scene
-            .materials
-            .iter()
-            .map(|(_, m)| PreparedMaterial::new(m))
-            .collect();
-        let lights = scene
-            .lights
-            .iter()
-            .map(|(handle, light)| {
-                PreparedLight::new(handle, light, scene.settings.attenuation_clamp)
-            })
-            .collect();
-        // Each mesh once (in parallel), shared by every object that instances it.
-        let meshes: Vec<Arc<PreparedMesh>> = scene
-            .meshes
-            .iter()
-            .collect::<Vec<_>>()
-            .par_iter()
-            .map(|(_, mesh)| Arc::new(PreparedMesh::new(mesh)))
-            .collect();
-        let shared = Shared {
-            materials: &materials,
-            meshes: &meshes,
-        };
-        let roots = flatten_groups(scene);
-        // Memory traffic dominates scenes of a million objects, so items are made once and
-        // moved once, into BVH order.
-        let (mut items, bounds): (Vec<Option<Item>>, Vec<Bound>) = roots
-            .par_iter()
-            .map(|&handle| {
-                let (item, bound) = prepare_item(scene, &shared, handle);
-                (Some(item), bound)
-            })
-            .unzip();
-        let mut bounded_slots = Vec::new();
-        let mut aabbs = Vec::new();
-        let mut unbounded = Vec::new();
-        for (slot, bound) in bounds.into_iter().enumerate() {
-            match bound {
-                Bound::Empty => {}
-                Bound::Infinite => unbounded.extend(items[slot].take()),
-                Bound::Finite(aabb) => {
-                    bounded_slots.push(slot);
-                    aabbs.push(aabb);
-                }
-            }
-        }
-        let (bounded, bvh) = build_bvh(&mut items, &bounded_slots, &aabbs);
-        let settings = scene.settings.clone();
-        let mesh_triangles = meshes.iter().map(|m| m.triangle_count()).sum();
-        let mesh_bvh_nodes = meshes.iter().map(|m| m.bvh_node_count()).sum();
-        PreparedScene {
-            mesh_count: meshes.len(),
-            mesh_triangles,
-            mesh_bvh_nodes,
-            camera: PreparedCamera::new(&scene.camera),
-            lights,
-            materials,
-            bounded,
-            unbounded,
-            bvh,
-            background: color(&settings.background),
-            ambient: color(&settings.ambient),
-            epsilon: settings.epsilon.map(|e| e as f32),
-            shadows: settings.shadows,
-            nested_media: scene.materials.iter().any(|(_, m)| m.priority != 0),
-            settings,
-            build_seconds: started.elapsed().as_secs_f64(),
-        }
+        Shapes::new(valid.scene()).finish(started)
+    }
+
+    /// [`PreparedScene::new`] for a caller that needs nothing of the IR afterwards (`render`
+    /// of a large scene): the IR is dropped as soon as the shapes are prepared, before the
+    /// BVH build, whose temporary arrays are the peak of memory. The result is the same.
+    pub fn new_releasing_ir(valid: ValidScene) -> PreparedScene {
+        let started = Instant::now();
+        let shapes = Shapes::new(valid.scene());
+        drop(valid);
+        shapes.finish(started)
     }
 
     /// Seconds spent in [`PreparedScene::new`]: shape preparation and the BVH build.
@@ -219,6 +161,122 @@ impl PreparedScene {
     /// How many of those are unbounded (planes and the like) and kept out of the BVH.
     pub fn unbounded_count(&self) -> usize {
         self.unbounded.len()
+    }
+}
+
+/// A scene's shapes prepared but not yet in BVH order: what [`PreparedScene`] needs of the
+/// IR, taken out of it, so that the IR can be dropped before the BVH build.
+struct Shapes {
+    settings: Settings,
+    camera: PreparedCamera,
+    lights: Vec<PreparedLight>,
+    materials: Vec<PreparedMaterial>,
+    nested_media: bool,
+    mesh_count: usize,
+    mesh_triangles: usize,
+    mesh_bvh_nodes: usize,
+    /// Bounded items in scene order, with their boxes (the same length).
+    bounded: Vec<Item>,
+    aabbs: Vec<Aabb>,
+    unbounded: Vec<Item>,
+}
+
+impl Shapes {
+    fn new(scene: &Scene) -> Shapes {
+        let materials: Vec<PreparedMaterial> = scene
+            .materials
+            .iter()
+            .map(|(_, m)| PreparedMaterial::new(m))
+            .collect();
+        let lights = scene
+            .lights
+            .iter()
+            .map(|(handle, light)| {
+                PreparedLight::new(handle, light, scene.settings.attenuation_clamp)
+            })
+            .collect();
+        // Each mesh once (in parallel), shared by every object that instances it.
+        let meshes: Vec<Arc<PreparedMesh>> = scene
+            .meshes
+            .iter()
+            .collect::<Vec<_>>()
+            .par_iter()
+            .map(|(_, mesh)| Arc::new(PreparedMesh::new(mesh)))
+            .collect();
+        let shared = Shared {
+            materials: &materials,
+            meshes: &meshes,
+        };
+        let roots = flatten_groups(scene);
+        // Memory traffic dominates scenes of a million objects, so items are made once and
+        // moved once, into BVH order.
+        let (items, bounds): (Vec<Item>, Vec<Bound>) = roots
+            .par_iter()
+            .map(|&handle| prepare_item(scene, &shared, handle))
+            .unzip();
+        drop(roots);
+        let mut bounded = Vec::new();
+        let mut aabbs = Vec::new();
+        let mut unbounded = Vec::new();
+        for (item, bound) in items.into_iter().zip(bounds) {
+            match bound {
+                Bound::Empty => {}
+                Bound::Infinite => unbounded.push(item),
+                Bound::Finite(aabb) => {
+                    bounded.push(item);
+                    aabbs.push(aabb);
+                }
+            }
+        }
+        Shapes {
+            settings: scene.settings.clone(),
+            camera: PreparedCamera::new(&scene.camera),
+            lights,
+            nested_media: scene.materials.iter().any(|(_, m)| m.priority != 0),
+            mesh_count: meshes.len(),
+            mesh_triangles: meshes.iter().map(|m| m.triangle_count()).sum(),
+            mesh_bvh_nodes: meshes.iter().map(|m| m.bvh_node_count()).sum(),
+            materials,
+            bounded,
+            aabbs,
+            unbounded,
+        }
+    }
+
+    /// Builds the BVH and puts the bounded items in its primitive order.
+    fn finish(self, started: Instant) -> PreparedScene {
+        let Shapes {
+            settings,
+            camera,
+            lights,
+            materials,
+            nested_media,
+            mesh_count,
+            mesh_triangles,
+            mesh_bvh_nodes,
+            bounded,
+            aabbs,
+            unbounded,
+        } = self;
+        let (bounded, bvh) = build_bvh(bounded, aabbs);
+        PreparedScene {
+            mesh_count,
+            mesh_triangles,
+            mesh_bvh_nodes,
+            camera,
+            lights,
+            materials,
+            bounded,
+            unbounded,
+            bvh,
+            background: color(&settings.background),
+            ambient: color(&settings.ambient),
+            epsilon: settings.epsilon.map(|e| e as f32),
+            shadows: settings.shadows,
+            nested_media,
+            settings,
+            build_seconds: started.elapsed().as_secs_f64(),
+        }
     }
 }
 
@@ -267,7 +325,7 @@ fn prepare_leaf(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (
     let materials = shared.materials;
     let object = &scene.objects[handle];
     // Projective rows are ignored: the language only makes affine transforms.
-    let world_from_object = DAffine3::from_mat4(object.world_from_object);
+    let world_from_object = DAffine3::from_mat4(object.world_from_object.matrix());
     let (geometry, bound, snap) = match &object.kind {
         ObjectKind::Shape {
             shape: Shape::Mesh { mesh, smooth },
@@ -393,44 +451,116 @@ fn node_bound(node: &CsgNode) -> Bound {
     }
 }
 
-/// Builds the BVH over the boxes of `items[bounded_slots[i]]` and moves those items out,
-/// in BVH primitive order.
-fn build_bvh(
-    items: &mut [Option<Item>],
-    bounded_slots: &[usize],
-    aabbs: &[Aabb],
-) -> (Vec<Item>, Option<Bvh>) {
-    let take_all = |items: &mut [Option<Item>]| -> Vec<Item> {
-        bounded_slots
-            .iter()
-            .filter_map(|&slot| items.get_mut(slot).and_then(Option::take))
-            .collect()
-    };
-    if bounded_slots.is_empty() || bounded_slots.len() > crate::bvh::MAX_PRIMITIVES {
-        return (take_all(items), None);
+/// Builds the BVH over `aabbs` (one per item) and returns the items in BVH primitive
+/// order. The boxes are handed to the build, which frees them as soon as it has scaled
+/// them, and the items are moved, not copied, so that no second copy of a million items
+/// exists at the peak.
+fn build_bvh(items: Vec<Item>, aabbs: Vec<Aabb>) -> (Vec<Item>, Option<Bvh>) {
+    if items.is_empty() || items.len() > crate::bvh::MAX_PRIMITIVES {
+        return (items, None);
     }
-    let (bvh, primitive_indices) = Bvh::build(aabbs);
-    // A parallel gather (random reads of a large array are the cost here); items are
-    // copied, and the originals dropped with `items`.
-    let ordered: Vec<Item> = primitive_indices
-        .par_iter()
-        .filter_map(|&index| {
-            let slot = *bounded_slots.get(index as usize)?;
-            items.get(slot)?.clone()
-        })
-        .collect();
-    if ordered.len() == bounded_slots.len() && primitive_indices.len() == ordered.len() {
-        (ordered, Some(bvh))
-    } else {
+    let count = items.len();
+    let (bvh, primitive_indices) = Bvh::build_from_vec(aabbs);
+    match permute(items, &primitive_indices) {
+        Ok(ordered) if ordered.len() == count => (ordered, Some(bvh)),
         // Not a permutation (obvhs never does this without spatial splits): keep every item
         // once and test them all, which is slow but right.
-        (take_all(items), None)
+        Ok(items) | Err(items) => (items, None),
     }
+}
+
+/// `items` reordered so that entry `i` is `items[order[i]]`, in place (by following the
+/// permutation's cycles with swaps: no second array of items); `Err(items)` (in the
+/// original order) when `order` is not a permutation of the indices.
+fn permute(mut items: Vec<Item>, order: &[u32]) -> Result<Vec<Item>, Vec<Item>> {
+    let mut done = vec![false; items.len()];
+    let is_permutation = order.len() == items.len()
+        && order.iter().all(|&i| {
+            done.get_mut(i as usize)
+                .is_some_and(|d| !std::mem::replace(d, true))
+        });
+    if !is_permutation {
+        return Err(items);
+    }
+    done.fill(false);
+    for start in 0..items.len() {
+        // Each cycle start -> order[start] -> ... -> start: position `i` takes the item
+        // at `order[i]`, which the swap brings from further along the same cycle.
+        let mut i = start;
+        while !done[i] {
+            done[i] = true;
+            let next = order[i] as usize;
+            if next == start {
+                break;
+            }
+            items.swap(i, next);
+            i = next;
+        }
+    }
+    Ok(items)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::{render, NoObserver, RenderOptions};
+    use crate::testing::{sphere_grid, whitted_classic};
+
+    /// Dropping the IR before the BVH build changes nothing a render sees.
+    #[test]
+    fn releasing_the_ir_prepares_the_same_scene() {
+        for builder in [whitted_classic(), sphere_grid(12)] {
+            let valid = builder.build().expect("valid");
+            let kept = PreparedScene::new(&valid);
+            let mut options = RenderOptions::from_settings(&valid.scene().settings);
+            options.width = 48;
+            options.height = 36;
+            let released = PreparedScene::new_releasing_ir(valid);
+            assert_eq!(kept.object_count(), released.object_count());
+            assert_eq!(kept.bvh_node_count(), released.bvh_node_count());
+            let image =
+                |scene: &PreparedScene| render(scene, &options, &NoObserver).expect("done").0;
+            assert_eq!(image(&kept).pixels, image(&released).pixels);
+        }
+    }
+
+    fn numbered(n: u32) -> Vec<Item> {
+        let builder = sphere_grid(n);
+        let valid = builder.build().expect("valid");
+        let shapes = Shapes::new(valid.scene());
+        shapes.bounded
+    }
+
+    #[test]
+    fn permute_moves_items_into_the_given_order() {
+        let objects: Vec<_> = numbered(4).iter().map(Item::object).collect();
+        let n = objects.len() as u32;
+        // Reversal (cycles of two), a rotation (one long cycle), and a mix of fixed points
+        // and cycles of several lengths.
+        let orders: [Vec<u32>; 3] = [
+            (0..n).rev().collect(),
+            (0..n).map(|i| (i + 3) % n).collect(),
+            (0..n).map(|i| (i * 5) % n).collect(),
+        ];
+        for order in orders {
+            let ordered = permute(numbered(4), &order).unwrap_or_else(|_| panic!("a permutation"));
+            let reordered: Vec<_> = ordered.iter().map(Item::object).collect();
+            let expected: Vec<_> = order.iter().map(|&i| objects[i as usize]).collect();
+            assert_eq!(reordered, expected, "{order:?}");
+        }
+    }
+
+    #[test]
+    fn permute_refuses_what_is_not_a_permutation() {
+        let items = numbered(2);
+        let n = items.len() as u32;
+        // A repeated index, an index out of range, a short order: each returns the items
+        // untouched.
+        for order in [vec![0, 0, 1, 2], vec![0, 1, 2, n], vec![0, 1]] {
+            let back = permute(numbered(2), &order).expect_err("refused");
+            assert_eq!(back.len(), items.len());
+        }
+    }
 
     /// A million of these must stay cheap to build and to walk.
     #[test]

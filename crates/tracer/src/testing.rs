@@ -144,7 +144,7 @@ impl SceneBuilder {
             Object {
                 name: None,
                 kind,
-                world_from_object,
+                world_from_object: world_from_object.into(),
                 material,
             },
             Span::detached(),

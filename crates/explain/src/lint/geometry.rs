@@ -237,7 +237,7 @@ pub(super) fn facing_away_from_lights(scene: &Scene, lints: &mut Vec<Lint>) {
         if material.diffuse.is_black() && material.specular.is_black() {
             continue;
         }
-        let world_from_object = object.world_from_object;
+        let world_from_object = object.world_from_object.matrix();
         let normal = world_from_object
             .inverse()
             .transpose()

@@ -762,7 +762,7 @@ impl<'a> Evaluator<'a> {
                 continue;
             };
             if !identity {
-                object.world_from_object = transform * object.world_from_object;
+                object.world_from_object = (transform * *object.world_from_object).into();
             }
             if let Some(material) = material {
                 if object.material.index() == INHERIT as usize {

@@ -83,7 +83,7 @@ impl<'a> Evaluator<'a> {
         let object = Object {
             name: self.object_name(name)?,
             kind,
-            world_from_object: builder.placement.transform,
+            world_from_object: builder.placement.transform.into(),
             material: material.unwrap_or_else(inherit),
         };
         let handle = self.scene.objects.append(object, header);

@@ -552,7 +552,7 @@ fn transforms_compose_in_the_order_written() {
     ));
     // Rotation about x first, then y: <0, 0, 1> → (x 90) → <0, -1, 0> → (y 90) → same.
     let scene = scene("sphere { rotate <90, 90, 0> }");
-    let m = scene.objects[scene.roots[0]].world_from_object;
+    let m = scene.objects[scene.roots[0]].world_from_object.matrix();
     assert!(close(m.transform_vector3(DVec3::Z), DVec3::NEG_Y));
     assert!(close(m.transform_vector3(DVec3::X), DVec3::NEG_Z));
     assert!(close(
@@ -569,7 +569,7 @@ fn transforms_compose_in_the_order_written() {
 
 fn scene_of(input: &str) -> DMat4 {
     let scene = scene(input);
-    scene.objects[scene.roots[0]].world_from_object
+    scene.objects[scene.roots[0]].world_from_object.matrix()
 }
 
 #[test]
@@ -581,7 +581,7 @@ fn a_childs_transforms_apply_before_its_parents() {
         .objects
         .iter()
         .find(|(_, o)| matches!(o.kind, ObjectKind::Shape { .. }))
-        .map(|(_, o)| o.world_from_object)
+        .map(|(_, o)| o.world_from_object.matrix())
         .expect("a sphere");
     assert!(close(
         sphere.transform_point3(DVec3::ZERO),
@@ -589,7 +589,7 @@ fn a_childs_transforms_apply_before_its_parents() {
     ));
     // A call block is a parent too.
     let scene = super::support::scene("fn f() { sphere { translate <1, 0, 0> } } f() { scale 3 }");
-    let m = scene.objects[scene.roots[0]].world_from_object;
+    let m = scene.objects[scene.roots[0]].world_from_object.matrix();
     assert!(close(
         m.transform_point3(DVec3::ZERO),
         DVec3::new(3.0, 0.0, 0.0)
