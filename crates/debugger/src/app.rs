@@ -596,7 +596,14 @@ impl App {
                     1 => " (1 warning)".to_string(),
                     n => format!(" ({n} warnings)"),
                 };
-                self.set_message(format!("reloaded {}{note}", self.scene_name), false);
+                // The popup's values and re-trace were of the old scene: showing them over
+                // the new one would explain a scene that is gone.
+                let closed = if self.what_if.take().is_some() {
+                    "; what-if closed (w opens it on the new scene)"
+                } else {
+                    ""
+                };
+                self.set_message(format!("reloaded {}{note}{closed}", self.scene_name), false);
                 let mut effects = vec![Effect::StartRender];
                 effects.extend(retrace);
                 effects
@@ -748,6 +755,23 @@ mod tests {
         assert_eq!(
             app.message.as_ref().unwrap().text,
             "reloaded scenes/whitted.scene"
+        );
+    }
+
+    #[test]
+    fn a_reload_closes_the_what_if_popup_of_the_old_scene() {
+        let mut app = app();
+        app.cursor = GLASS_PIXEL;
+        app.trace_cursor();
+        finish_trace(&mut app);
+        crate::update::update(&mut app, crate::action::Action::WhatIf);
+        assert!(app.what_if.is_some(), "the popup opens on a picked pixel");
+        app.apply_reload(Ok((LoadedScene::new(whitted_scene()), 0)));
+        assert!(app.what_if.is_none());
+        let message = app.message.as_ref().map(|m| m.text.as_str());
+        assert!(
+            message.is_some_and(|m| m.contains("what-if closed")),
+            "{message:?}"
         );
     }
 
