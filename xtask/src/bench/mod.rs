@@ -39,6 +39,12 @@ const RENDERS: &[Case] = &[
         pov: Some("scenes/bench/pov/spheres1000.pov"),
     },
     Case {
+        label: "grid 10,000 spheres",
+        scene: "scenes/bench/grid.scene",
+        defines: &["N=100"],
+        pov: None,
+    },
+    Case {
         label: "grid 1,000,000 spheres",
         scene: "scenes/bench/grid.scene",
         defines: &["N=1000"],
