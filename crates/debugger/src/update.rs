@@ -327,25 +327,35 @@ fn step_match(app: &mut App, backward: bool) {
     app.set_message(format!("match {} of {count}", index + 1), false);
 }
 
+/// How many lines either side of the definition the source pane's sideways scroll measures
+/// for the longest line.
+const SOURCE_SCROLL_REACH: u32 = 500;
+
 /// Scrolls the source pane, within its file: no further up than its first line, down than
-/// its last, or right than its longest line.
+/// its last, or right than the longest line near the definition.
 fn scroll_source(app: &mut App, lines: i32, columns: i32) {
     let shown = crate::ui::source_pane::target_span(app);
     let Some(file) = shown.and_then(|span| app.loaded.scene.sources.get(span.file)) else {
         app.set_message("no source to scroll: pick a ray that hit something", false);
         return;
     };
-    let line_count = i32::try_from(file.line_count()).unwrap_or(i32::MAX);
-    let longest = (1..=file.line_count())
+    // Bounds relative to the definition's line, so that a key pressed past an end is not
+    // stored (the next press the other way moves at once). The longest line is looked for
+    // near the definition only: a scene written by a program can have a million lines, and
+    // this runs on every key.
+    let line_count = file.line_count();
+    let at = shown.map_or(1, |span| file.line_col(span.start).line);
+    let near = at.saturating_sub(SOURCE_SCROLL_REACH).max(1)
+        ..=at.saturating_add(SOURCE_SCROLL_REACH).min(line_count);
+    let longest = near
         .map(|n| file.line_text(n).chars().count())
         .max()
         .unwrap_or(0);
     let scroll = &mut app.source_scroll;
     scroll.span = shown;
-    scroll.lines = scroll
-        .lines
-        .saturating_add(lines)
-        .clamp(-line_count, line_count);
+    let above = -i64::from(at);
+    let below = i64::from(line_count) - i64::from(at);
+    scroll.lines = (i64::from(scroll.lines) + i64::from(lines)).clamp(above, below) as i32;
     let columns = i64::from(scroll.columns) + i64::from(columns);
     scroll.columns = columns.clamp(0, longest.min(usize::from(u16::MAX)) as i64) as u16;
 }
@@ -665,6 +675,12 @@ mod tests {
             .max()
             .unwrap();
         assert_eq!(usize::from(app.source_scroll.columns), longest);
+        // Presses past the file's first line are not stored: the next press down moves.
+        let at = file.line_col(glass.start).line as i32;
+        update(&mut app, up_down(-1000));
+        assert_eq!(app.source_scroll.lines, -at);
+        update(&mut app, up_down(1));
+        assert_eq!(app.source_scroll.lines, 1 - at);
         update(&mut app, Action::SourceScrollHome);
         assert_eq!((app.source_scroll.lines, app.source_scroll.columns), (0, 0));
         // Another ray's definition (the floor, hit by the reflected ray) starts unscrolled.
