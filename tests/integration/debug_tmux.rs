@@ -87,13 +87,21 @@ impl Tmux {
         String::from_utf8_lossy(&output.stdout).trim().to_string()
     }
 
-    /// Polls the screen until `ready` holds; fails with the last screen after [`PATIENCE`].
+    /// Polls the screen until `ready` holds on two captures in a row that are the same;
+    /// fails with the last screen after [`PATIENCE`]. One capture is not enough: tmux can
+    /// capture a frame half written (CI caught a tree title new and its rows still old).
     fn wait_for(&self, what: &str, ready: impl Fn(&str) -> bool) -> String {
         let started = Instant::now();
+        let mut previous: Option<String> = None;
         loop {
             let screen = self.screen();
             if ready(&screen) {
-                return screen;
+                if previous.as_deref() == Some(screen.as_str()) {
+                    return screen;
+                }
+                previous = Some(screen.clone());
+            } else {
+                previous = None;
             }
             assert!(
                 started.elapsed() < PATIENCE,
