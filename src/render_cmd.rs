@@ -373,7 +373,10 @@ impl Summary<'_> {
                 "render           {:.3} s on {} threads",
                 s.render_seconds, self.threads
             ),
-            format!("camera rays      {}", s.camera_rays),
+            format!(
+                "camera rays      {} ({} in packets)",
+                s.camera_rays, s.camera_rays_in_packets
+            ),
             format!("shadow rays      {}", s.shadow_rays),
             format!("reflected rays   {}", s.reflected_rays),
             format!("transmitted rays {}", s.transmitted_rays),
@@ -414,6 +417,7 @@ impl Summary<'_> {
             "render_seconds": s.render_seconds,
             "camera_rays": s.camera_rays,
             "shadow_rays": s.shadow_rays,
+            "camera_rays_in_packets": s.camera_rays_in_packets,
             "reflected_rays": s.reflected_rays,
             "transmitted_rays": s.transmitted_rays,
             "total_rays": s.total_rays(),

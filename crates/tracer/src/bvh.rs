@@ -289,9 +289,206 @@ impl Bvh {
         }
     }
 
+    /// Walks the BVH with up to [`PACKET`] rays at once, each seeing exactly what
+    /// [`Bvh::traverse`] would show it, in the same order: `visit(r, id, tmax)` is called
+    /// for ray `r` with its own `tmax[r]`, which it may shrink, or stop that ray. Returns
+    /// false, having visited nothing, when the rays do not all travel into the same octant
+    /// (the walk's child order depends on it); then the caller walks them one by one.
+    ///
+    /// Why the visits are the same: the single walk is a depth-first walk over a child
+    /// order fixed by the octant, in which a ray enters a child when its own test at the
+    /// parent (with its `tmax` then) touched it, and looks at a node's primitives before its
+    /// children. The packet walks the same order over the union of what its rays touch,
+    /// and keeps for every pending node which rays touched it; each ray's tests are the
+    /// single walk's, bit for bit. What the packet shares is each node's load and the
+    /// walk's bookkeeping, and its rays' box tests, independent of each other, overlap
+    /// instead of waiting one behind the other.
+    pub fn traverse_packet(
+        &self,
+        rays: &[Ray],
+        tmin: f32,
+        tmax: &mut [f32; PACKET],
+        stack: &mut Vec<PacketEntry>,
+        visit: impl FnMut(usize, u32, f32) -> Step,
+    ) -> bool {
+        let Some(first) = rays.first() else {
+            return true;
+        };
+        let octant = octant_inv4(first.direction);
+        if rays.len() > PACKET || rays.iter().any(|r| octant_inv4(r.direction) != octant) {
+            return false;
+        }
+        if self.nodes.is_empty() {
+            return true;
+        }
+        let test = PerRayTest::new(rays, tmin);
+        self.traverse_packet_octants(&test, rays.len(), tmax, stack, visit, octant);
+        true
+    }
+
+    /// The packet walk for the octant code `octant`, each a walk of its own.
+    #[inline(always)]
+    fn traverse_packet_octants(
+        &self,
+        test: &PerRayTest,
+        count: usize,
+        tmax: &mut [f32; PACKET],
+        stack: &mut Vec<PacketEntry>,
+        visit: impl FnMut(usize, u32, f32) -> Step,
+        octant: u32,
+    ) {
+        match octant & 0b111 {
+            0 => self.traverse_packet_octant::<0>(test, count, tmax, stack, visit),
+            1 => self.traverse_packet_octant::<1>(test, count, tmax, stack, visit),
+            2 => self.traverse_packet_octant::<2>(test, count, tmax, stack, visit),
+            3 => self.traverse_packet_octant::<3>(test, count, tmax, stack, visit),
+            4 => self.traverse_packet_octant::<4>(test, count, tmax, stack, visit),
+            5 => self.traverse_packet_octant::<5>(test, count, tmax, stack, visit),
+            6 => self.traverse_packet_octant::<6>(test, count, tmax, stack, visit),
+            _ => self.traverse_packet_octant::<7>(test, count, tmax, stack, visit),
+        }
+    }
+
+    /// [`Bvh::traverse_packet`] for rays whose `octant_inv4` code is `OCT` in every byte.
+    #[inline(always)]
+    fn traverse_packet_octant<const OCT: u32>(
+        &self,
+        test: &PerRayTest,
+        count: usize,
+        tmax: &mut [f32; PACKET],
+        stack: &mut Vec<PacketEntry>,
+        mut visit: impl FnMut(usize, u32, f32) -> Step,
+    ) {
+        let count = count.min(PACKET);
+        let inner_order = &INNER_ORDER[OCT as usize];
+        // Rays that have not stopped.
+        let mut alive = (1u32 << count) - 1;
+        stack.clear();
+        stack.push(PacketEntry {
+            node: 0,
+            rays: alive as u8,
+        });
+        while let Some(entry) = stack.pop() {
+            let active = u32::from(entry.rays) & alive;
+            if active == 0 {
+                continue;
+            }
+            let Some(node) = self.nodes.get(entry.node as usize) else {
+                return;
+            };
+            // Which active rays touch each child slot (every ray's own single-walk test).
+            let child_rays = test.child_rays::<OCT>(node, tmax, active);
+            // Each ray's primitives: those of the leaves it touches, in the single walk's
+            // order (highest bit first).
+            let mut primitives = [0u32; PACKET];
+            let mut leaves = !node.imask & 0xff;
+            while leaves != 0 {
+                let slot = leaves.trailing_zeros() as usize & 7;
+                leaves &= leaves - 1;
+                let mut rays = u32::from(child_rays[slot]);
+                while rays != 0 {
+                    let r = rays.trailing_zeros() as usize & (PACKET - 1);
+                    rays &= rays - 1;
+                    primitives[r] |= node.leaf_bits[slot];
+                }
+            }
+            for (r, bits) in primitives.iter_mut().enumerate() {
+                while *bits != 0 {
+                    let local = first_bit_high(*bits);
+                    *bits &= !(1u32 << local);
+                    match visit(r, node.primitive_base + local, tmax[r]) {
+                        Step::Continue => {}
+                        Step::Shrink(t) => tmax[r] = t,
+                        Step::Stop => {
+                            alive &= !(1u32 << r);
+                            break;
+                        }
+                    }
+                }
+            }
+            // The inner children that rays still walking touched. The single walk enters
+            // the child of the highest ordered bit first: pushed last, it is popped first.
+            let mut union = 0u32;
+            let mut inner = node.imask & 0xff;
+            while inner != 0 {
+                let slot = inner.trailing_zeros();
+                inner &= inner - 1;
+                if u32::from(child_rays[slot as usize & 7]) & alive != 0 {
+                    union |= 1 << slot;
+                }
+            }
+            let mut order = u32::from(inner_order[union as usize & 0xff]);
+            while order != 0 {
+                let bit = order.trailing_zeros();
+                order &= order - 1;
+                let slot = ((bit ^ OCT) & 7) as usize;
+                let below = INNER_BELOW[(node.imask & 0xff) as usize][slot];
+                stack.push(PacketEntry {
+                    node: node.child_base + u32::from(below),
+                    rays: child_rays[slot] & alive as u8,
+                });
+            }
+        }
+    }
+
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
+}
+
+/// At most this many rays walk the BVH together ([`Bvh::traverse_packet`]).
+pub const PACKET: usize = 8;
+
+/// A packet's child test: each ray's own single-walk test ([`NodeQuery::touched`]), one
+/// ray after another. (An AVX2 test of one child against all eight rays at once visits the
+/// same and was measured no faster: see ARCHITECTURE.md.)
+struct PerRayTest {
+    queries: [NodeQuery; PACKET],
+}
+
+impl PerRayTest {
+    fn new(rays: &[Ray], tmin: f32) -> PerRayTest {
+        let last = rays.len().clamp(1, PACKET) - 1;
+        PerRayTest {
+            queries: std::array::from_fn(|r| match rays.get(r.min(last)) {
+                Some(ray) => NodeQuery::new(ray, tmin),
+                None => NodeQuery::new(&Ray::new(Vec3A::ZERO, Vec3A::X), tmin),
+            }),
+        }
+    }
+}
+
+impl PerRayTest {
+    /// For each child slot of `node`, which of the `active` rays' segments
+    /// `(tmin, tmax[r])` touch its box.
+    #[inline(always)]
+    fn child_rays<const OCT: u32>(
+        &self,
+        node: &WideNode,
+        tmax: &[f32; PACKET],
+        active: u32,
+    ) -> [u8; 8] {
+        let mut child_rays = [0u8; 8];
+        let mut each = active;
+        while each != 0 {
+            let r = each.trailing_zeros() as usize & (PACKET - 1);
+            each &= each - 1;
+            let mut touched = self.queries[r].touched::<OCT>(node, tmax[r]);
+            while touched != 0 {
+                let slot = touched.trailing_zeros() as usize & 7;
+                touched &= touched - 1;
+                child_rays[slot] |= 1 << r;
+            }
+        }
+        child_rays
+    }
+}
+
+/// A node the packet walk has still to visit, and which of its rays touched it.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PacketEntry {
+    node: u32,
+    rays: u8,
 }
 
 /// The ray, prepared once per query for the slab tests.
@@ -565,7 +762,106 @@ mod tests {
         assert!(compared > 10_000, "{compared}");
     }
 
-    /// The decoded child bits give obvhs's hit mask for every touched set and octant.
+    /// Each ray of a packet sees exactly the visits, with the same `tmax`, that it sees
+    /// walking alone, whatever the visitor does: coherent packets (neighbouring camera
+    /// rays), incoherent ones (any rays of one octant), partial ones, with axis-parallel
+    /// directions and negative zeros among them.
+    #[test]
+    fn a_packet_walk_shows_each_ray_its_single_walk() {
+        let mut state = 0x2545_f491u32;
+        let mut random = move || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            (state >> 8) as f32 / (1u32 << 24) as f32
+        };
+        let aabbs: Vec<Aabb> = (0..4000)
+            .map(|_| {
+                let c = Vec3A::new(random(), random(), random()) * 40.0;
+                let half = Vec3A::new(random(), random(), random()) * 1.5 + 0.05;
+                Aabb::new(c - half, c + half)
+            })
+            .collect();
+        let (bvh, _) = Bvh::build(&aabbs);
+        let mut stack = Vec::new();
+        let mut packet_stack = Vec::new();
+        let (mut compared, mut packets) = (0, 0);
+        for k in 0..400 {
+            let eye = Vec3A::new(random(), random(), random()) * 80.0 - 20.0;
+            let target = Vec3A::new(random(), random(), random()) * 40.0;
+            let coherent = k % 2 == 0;
+            let count = if k % 5 == 0 { 1 + k % 8 } else { PACKET };
+            let mut rays: Vec<Ray> = Vec::new();
+            let mut attempt = 0usize;
+            while rays.len() < count {
+                attempt += 1;
+                let (origin, mut direction) = if coherent {
+                    let jitter = Vec3A::new(random(), random(), random()) - 0.5;
+                    (eye, target + jitter * 2.0 - eye)
+                } else {
+                    let origin = Vec3A::new(random(), random(), random()) * 80.0 - 20.0;
+                    (origin, target - origin)
+                };
+                match (k + attempt) % 9 {
+                    0 => direction.x = 0.0,
+                    1 => direction.y = -0.0,
+                    2 => direction.z = direction.z.signum() * 0.0,
+                    _ => {}
+                }
+                let ray = Ray::new(origin, direction.normalize_or(Vec3A::X));
+                let same_octant = rays
+                    .first()
+                    .is_none_or(|first| octant_inv4(first.direction) == octant_inv4(ray.direction));
+                if same_octant {
+                    rays.push(ray);
+                }
+            }
+            for mode in 0..3u32 {
+                let mut alone: Vec<Vec<(u32, u32)>> = vec![Vec::new(); count];
+                for (log, ray) in alone.iter_mut().zip(&rays) {
+                    bvh.traverse(ray, 1e-3, f32::INFINITY, &mut stack, |id, tmax| {
+                        logging_visit(log, mode, id, tmax)
+                    });
+                }
+                let mut together: Vec<Vec<(u32, u32)>> = vec![Vec::new(); count];
+                let mut tmax = [f32::INFINITY; PACKET];
+                let walked =
+                    bvh.traverse_packet(&rays, 1e-3, &mut tmax, &mut packet_stack, |r, id, t| {
+                        logging_visit(&mut together[r], mode, id, t)
+                    });
+                assert!(walked, "ray {k}: one octant");
+                assert_eq!(together, alone, "packet {k}, mode {mode}");
+                compared += alone.iter().map(Vec::len).sum::<usize>();
+                packets += 1;
+            }
+        }
+        assert!(compared > 20_000 && packets == 1200, "{compared} visits");
+    }
+
+    /// Rays of different octants are refused, untouched, for the caller to walk alone.
+    #[test]
+    fn a_packet_of_mixed_octants_is_refused() {
+        let (bvh, _) = Bvh::build(&boxes(100));
+        let rays = [
+            Ray::new(Vec3A::ZERO, Vec3A::X),
+            Ray::new(Vec3A::ZERO, Vec3A::NEG_X),
+        ];
+        let mut tmax = [f32::INFINITY; PACKET];
+        let mut visits = 0;
+        let walked = bvh.traverse_packet(&rays, 0.0, &mut tmax, &mut Vec::new(), |_, _, _| {
+            visits += 1;
+            Step::Continue
+        });
+        assert!(!walked);
+        assert_eq!(visits, 0);
+        assert!(
+            bvh.traverse_packet(&rays[..1], 0.0, &mut tmax, &mut Vec::new(), |_, _, _| {
+                Step::Continue
+            })
+        );
+    }
+
+    /// The decoded child bits give obvhs's hit masks for every touched set and octant.
     #[test]
     fn decoded_child_bits_give_obvhs_hit_masks() {
         let (cwbvh, scale) = build_cwbvh(&boxes(2000));

@@ -10,7 +10,7 @@
 use glam::{UVec2, Vec3A};
 use whitted_ir::{Handle, Material};
 
-use crate::bvh::{Bvh, Step};
+use crate::bvh::{Bvh, PacketEntry, Step, PACKET};
 use crate::csg::CsgScratch;
 use crate::ray::Ray;
 use crate::scene::{Item, Leaf, PreparedScene};
@@ -82,6 +82,7 @@ pub struct Surface<'a> {
 pub struct Scratch {
     csg: CsgScratch,
     bvh_stack: Vec<UVec2>,
+    packet_stack: Vec<PacketEntry>,
 }
 
 #[cfg(test)]
@@ -200,7 +201,7 @@ impl PreparedScene {
         tmax: f32,
         scratch: &mut Scratch,
     ) -> Option<Hit> {
-        let Scratch { csg, bvh_stack } = scratch;
+        let Scratch { csg, bvh_stack, .. } = scratch;
         let mut best = None;
         bvh.traverse(ray, tmin, tmax, bvh_stack, |id, tmax| {
             let Some(item) = self.bounded.get(id as usize) else {
@@ -215,6 +216,71 @@ impl PreparedScene {
             }
         });
         best
+    }
+
+    /// [`PreparedScene::intersect`] of up to [`PACKET`] rays over `(tmin, ∞)` at once, the
+    /// bounded items walked as a packet ([`Bvh::traverse_packet`]): `hits[r]` is what
+    /// `intersect` returns for `rays[r]`, bit for bit, since each ray meets the same items
+    /// in the same order. Returns false, with `hits` untouched, when the rays cannot walk
+    /// together (no BVH, too many, or not all of one octant).
+    pub(crate) fn intersect_packet(
+        &self,
+        rays: &[Ray],
+        tmin: f32,
+        scratch: &mut Scratch,
+        hits: &mut [Option<Hit>; PACKET],
+    ) -> bool {
+        match self.walk_bvh() {
+            Some(bvh) if rays.len() <= PACKET => {
+                self.intersect_packet_bvh(bvh, rays, tmin, scratch, hits)
+            }
+            _ => false,
+        }
+    }
+
+    #[inline(never)]
+    fn intersect_packet_bvh(
+        &self,
+        bvh: &Bvh,
+        rays: &[Ray],
+        tmin: f32,
+        scratch: &mut Scratch,
+        hits: &mut [Option<Hit>; PACKET],
+    ) -> bool {
+        let Scratch {
+            csg, packet_stack, ..
+        } = scratch;
+        // Unbounded items first, ray by ray, as `intersect` tests them.
+        let mut tmax = [f32::INFINITY; PACKET];
+        let mut unbounded_best: [Option<Hit>; PACKET] = [None; PACKET];
+        for ((ray, tmax), best) in rays.iter().zip(&mut tmax).zip(&mut unbounded_best) {
+            for (i, item) in self.unbounded.iter().enumerate() {
+                if let Some(found) = item_hit(item, ray, tmin, *tmax, csg) {
+                    *tmax = found.0;
+                    *best = Some(Hit::new(ItemRef::Unbounded(i as u32), found));
+                }
+            }
+        }
+        let mut bounded_best: [Option<Hit>; PACKET] = [None; PACKET];
+        let walked = bvh.traverse_packet(rays, tmin, &mut tmax, packet_stack, |r, id, tmax| {
+            let (Some(item), Some(ray)) = (self.bounded.get(id as usize), rays.get(r)) else {
+                return Step::Continue;
+            };
+            match item_hit(item, ray, tmin, tmax, csg) {
+                Some(found) => {
+                    bounded_best[r] = Some(Hit::new(ItemRef::Bounded(id), found));
+                    Step::Shrink(found.0)
+                }
+                None => Step::Continue,
+            }
+        });
+        if walked {
+            for ((hit, bounded), unbounded) in hits.iter_mut().zip(bounded_best).zip(unbounded_best)
+            {
+                *hit = bounded.or(unbounded);
+            }
+        }
+        walked
     }
 
     /// Any surface strictly inside `(tmin, tmax)`: the first one found, not the nearest
@@ -251,7 +317,7 @@ impl PreparedScene {
         tmax: f32,
         scratch: &mut Scratch,
     ) -> Option<Hit> {
-        let Scratch { csg, bvh_stack } = scratch;
+        let Scratch { csg, bvh_stack, .. } = scratch;
         let mut blocker = None;
         bvh.traverse(ray, tmin, tmax, bvh_stack, |id, tmax| {
             let Some(item) = self.bounded.get(id as usize) else {
@@ -319,7 +385,7 @@ impl PreparedScene {
         tmax: f32,
         scratch: &mut Scratch,
     ) -> Shadow {
-        let Scratch { csg, bvh_stack } = scratch;
+        let Scratch { csg, bvh_stack, .. } = scratch;
         let mut transmittance = Vec3A::ONE;
         let mut blockers = 0u32;
         let mut blocked = None;
@@ -371,7 +437,7 @@ impl PreparedScene {
         scratch: &mut Scratch,
         mut found: impl FnMut(Hit) -> bool,
     ) {
-        let Scratch { csg, bvh_stack } = scratch;
+        let Scratch { csg, bvh_stack, .. } = scratch;
         let (low, high) = ((t - window).max(tmin), t + window);
         self.visit(ray, low, high, bvh_stack, |item_ref, item, _| {
             let mut from = low;

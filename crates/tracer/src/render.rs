@@ -18,7 +18,9 @@ use glam::Vec3A;
 use rayon::prelude::*;
 use whitted_ir::{Camera, Settings};
 
+use crate::bvh::PACKET;
 use crate::camera::PreparedCamera;
+use crate::query::Hit;
 use crate::ray::Ray;
 use crate::recorder::{NoRecord, PixelStats, Recorder};
 use crate::sampling::sample_offset;
@@ -88,6 +90,8 @@ pub struct RenderStats {
     pub shadow_rays: u64,
     pub reflected_rays: u64,
     pub transmitted_rays: u64,
+    /// Camera rays whose first hit was found in a packet of neighbouring rays.
+    pub camera_rays_in_packets: u64,
     /// Wall-clock seconds of [`render`] (not including scene preparation).
     pub render_seconds: f64,
     /// The deepest ray traced (0 when only camera rays were traced).
@@ -254,6 +258,9 @@ struct Worker<'a, R> {
     /// ends in a square root and a division, and made back to back these overlap instead
     /// of each stalling the start of its trace.
     rays: Vec<Ray>,
+    /// The first hit of each of `rays`, found a packet at a time (`Tracer::camera_hits`);
+    /// `None` for rays of a packet that could not walk together, which find their own.
+    first_hits: Vec<Option<Option<Hit>>>,
     pixels: Vec<[f32; 3]>,
     recorders: Vec<R>,
 }
@@ -293,6 +300,7 @@ fn render_recorded<R: Recorder + Default + Send>(
             || Worker {
                 tracer: Tracer::new(scene, options.depth_limit(), options.min_weight),
                 rays: Vec::new(),
+                first_hits: Vec::new(),
                 pixels: Vec::new(),
                 recorders: Vec::new(),
             },
@@ -313,6 +321,7 @@ fn render_recorded<R: Recorder + Default + Send>(
         shadow_rays: counters.shadow,
         reflected_rays: counters.reflected,
         transmitted_rays: counters.transmitted,
+        camera_rays_in_packets: counters.camera_in_packets,
         render_seconds: started.elapsed().as_secs_f64(),
         deepest_ray: counters.deepest,
         threads: rayon::current_num_threads(),
@@ -354,13 +363,29 @@ fn render_tile<R: Recorder + Default>(
                 rays.push(camera_ray(camera, options, x, y, sample));
             }
         }
+        // Neighbouring camera rays find their first hits together: a packet shares the
+        // BVH walk and gives each ray exactly the hit it would find alone.
+        let first_hits = &mut worker.first_hits;
+        first_hits.clear();
+        for packet in rays.chunks(PACKET) {
+            let mut hits = [None; PACKET];
+            if tracer.camera_hits(packet, &mut hits) {
+                first_hits.extend(hits.iter().take(packet.len()).map(|hit| Some(*hit)));
+            } else {
+                first_hits.extend(packet.iter().map(|_| None));
+            }
+        }
         // The rays in the order they were made: pixel by pixel, sample by sample, exactly
         // as `trace_sample` traces them one at a time.
-        for pixel_rays in rays.chunks(samples as usize) {
+        let samples = samples as usize;
+        for (pixel_rays, pixel_hits) in rays.chunks(samples).zip(first_hits.chunks(samples)) {
             let mut rec = R::default();
             let mut accumulator = PixelAccumulator::new();
-            for ray in pixel_rays {
-                let color = tracer.trace(ray, &PathState::camera(), &mut rec);
+            for (ray, first_hit) in pixel_rays.iter().zip(pixel_hits) {
+                let color = match first_hit {
+                    Some(hit) => tracer.trace_from_hit(ray, &PathState::camera(), &mut rec, *hit),
+                    None => tracer.trace(ray, &PathState::camera(), &mut rec),
+                };
                 accumulator.add(color.to_array());
             }
             pixels.push(accumulator.mean());

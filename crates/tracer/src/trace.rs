@@ -15,6 +15,7 @@
 use glam::Vec3A;
 use whitted_ir::{Fresnel, Handle, Highlight, Material, ShadowMode};
 
+use crate::bvh::PACKET;
 use crate::material::PreparedMaterial;
 use crate::media::{same_medium, Medium, MediumStack};
 use crate::optics::{beer_lambert, fresnel_exact, max_channel, reflect, refract, schlick};
@@ -34,6 +35,8 @@ pub struct RayCounters {
     pub reflected: u64,
     pub transmitted: u64,
     pub deepest: u32,
+    /// Camera rays whose first hit was found in a packet.
+    pub camera_in_packets: u64,
 }
 
 impl RayCounters {
@@ -43,6 +46,7 @@ impl RayCounters {
         self.reflected += other.reflected;
         self.transmitted += other.transmitted;
         self.deepest = self.deepest.max(other.deepest);
+        self.camera_in_packets += other.camera_in_packets;
     }
 }
 
@@ -177,6 +181,38 @@ impl<'a> Tracer<'a> {
 
     /// Traces one ray and returns the colour it brings back to its origin.
     pub fn trace<R: Recorder>(&mut self, ray: &Ray, path: &PathState, rec: &mut R) -> Vec3A {
+        self.trace_first(ray, path, rec, FirstHit::Find)
+    }
+
+    /// The closest hits of camera rays walked together through the BVH, each what
+    /// [`Tracer::trace`] would find first for its ray (see `intersect_packet`); false, with
+    /// `hits` untouched, when these rays cannot walk together.
+    pub(crate) fn camera_hits(&mut self, rays: &[Ray], hits: &mut [Option<Hit>; PACKET]) -> bool {
+        self.scene
+            .intersect_packet(rays, 0.0, &mut self.scratch, hits)
+    }
+
+    /// [`Tracer::trace`] of a ray whose first hit is already known (from
+    /// [`Tracer::camera_hits`]): the same trace, bit for bit, without finding it again.
+    pub(crate) fn trace_from_hit<R: Recorder>(
+        &mut self,
+        ray: &Ray,
+        path: &PathState,
+        rec: &mut R,
+        hit: Option<Hit>,
+    ) -> Vec3A {
+        self.counters.camera_in_packets += 1;
+        self.trace_first(ray, path, rec, FirstHit::Known(hit))
+    }
+
+    #[inline(always)]
+    fn trace_first<R: Recorder>(
+        &mut self,
+        ray: &Ray,
+        path: &PathState,
+        rec: &mut R,
+        first: FirstHit,
+    ) -> Vec3A {
         rec.ray_started(&RayStart {
             kind: path.kind,
             depth: path.depth,
@@ -194,7 +230,7 @@ impl<'a> Tracer<'a> {
             media: &path.media,
         };
         self.count(&path);
-        self.trace_started(ray, &path, rec)
+        self.trace_started(ray, &path, rec, first)
     }
 
     /// Counts a ray about to be traced (its caller has reported it to the recorder).
@@ -212,7 +248,13 @@ impl<'a> Tracer<'a> {
 
     /// The body of [`Tracer::trace`], once the recorder has heard of the ray: the recursion
     /// passes only what the colour depends on, and each caller reports the rest.
-    fn trace_started<R: Recorder>(&mut self, ray: &Ray, path: &Path<'_>, rec: &mut R) -> Vec3A {
+    fn trace_started<R: Recorder>(
+        &mut self,
+        ray: &Ray,
+        path: &Path<'_>,
+        rec: &mut R,
+        first: FirstHit,
+    ) -> Vec3A {
         let scene = self.scene;
         // Most rays travel in air; then nothing is absorbed and multiplying by the
         // transmittance (exactly 1) can be skipped without changing a bit.
@@ -221,7 +263,11 @@ impl<'a> Tracer<'a> {
         // False hits (surfaces that do not change the medium) are passed through: the same
         // ray looks on beyond them, so `t` stays measured from its origin and the medium,
         // unchanged by a false hit, absorbs along the whole distance.
-        let Some(hit) = scene.intersect(ray, 0.0, f32::INFINITY, &mut self.scratch) else {
+        let found = match first {
+            FirstHit::Find => scene.intersect(ray, 0.0, f32::INFINITY, &mut self.scratch),
+            FirstHit::Known(hit) => hit,
+        };
+        let Some(hit) = found else {
             return self.missed(path, rec);
         };
         let mut meeting = self.meet(ray, 0.0, hit, path.media);
@@ -750,7 +796,7 @@ impl<'a> Tracer<'a> {
                     interface: Some(split.interface),
                 });
                 self.count(child);
-                Some(self.trace_started(ray, child, rec))
+                Some(self.trace_started(ray, child, rec, FirstHit::Find))
             }
             Some(reason) => {
                 rec.secondary_skipped(&SkippedRay {
@@ -777,6 +823,15 @@ impl<'a> Tracer<'a> {
             None
         }
     }
+}
+
+/// Where a trace's first hit comes from.
+#[derive(Clone, Copy)]
+enum FirstHit {
+    /// Found by the trace itself.
+    Find,
+    /// Already found by a packet query over `(0, ∞)`.
+    Known(Option<Hit>),
 }
 
 /// Whether a meeting is no interface at all: a solid's surface that leaves the current

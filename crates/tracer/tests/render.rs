@@ -10,7 +10,7 @@ use whitted_ir::{
     ShadowMode, Shape,
 };
 use whitted_tracer::testing::{
-    glass, matte, mirror, plane_y, sphere, whitted_classic, SceneBuilder,
+    glass, matte, mirror, plane_y, sphere, sphere_grid, whitted_classic, SceneBuilder,
 };
 use whitted_tracer::{
     render, render_with_pixel_stats, trace_pixel_with, LightSample, NoObserver, NoRecord,
@@ -184,6 +184,36 @@ fn tracing_a_pixel_reproduces_the_rendered_pixel_bit_for_bit() {
     }
     // The recorder saw every ray the renderer counted.
     assert_eq!(rays, stats.total_rays());
+}
+
+/// Camera rays walked in packets (neighbouring rays sharing one BVH walk) give every pixel
+/// exactly the colour of its rays traced alone, with one sample or several; a packet whose
+/// rays point into different octants (across the middle column here) is walked ray by ray.
+#[test]
+fn camera_rays_in_packets_give_the_pixels_of_rays_traced_alone() {
+    let scene = prepare(sphere_grid(9));
+    for samples in [1, 3] {
+        let opts = options(40, 30, samples);
+        let (image, stats) =
+            render(&scene, &opts, &NoObserver).unwrap_or_else(|| panic!("cancelled"));
+        for y in 0..opts.height {
+            for x in 0..opts.width {
+                let mut alone = PixelAccumulator::new();
+                for k in 0..samples {
+                    alone.add(trace_pixel_with(&scene, &opts, x, y, k, &mut NoRecord));
+                }
+                let rendered = image.pixel(x, y).unwrap_or([f32::NAN; 3]);
+                assert_eq!(
+                    bits(&[alone.mean()]),
+                    bits(&[rendered]),
+                    "pixel {x},{y}, {samples} samples"
+                );
+            }
+        }
+        let (packed, all) = (stats.camera_rays_in_packets, stats.camera_rays);
+        assert!(packed > all / 2, "{packed} of {all} camera rays in packets");
+        assert!(packed < all, "the middle column's packets point two ways");
+    }
 }
 
 #[test]
