@@ -354,24 +354,62 @@ impl Prop {
 
     /// How many values it takes: the same in every block that accepts it.
     pub fn arity(self) -> Arity {
-        self.rows()
-            .next()
-            .map_or(Arity::One, |row| row.kind.arity())
+        self.facts().arity
     }
 
     /// The words it takes, when its value is one of a few words rather than an expression.
     pub fn words(self) -> Option<&'static [&'static str]> {
-        self.rows().find_map(|row| match row.kind {
-            Kind::Word(words) => Some(words),
-            _ => None,
-        })
+        self.facts().words
     }
 
     /// Transforms may be given any number of times; every other property once per block.
     pub fn is_transform(self) -> bool {
-        self.rows().any(|row| row.block == Block::Transforms)
+        self.facts().transform
+    }
+
+    /// What the rows say of this property, read from [`FACTS`]: the evaluator asks it for
+    /// every property of every statement, and searching the rows each time was a tenth of
+    /// compiling a million spheres written by loops (issue 14).
+    fn facts(self) -> Facts {
+        FACTS
+            .get(self as usize)
+            .copied()
+            .unwrap_or_else(|| Facts::from_rows(self))
     }
 }
+
+/// The facts about a property that hold in every block accepting it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Facts {
+    arity: Arity,
+    words: Option<&'static [&'static str]>,
+    transform: bool,
+}
+
+impl Facts {
+    fn from_rows(prop: Prop) -> Facts {
+        Facts {
+            arity: prop
+                .rows()
+                .next()
+                .map_or(Arity::One, |row| row.kind.arity()),
+            words: prop.rows().find_map(|row| match row.kind {
+                Kind::Word(words) => Some(words),
+                _ => None,
+            }),
+            transform: prop.rows().any(|row| row.block == Block::Transforms),
+        }
+    }
+}
+
+/// [`Facts`] of every property, by its place in [`Prop::ALL`] (its discriminant: the enum
+/// and the list come from the same macro line).
+static FACTS: std::sync::LazyLock<Vec<Facts>> = std::sync::LazyLock::new(|| {
+    Prop::ALL
+        .iter()
+        .map(|&prop| Facts::from_rows(prop))
+        .collect()
+});
 
 /// The families of blocks whose properties the evaluator converts by their rows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -457,6 +495,17 @@ mod tests {
         all.extend(CameraTag::ALL.into_iter().map(Context::Camera));
         all.extend(LightTag::ALL.into_iter().map(Context::Light));
         all
+    }
+
+    /// The facts table is indexed by discriminant and must say what the rows say.
+    #[test]
+    fn the_facts_of_each_property_are_its_rows() {
+        for (index, &prop) in Prop::ALL.iter().enumerate() {
+            assert_eq!(prop as usize, index, "{prop:?}");
+            assert_eq!(prop.facts(), Facts::from_rows(prop), "{prop:?}");
+        }
+        assert!(Prop::Translate.is_transform() && !Prop::Radius.is_transform());
+        assert_eq!(Prop::Matrix.arity(), Arity::Numbers(16));
     }
 
     #[test]
