@@ -22,6 +22,9 @@
 //! Each step sits on the chain of dependent loads and compares from one node to the next,
 //! which is what bounds the speed of a walk. The traversal stack is a per-thread `Vec`
 //! reused across rays: no depth limit and no per-ray allocation or zeroing.
+//!
+//! Up to eight rays of one octant can also walk together ([`Bvh::traverse_packet`]), each
+//! seeing exactly its single walk's visits; camera rays use it.
 
 use glam::{UVec2, Vec3A, Vec4};
 use obvhs::aabb::Aabb;
