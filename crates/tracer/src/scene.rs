@@ -119,8 +119,11 @@ impl PreparedScene {
     /// BVH build, whose temporary arrays are the peak of memory. The result is the same.
     pub fn new_releasing_ir(valid: ValidScene) -> PreparedScene {
         let started = Instant::now();
-        let shapes = Shapes::new(valid.scene());
-        drop(valid);
+        // Only the objects, materials and meshes are read from here on.
+        let mut scene = valid.into_inner();
+        scene.provenance = Default::default();
+        let shapes = Shapes::new(&scene);
+        drop(scene);
         shapes.finish(started)
     }
 
@@ -208,30 +211,38 @@ impl Shapes {
             meshes: &meshes,
         };
         let roots = flatten_groups(scene);
-        // Memory traffic dominates scenes of a million objects, so items are made once and
-        // moved once, into BVH order.
-        let (items, bounds): (Vec<Item>, Vec<Bound>) = roots
+        // Memory dominates scenes of a million objects, and the IR is still alive here: items
+        // are made once, beside their bounds as plain boxes (32 bytes, a `Bound` takes 48),
+        // and the arrays are then compacted in place.
+        let (mut bounded, mut aabbs): (Vec<Item>, Vec<Aabb>) = roots
             .par_iter()
-            .map(|&handle| prepare_item(scene, &shared, handle))
+            .map(|&handle| {
+                let (item, bound) = prepare_item(scene, &shared, handle);
+                (item, bound_as_box(bound))
+            })
             .unzip();
         drop(roots);
-        let finite = bounds
-            .iter()
-            .filter(|b| matches!(b, Bound::Finite(_)))
-            .count();
-        let mut bounded = Vec::with_capacity(finite);
-        let mut aabbs = Vec::with_capacity(finite);
-        let mut unbounded = Vec::new();
-        for (item, bound) in items.into_iter().zip(bounds) {
-            match bound {
-                Bound::Empty => {}
-                Bound::Infinite => unbounded.push(item),
-                Bound::Finite(aabb) => {
-                    bounded.push(item);
-                    aabbs.push(aabb);
+        // The items without a finite bound leave the array in order: the unbounded are tested
+        // one by one, the empty never.
+        let mut position = 0;
+        let mut infinite = Vec::new();
+        let extracted: Vec<Item> = bounded
+            .extract_if(.., |_| {
+                let bound = aabbs.get(position).map_or(Bound::Empty, box_as_bound);
+                position += 1;
+                let finite = matches!(bound, Bound::Finite(_));
+                if !finite {
+                    infinite.push(bound == Bound::Infinite);
                 }
-            }
-        }
+                !finite
+            })
+            .collect();
+        let unbounded: Vec<Item> = extracted
+            .into_iter()
+            .zip(infinite)
+            .filter_map(|(item, infinite)| infinite.then_some(item))
+            .collect();
+        aabbs.retain(|aabb| matches!(box_as_bound(aabb), Bound::Finite(_)));
         Shapes {
             settings: scene.settings.clone(),
             camera: PreparedCamera::new(&scene.camera),
@@ -296,6 +307,31 @@ fn flatten_groups(scene: &Scene) -> Vec<Handle<Object>> {
         }
     }
     out
+}
+
+/// A bound as a plain box, so that a million of them take 32 bytes each (a `Bound` takes
+/// 48): a finite bound is its box; the empty and the unbounded are boxes with a NaN corner,
+/// which no finite bound has (one that did would be tested as unbounded: always right).
+fn bound_as_box(bound: Bound) -> Aabb {
+    let marked = |max: f32| Aabb::new(Vec3A::splat(f32::NAN), Vec3A::splat(max));
+    match bound {
+        Bound::Finite(aabb) if !(aabb.min.is_nan_mask().any() || aabb.max.is_nan_mask().any()) => {
+            aabb
+        }
+        Bound::Empty => marked(0.0),
+        Bound::Finite(_) | Bound::Infinite => marked(1.0),
+    }
+}
+
+/// The bound [`bound_as_box`] stored.
+fn box_as_bound(aabb: &Aabb) -> Bound {
+    if !aabb.min.x.is_nan() {
+        Bound::Finite(*aabb)
+    } else if aabb.max.x == 0.0 {
+        Bound::Empty
+    } else {
+        Bound::Infinite
+    }
 }
 
 /// What every item's preparation reads: the prepared materials and meshes.
@@ -561,6 +597,21 @@ mod tests {
             let back = permute(numbered(2), &order).expect_err("refused");
             assert_eq!(back.len(), items.len());
         }
+    }
+
+    /// Bounds stored as boxes come back as they went in; a finite box with a NaN corner
+    /// (which no bound computation makes) comes back unbounded, which is tested by itself.
+    #[test]
+    fn bounds_survive_being_stored_as_boxes() {
+        let aabb = Aabb::new(Vec3A::new(-1.0, -0.0, 2.0), Vec3A::new(0.0, 5.0, 2.5));
+        for bound in [Bound::Empty, Bound::Infinite, Bound::Finite(aabb)] {
+            assert_eq!(box_as_bound(&bound_as_box(bound)), bound);
+        }
+        let broken = Aabb::new(Vec3A::new(0.0, f32::NAN, 0.0), Vec3A::ONE);
+        assert_eq!(
+            box_as_bound(&bound_as_box(Bound::Finite(broken))),
+            Bound::Infinite
+        );
     }
 
     /// A million of these must stay cheap to build and to walk.
