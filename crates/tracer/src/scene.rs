@@ -122,8 +122,7 @@ impl PreparedScene {
         // Only the objects, materials and meshes are read from here on.
         let mut scene = valid.into_inner();
         scene.provenance = Default::default();
-        let shapes = Shapes::new(&scene);
-        drop(scene);
+        let shapes = Shapes::new_releasing(scene, RELEASE_CHUNK);
         shapes.finish(started)
     }
 
@@ -167,6 +166,10 @@ impl PreparedScene {
     }
 }
 
+/// Items prepared between two releases of objects by [`PreparedScene::new_releasing_ir`]:
+/// large enough for rayon to share out, small beside a million.
+const RELEASE_CHUNK: usize = 1 << 16;
+
 /// A scene's shapes prepared but not yet in BVH order: what [`PreparedScene`] needs of the
 /// IR, taken out of it, so that the IR can be dropped before the BVH build.
 struct Shapes {
@@ -186,6 +189,52 @@ struct Shapes {
 
 impl Shapes {
     fn new(scene: &Scene) -> Shapes {
+        let (shapes, meshes) = Shapes::without_items(scene);
+        let shared = Shared {
+            materials: &shapes.materials,
+            meshes: &meshes,
+        };
+        let roots = flatten_groups(scene);
+        let (items, aabbs) = prepare_items(scene, &shared, &roots);
+        shapes.with_items(items, aabbs)
+    }
+
+    /// [`Shapes::new`] that frees the scene's objects as it goes: the items are prepared
+    /// from the last to the first, a chunk at a time, and after each chunk the objects that
+    /// no item still to come can reach are dropped (an object's parts come before it in the
+    /// arena, so an item reaches no object after its own). For a million objects made by a
+    /// loop the IR and the items then never coexist in full.
+    fn new_releasing(mut scene: Scene, chunk_len: usize) -> Shapes {
+        let (shapes, meshes) = Shapes::without_items(&scene);
+        let shared = Shared {
+            materials: &shapes.materials,
+            meshes: &meshes,
+        };
+        let roots = flatten_groups(&scene);
+        // The last object each chunk's predecessors can reach.
+        let mut reach_before = Vec::with_capacity(roots.len().div_ceil(chunk_len));
+        let mut reach = None;
+        for chunk in roots.chunks(chunk_len) {
+            reach_before.push(reach);
+            reach = chunk.iter().map(|h| h.index()).chain(reach).max();
+        }
+        let mut chunks = Vec::with_capacity(reach_before.len());
+        for (chunk, reach) in roots.chunks(chunk_len).zip(reach_before).rev() {
+            chunks.push(prepare_items(&scene, &shared, chunk));
+            scene.objects.truncate(reach.map_or(0, |last| last + 1));
+        }
+        drop(scene);
+        let mut items = Vec::with_capacity(roots.len());
+        let mut aabbs = Vec::with_capacity(roots.len());
+        for (chunk_items, chunk_aabbs) in chunks.into_iter().rev() {
+            items.extend(chunk_items);
+            aabbs.extend(chunk_aabbs);
+        }
+        shapes.with_items(items, aabbs)
+    }
+
+    /// Everything but the items, and the prepared meshes the items will share.
+    fn without_items(scene: &Scene) -> (Shapes, Vec<Arc<PreparedMesh>>) {
         let materials: Vec<PreparedMaterial> = scene
             .materials
             .iter()
@@ -206,22 +255,25 @@ impl Shapes {
             .par_iter()
             .map(|(_, mesh)| Arc::new(PreparedMesh::new(mesh)))
             .collect();
-        let shared = Shared {
-            materials: &materials,
-            meshes: &meshes,
+        let shapes = Shapes {
+            settings: scene.settings.clone(),
+            camera: PreparedCamera::new(&scene.camera),
+            lights,
+            nested_media: scene.materials.iter().any(|(_, m)| m.priority != 0),
+            mesh_count: meshes.len(),
+            mesh_triangles: meshes.iter().map(|m| m.triangle_count()).sum(),
+            mesh_bvh_nodes: meshes.iter().map(|m| m.bvh_node_count()).sum(),
+            materials,
+            bounded: Vec::new(),
+            aabbs: Vec::new(),
+            unbounded: Vec::new(),
         };
-        let roots = flatten_groups(scene);
-        // Memory dominates scenes of a million objects, and the IR is still alive here: items
-        // are made once, beside their bounds as plain boxes (32 bytes, a `Bound` takes 48),
-        // and the arrays are then compacted in place.
-        let (mut bounded, mut aabbs): (Vec<Item>, Vec<Aabb>) = roots
-            .par_iter()
-            .map(|&handle| {
-                let (item, bound) = prepare_item(scene, &shared, handle);
-                (item, bound_as_box(bound))
-            })
-            .unzip();
-        drop(roots);
+        (shapes, meshes)
+    }
+
+    /// Takes the prepared items with their bounds stored as boxes (see [`bound_as_box`]),
+    /// in scene order, and keeps them apart by bound, in place.
+    fn with_items(self, mut bounded: Vec<Item>, mut aabbs: Vec<Aabb>) -> Shapes {
         // The items without a finite bound leave the array in order: the unbounded are tested
         // one by one, the empty never.
         let mut position = 0;
@@ -244,17 +296,10 @@ impl Shapes {
             .collect();
         aabbs.retain(|aabb| matches!(box_as_bound(aabb), Bound::Finite(_)));
         Shapes {
-            settings: scene.settings.clone(),
-            camera: PreparedCamera::new(&scene.camera),
-            lights,
-            nested_media: scene.materials.iter().any(|(_, m)| m.priority != 0),
-            mesh_count: meshes.len(),
-            mesh_triangles: meshes.iter().map(|m| m.triangle_count()).sum(),
-            mesh_bvh_nodes: meshes.iter().map(|m| m.bvh_node_count()).sum(),
-            materials,
             bounded,
             aabbs,
             unbounded,
+            ..self
         }
     }
 
@@ -332,6 +377,23 @@ fn box_as_bound(aabb: &Aabb) -> Bound {
     } else {
         Bound::Infinite
     }
+}
+
+/// The items of `roots` (in parallel), each beside its bound stored as a box. Memory
+/// dominates scenes of a million objects: an item is made once, and its bound takes 32
+/// bytes this way (a `Bound` takes 48).
+fn prepare_items(
+    scene: &Scene,
+    shared: &Shared<'_>,
+    roots: &[Handle<Object>],
+) -> (Vec<Item>, Vec<Aabb>) {
+    roots
+        .par_iter()
+        .map(|&handle| {
+            let (item, bound) = prepare_item(scene, shared, handle);
+            (item, bound_as_box(bound))
+        })
+        .unzip()
 }
 
 /// What every item's preparation reads: the prepared materials and meshes.
@@ -558,6 +620,62 @@ mod tests {
             let image =
                 |scene: &PreparedScene| render(scene, &options, &NoObserver).expect("done").0;
             assert_eq!(image(&kept).pixels, image(&released).pixels);
+        }
+    }
+
+    /// Preparing from the end while releasing objects gives the items, bounds and order of
+    /// preparing with the whole IR, whatever the chunks, with CSG parts and group members
+    /// before their parents, unbounded and empty objects among bounded ones, and top-level
+    /// objects out of arena order.
+    #[test]
+    fn releasing_objects_chunk_by_chunk_prepares_the_same_shapes() {
+        use crate::testing::{matte, plane_y, sphere, SceneBuilder};
+        use glam::DMat4;
+        use whitted_ir::CsgOp;
+        let mut b = SceneBuilder::new();
+        let m = b.material(matte(0.5, 0.5, 0.5));
+        let id = DMat4::IDENTITY;
+        let first = b.add(sphere(0.0, 0.0, 0.0, 1.0), id, m);
+        let second = b.add(sphere(0.0, 0.0, 3.0, 1.0), id, m);
+        for i in 0..4 {
+            b.add(sphere(f64::from(i) * 3.0, 1.0, 0.0, 1.0), id, m);
+        }
+        let p = b.part(sphere(0.0, 5.0, 0.0, 1.0), id, m);
+        let q = b.part(sphere(0.5, 5.0, 0.0, 1.0), id, m);
+        b.csg(CsgOp::Difference, vec![p, q], m);
+        b.add(plane_y(-1.0), id, m);
+        let r = b.part(sphere(0.0, -5.0, 0.0, 1.0), id, m);
+        let s = b.part(plane_y(2.0), id, m);
+        b.group(vec![r, s]);
+        let t = b.part(sphere(9.0, 0.0, 0.0, 1.0), id, m);
+        let u = b.part(sphere(20.0, 0.0, 0.0, 1.0), id, m);
+        // Disjoint: an empty solid.
+        b.csg(CsgOp::Intersection, vec![t, u], m);
+        for i in 0..4 {
+            b.add(sphere(f64::from(i) * 3.0, -3.0, 1.0, 0.5), id, m);
+        }
+        // The first two objects last at the top level.
+        for early in [first, second] {
+            b.demote(early);
+            b.promote(early);
+        }
+        let valid = b.build().expect("valid");
+        let key = |shapes: &Shapes| {
+            let objects = |items: &[Item]| items.iter().map(Item::object).collect::<Vec<_>>();
+            let boxes: Vec<_> = shapes
+                .aabbs
+                .iter()
+                .map(|a| (a.min.to_array(), a.max.to_array()))
+                .collect();
+            (objects(&shapes.bounded), boxes, objects(&shapes.unbounded))
+        };
+        let whole = key(&Shapes::new(valid.scene()));
+        assert_eq!(whole.0.len(), 12);
+        assert_eq!(whole.2.len(), 2);
+        for chunk_len in [1, 2, 3, 5, 100] {
+            let scene = valid.scene().clone();
+            let released = key(&Shapes::new_releasing(scene, chunk_len));
+            assert!(released == whole, "chunks of {chunk_len}");
         }
     }
 
