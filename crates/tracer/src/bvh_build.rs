@@ -24,7 +24,10 @@
 //! children's bounds, and each inner node gets obvhs's wide-conversion decisions on the way
 //! back up (its costs need only its children's), so no pass over the tree is left for the
 //! converter but the one that writes the wide nodes. The tree is the one the earlier
-//! index-moving build made (the test `builds_the_tree_of_the_index_build` keeps that one).
+//! index-moving build made (the test `builds_the_tree_of_the_index_build` keeps that one):
+//! the primitives of a range lie in the order its indices did. A node's bounds are
+//! gathered in another order, which can change only the sign of a zero bound, and no wide
+//! node keeps that (the conversion's origin does; the walk's planes do not).
 
 use glam::Vec3A;
 use obvhs::aabb::Aabb;
@@ -399,18 +402,25 @@ fn split(prims: &mut [Prim], centroid_bounds: &Aabb, depth: u32) -> Split {
 /// The cheapest bin boundary over the three axes, applied; `None` when no boundary leaves
 /// both sides non-empty.
 fn sah_split(prims: &mut [Prim], lo: Vec3A, extent: Vec3A) -> Option<Split> {
-    let bin_of = |c: Vec3A, axis: usize| -> usize {
-        let x = (c[axis] - lo[axis]) / extent[axis] * BINS as f32;
-        // `as` saturates, and NaN becomes 0.
-        (x as usize).min(BINS - 1)
+    // A centroid's bin on each axis: `((c - lo) / extent * BINS) as usize`, at most the
+    // last bin, for the three axes at once. Clamping to [0, BINS − 1] first gives what
+    // `as` gives (it saturates, and makes NaN 0: so does `max` with 0, which returns its
+    // argument for NaN); the truncated bin plus 2^23 then holds the bin in its low
+    // mantissa bits, exactly, which spares three saturating conversions per primitive.
+    let bins = Vec3A::splat(BINS as f32);
+    let last_bin = Vec3A::splat((BINS - 1) as f32);
+    let two_to_23 = Vec3A::splat(8_388_608.0);
+    let bins_of = |c: Vec3A| -> [usize; 3] {
+        let x = ((c - lo) / extent * bins).max(Vec3A::ZERO).min(last_bin);
+        let shifted = x.trunc() + two_to_23;
+        shifted.to_array().map(|v| (v.to_bits() & 0xff) as usize)
     };
     // One pass bins every primitive on all three axes.
     let mut counts = [[0u32; BINS]; 3];
     let mut bin_boxes = [[Aabb::empty(); BINS]; 3];
     for p in prims.iter() {
         let (c, aabb) = (p.centroid(), p.aabb());
-        for axis in 0..3 {
-            let b = bin_of(c, axis);
+        for (axis, b) in bins_of(c).into_iter().enumerate() {
             counts[axis][b] += 1;
             bin_boxes[axis][b] = bin_boxes[axis][b].union(&aabb);
         }
@@ -456,7 +466,7 @@ fn sah_split(prims: &mut [Prim], lo: Vec3A, extent: Vec3A) -> Option<Split> {
     for i in 0..prims.len() {
         let p = prims[i];
         let c = p.centroid();
-        if bin_of(c, axis) <= last_left_bin {
+        if bins_of(c)[axis] <= last_left_bin {
             split.left_bounds = split.left_bounds.union(&p.aabb());
             split.left_centroids = split.left_centroids.union(&Aabb::new(c, c));
             prims.swap(i, split.left_len);
