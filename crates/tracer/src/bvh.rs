@@ -1,5 +1,6 @@
-//! The BVH over bounded objects: obvhs builds a compressed wide BVH (`CwBvh`, eight children
-//! per node, child boxes quantised to bytes); this module walks it.
+//! The BVH over bounded objects, in obvhs's compressed wide layout (`CwBvh`, eight children
+//! per node, child boxes quantised to bytes); this module builds it through `bvh_build` and
+//! `bvh_wide` and walks it.
 //!
 //! The walk visits primitives in exactly obvhs's traversal order (its `traverse!` macro: the
 //! same node groups, octant-sorted child order and hit masks; a test compares the two visit

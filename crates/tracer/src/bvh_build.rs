@@ -392,11 +392,42 @@ fn split(prims: &mut [Prim], centroid_bounds: &Aabb, depth: u32) -> Split {
     let extent = centroid_bounds.max - lo;
     let axis = extent.max_position();
     if extent[axis] > 0.0 && depth < SAH_DEPTH_LIMIT {
+        if prims.len() == 2 {
+            return pair_split(prims, extent);
+        }
         if let Some(split) = sah_split(prims, lo, extent) {
             return split;
         }
     }
     median_split(prims, axis)
+}
+
+/// [`sah_split`] of two primitives whose centroids differ, in closed form (half the
+/// ranges are pairs, and binning them costs far more than the pair): on every axis where
+/// the centroids differ the two fall into the first and the last bin, and the cost is the
+/// sum of their two half areas whatever the axis, so the first such axis wins and the
+/// primitive with the lower centroid on it goes first.
+fn pair_split(prims: &mut [Prim], extent: Vec3A) -> Split {
+    let axis = (0..3).find(|&a| extent[a] > 0.0).unwrap_or(0);
+    if prims[1].centroid()[axis] < prims[0].centroid()[axis] {
+        prims.swap(0, 1);
+    }
+    let side = |p: &Prim| {
+        let c = p.centroid();
+        (
+            Aabb::empty().union(&p.aabb()),
+            Aabb::empty().union(&Aabb::new(c, c)),
+        )
+    };
+    let (left_bounds, left_centroids) = side(&prims[0]);
+    let (right_bounds, right_centroids) = side(&prims[1]);
+    Split {
+        left_len: 1,
+        left_bounds,
+        left_centroids,
+        right_bounds,
+        right_centroids,
+    }
 }
 
 /// The cheapest bin boundary over the three axes, applied; `None` when no boundary leaves
@@ -469,7 +500,9 @@ fn sah_split(prims: &mut [Prim], lo: Vec3A, extent: Vec3A) -> Option<Split> {
         if bins_of(c)[axis] <= last_left_bin {
             split.left_bounds = split.left_bounds.union(&p.aabb());
             split.left_centroids = split.left_centroids.union(&Aabb::new(c, c));
-            prims.swap(i, split.left_len);
+            if i != split.left_len {
+                prims.swap(i, split.left_len);
+            }
             split.left_len += 1;
         } else {
             split.right_bounds = split.right_bounds.union(&p.aabb());
