@@ -238,17 +238,19 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     // has them): they would add about a second per million objects to the render.
     let lint =
         !args.quiet && !args.no_lint && whitted_explain::lint::lints_by_default(&loaded.scene);
+    // The scene is prepared (shapes, BVH) on the render's threads too, so that `--threads`
+    // bounds the whole run.
+    let pool = thread_pool(args.threads)?;
     let prepared = if lint {
-        let prepared = PreparedScene::new(&loaded.scene);
+        let prepared = pool.install(|| PreparedScene::new(&loaded.scene));
         crate::scene_input::print_lints(&loaded, &prepared);
         prepared
     } else {
-        // Nothing below needs the IR (names, spans, provenance): it goes before the BVH
-        // build, the peak of memory for a large scene.
-        PreparedScene::new_releasing_ir(loaded.scene)
+        // Nothing below needs the IR (names, spans, provenance): it is freed while the
+        // shapes are prepared, before the BVH build.
+        let scene = loaded.scene;
+        pool.install(|| PreparedScene::new_releasing_ir(scene))
     };
-
-    let pool = thread_pool(args.threads)?;
 
     let show_progress = !args.quiet && std::io::stderr().is_terminal();
     let bar = show_progress.then(|| {

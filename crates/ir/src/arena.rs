@@ -158,6 +158,16 @@ impl<T> Arena<T> {
     pub fn as_slice(&self) -> &[T] {
         &self.items
     }
+
+    /// Drops the items from `len` on, with their spans, and gives their memory back: for a
+    /// consumer that reads the arena from its end and needs no handle at or past `len`
+    /// again (such a handle is then foreign).
+    pub fn truncate(&mut self, len: usize) {
+        self.items.truncate(len);
+        self.items.shrink_to_fit();
+        self.spans.truncate(len);
+        self.spans.shrink_to_fit();
+    }
 }
 
 impl<T> std::ops::Index<Handle<T>> for Arena<T> {
@@ -177,6 +187,19 @@ impl<T> std::ops::IndexMut<Handle<T>> for Arena<T> {
 mod tests {
     use super::*;
     use crate::source::FileId;
+
+    #[test]
+    fn truncate_keeps_the_first_items_and_their_spans() {
+        let mut arena = Arena::new();
+        let spans: Vec<Span> = (0..5).map(|i| Span::new(FileId(0), i, i + 1)).collect();
+        let handles: Vec<_> = spans.iter().map(|&s| arena.append(s.start, s)).collect();
+        arena.truncate(2);
+        assert_eq!(arena.len(), 2);
+        assert_eq!((arena[handles[1]], arena.span(handles[1])), (1, spans[1]));
+        assert!(!arena.contains(handles[2]));
+        arena.truncate(7);
+        assert_eq!(arena.len(), 2);
+    }
 
     #[test]
     fn append_returns_sequential_handles_and_keeps_spans() {

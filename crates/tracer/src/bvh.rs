@@ -1,5 +1,6 @@
-//! The BVH over bounded objects: obvhs builds a compressed wide BVH (`CwBvh`, eight children
-//! per node, child boxes quantised to bytes); this module walks it.
+//! The BVH over bounded objects, in obvhs's compressed wide layout (`CwBvh`, eight children
+//! per node, child boxes quantised to bytes); this module builds it through `bvh_build` and
+//! `bvh_wide` and walks it.
 //!
 //! The walk visits primitives in exactly obvhs's traversal order (its `traverse!` macro: the
 //! same node groups, octant-sorted child order and hit masks; a test compares the two visit
@@ -33,6 +34,7 @@ use obvhs::cwbvh::CwBvh;
 
 use crate::bounds::inverse_direction;
 use crate::bvh_build::{build_bvh2, round_down, round_up, BuildScale};
+use crate::bvh_wide;
 use crate::ray::Ray;
 
 /// Children's box planes of one node, four children per half: `halves[h][axis * 2]` holds
@@ -52,7 +54,7 @@ impl NodePlanes {
 /// A node's dequantised child planes next to what the walk needs of obvhs's node, so one
 /// node is one contiguous read: 256 bytes, aligned to cache lines (the node index becomes a
 /// shift, and a node never straddles a fifth line).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 #[repr(align(64))]
 struct WideNode {
     planes: NodePlanes,
@@ -159,16 +161,12 @@ pub enum Step {
 
 /// Our binary BVH (see `bvh_build`) converted by obvhs, with leaves of up to three
 /// primitives as `BvhBuildParams::medium_build()` would make them; the boxes it holds are
-/// in build space, `scale` times the world.
+/// in build space, `scale` times the world. The walk's tests compare with obvhs's nodes;
+/// builds convert with `bvh_wide`, which makes the same nodes.
 #[cfg(test)]
 fn build_cwbvh(aabbs: &[Aabb]) -> (CwBvh, BuildScale) {
-    build_cwbvh_from_vec(aabbs.to_vec())
-}
-
-/// [`build_cwbvh`] consuming its boxes (scaled in place and freed before the conversion).
-fn build_cwbvh_from_vec(aabbs: Vec<Aabb>) -> (CwBvh, BuildScale) {
     let built = build_bvh2(aabbs);
-    let cwbvh = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&built.bvh2, 3, true, false);
+    let cwbvh = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&built.tree.to_bvh2(), 3, true, false);
     (cwbvh, built.scale)
 }
 
@@ -176,18 +174,30 @@ fn build_cwbvh_from_vec(aabbs: Vec<Aabb>) -> (CwBvh, BuildScale) {
 pub const MAX_PRIMITIVES: usize = u32::MAX as usize;
 
 impl Bvh {
-    /// Builds the binary BVH (`bvh_build`, parallel on the current rayon pool) and has
-    /// obvhs convert it. Returns the BVH and `primitive_indices`: the input index of each
+    /// Builds the binary BVH (`bvh_build`, parallel on the current rayon pool) and converts
+    /// it into obvhs's wide nodes (`bvh_wide`). Returns the BVH and `primitive_indices`: the input index of each
     /// BVH primitive id.
     pub fn build(aabbs: &[Aabb]) -> (Bvh, Vec<u32>) {
         Self::build_from_vec(aabbs.to_vec())
     }
 
     /// [`Bvh::build`] that consumes the boxes: the build scales them in place and frees
-    /// them before obvhs's conversion, the peak of memory for a million objects.
+    /// them before the conversion.
     pub fn build_from_vec(aabbs: Vec<Aabb>) -> (Bvh, Vec<u32>) {
-        let (cwbvh, scale) = build_cwbvh_from_vec(aabbs);
-        Self::from_cwbvh(cwbvh, scale)
+        let built = build_bvh2(aabbs);
+        let scale = built.scale;
+        let converted = bvh_wide::convert(&built.tree, |node| WideNode::new(node, scale));
+        match converted {
+            Some((nodes, primitive_indices)) => (Bvh { nodes }, primitive_indices),
+            // A tree obvhs's converter reads outside its tables on, or whose metadata the walk
+            // does not expect: whatever obvhs makes of it, as before.
+            None => {
+                let bvh2 = built.tree.to_bvh2();
+                drop(built);
+                let cwbvh = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&bvh2, 3, true, false);
+                Self::from_cwbvh(cwbvh, scale)
+            }
+        }
     }
 
     fn from_cwbvh(cwbvh: CwBvh, scale: BuildScale) -> (Bvh, Vec<u32>) {

@@ -1,5 +1,5 @@
-//! Builds the binary BVH that obvhs converts into its wide `CwBvh`: a binned SAH build with
-//! a median fallback, in O(n log n) for any finite input.
+//! Builds the binary BVH that `bvh_wide` converts into obvhs's wide nodes: a binned SAH
+//! build with a median fallback, in O(n log n) for any finite input.
 //!
 //! obvhs's own PLOC builder is not used, because two kinds of input break it:
 //!
@@ -17,11 +17,24 @@
 //! surface area heuristic; when the centroids coincide, or no bin split separates them, or
 //! the depth passes [`SAH_DEPTH_LIMIT`], the range is split at its median instead, so the
 //! depth stays below `SAH_DEPTH_LIMIT + log2(n) + 1` and every level costs O(n).
+//!
+//! For a million objects the build is bound by memory traffic, so the primitives' boxes
+//! (with their input index) are moved through the partitions rather than indices to them:
+//! every pass reads memory in order. Each split's partition pass also gathers the two
+//! children's bounds, and each inner node gets obvhs's wide-conversion decisions on the way
+//! back up (its costs need only its children's), so no pass over the tree is left for the
+//! converter but the one that writes the wide nodes. The tree is the one the earlier
+//! index-moving build made (the test `builds_the_tree_of_the_index_build` keeps that one):
+//! the primitives of a range lie in the order its indices did. A node's bounds are
+//! gathered in another order, which can change only the sign of a zero bound, and no wide
+//! node keeps that (the conversion's origin does; the walk's planes do not).
 
 use glam::Vec3A;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::node::Bvh2Node;
 use obvhs::bvh2::Bvh2;
+
+use crate::bvh_wide::{decide, leaf_costs, BinaryTree, Decision};
 
 /// Bins per axis for the surface area heuristic.
 const BINS: usize = 16;
@@ -87,9 +100,128 @@ pub fn round_up(v: f64) -> f32 {
     }
 }
 
+/// A primitive's box in build space and its input index: a leaf of the tree. 28 bytes (an
+/// `Aabb` takes 32): the leaves are alive through the whole build and conversion.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Prim {
+    min: [f32; 3],
+    index: u32,
+    max: [f32; 3],
+}
+
+impl Prim {
+    fn new(aabb: &Aabb, index: u32) -> Prim {
+        Prim {
+            min: aabb.min.to_array(),
+            index,
+            max: aabb.max.to_array(),
+        }
+    }
+
+    #[inline(always)]
+    fn aabb(&self) -> Aabb {
+        Aabb::new(Vec3A::from(self.min), Vec3A::from(self.max))
+    }
+
+    #[inline(always)]
+    fn centroid(&self) -> Vec3A {
+        (Vec3A::from(self.min) + Vec3A::from(self.max)) * 0.5
+    }
+}
+
+/// An inner node: its box, its two children (node ids, see [`BinaryBvh`]) and obvhs's seven
+/// conversion decisions for it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Inner {
+    min: [f32; 3],
+    first: u32,
+    max: [f32; 3],
+    second: u32,
+    decisions: [Decision; 7],
+}
+
+/// The binary BVH: node ids below `inner.len()` are inner nodes (the root is 0 when there
+/// are two primitives or more), id `inner.len() + k` is the leaf of `leaves[k]`, one
+/// primitive each, in tree order.
+#[derive(Clone, Debug, Default)]
+pub struct BinaryBvh {
+    inner: Vec<Inner>,
+    leaves: Vec<Prim>,
+}
+
+impl BinaryBvh {
+    fn leaf(&self, node: u32) -> &Prim {
+        &self.leaves[node as usize - self.inner.len()]
+    }
+
+    /// The same tree as obvhs's `Bvh2` (children in adjacent nodes), for obvhs's converter.
+    pub fn to_bvh2(&self) -> Bvh2 {
+        let mut nodes = Vec::with_capacity(self.node_count());
+        if self.node_count() > 0 {
+            nodes.push(Bvh2Node::default());
+        }
+        // (obvhs node, our node) pairs whose obvhs node is still to be filled in.
+        let mut pending = vec![(0usize, 0u32)];
+        while let Some((at, node)) = pending.pop() {
+            let filled = match self.children(node) {
+                Some([first, second]) => {
+                    let first_index = nodes.len();
+                    nodes.push(Bvh2Node::default());
+                    nodes.push(Bvh2Node::default());
+                    pending.push((first_index + 1, second));
+                    pending.push((first_index, first));
+                    Bvh2Node::new(self.aabb(node), 0, first_index as u32)
+                }
+                None => {
+                    let leaf = node - self.inner.len() as u32;
+                    Bvh2Node::new(self.aabb(node), 1, leaf)
+                }
+            };
+            if let Some(slot) = nodes.get_mut(at) {
+                *slot = filled;
+            }
+        }
+        Bvh2 {
+            nodes,
+            primitive_indices: self.leaves.iter().map(|p| p.index).collect(),
+            ..Bvh2::default()
+        }
+    }
+}
+
+impl BinaryTree for BinaryBvh {
+    fn node_count(&self) -> usize {
+        self.inner.len() + self.leaves.len()
+    }
+
+    fn aabb(&self, node: u32) -> Aabb {
+        match self.inner.get(node as usize) {
+            Some(inner) => Aabb::new(Vec3A::from(inner.min), Vec3A::from(inner.max)),
+            None => self.leaf(node).aabb(),
+        }
+    }
+
+    fn children(&self, node: u32) -> Option<[u32; 2]> {
+        self.inner
+            .get(node as usize)
+            .map(|inner| [inner.first, inner.second])
+    }
+
+    fn primitive(&self, leaf: u32) -> u32 {
+        self.leaf(leaf).index
+    }
+
+    fn decision(&self, node: u32, i: u8) -> Decision {
+        match self.inner.get(node as usize) {
+            Some(inner) => inner.decisions[usize::from(i)],
+            None => Decision::LEAF,
+        }
+    }
+}
+
 /// What a build did: its result and how much work it took, for tests that bound both.
 pub struct Built {
-    pub bvh2: Bvh2,
+    pub tree: BinaryBvh,
     pub scale: BuildScale,
     /// Primitives looked at over all splits: O(n log n) when the depth is O(log n). Only
     /// tests read the counts; counting costs one addition per node.
@@ -100,39 +232,55 @@ pub struct Built {
 }
 
 /// Builds the binary BVH over `aabbs` (one primitive per leaf, as obvhs's converter wants).
-/// The boxes are scaled in place, so that handing over a `Vec` costs no second copy.
+/// A `Vec` handed over is freed as soon as its boxes are leaves.
 pub fn build_bvh2(aabbs: impl Into<Vec<Aabb>>) -> Built {
-    let mut boxes: Vec<Aabb> = aabbs.into();
-    let scale = BuildScale::for_boxes(&boxes);
-    for b in &mut boxes {
-        *b = scale.scale_box(b);
-    }
-    let centroids: Vec<Vec3A> = boxes.iter().map(|b| (b.min + b.max) * 0.5).collect();
-    let mut prims: Vec<u32> = (0..boxes.len() as u32).collect();
-    let mut nodes = vec![Bvh2Node::default(); (2 * boxes.len()).saturating_sub(1)];
+    let aabbs: Vec<Aabb> = aabbs.into();
+    let scale = BuildScale::for_boxes(&aabbs);
+    let mut prims: Vec<Prim> = aabbs
+        .into_iter()
+        .enumerate()
+        .map(|(i, b)| Prim::new(&scale.scale_box(&b), i as u32))
+        .collect();
+    let mut inner = vec![Inner::default(); prims.len().saturating_sub(1)];
     let mut steps = 0;
     let mut depth = 0;
-    if let Some((root, region)) = nodes.split_first_mut() {
-        let input = Input {
-            boxes: &boxes,
-            centroids: &centroids,
+    if !prims.is_empty() {
+        let (bounds, centroid_bounds) = bounds_of(&prims);
+        let builder = Builder {
+            leaf_base: inner.len() as u32,
         };
-        let (node, work) = input.build(&mut prims, 0, region, 1, 0);
-        *root = node;
+        let range = Range {
+            bounds,
+            centroid_bounds,
+            first_leaf: 0,
+            first_inner: 0,
+            depth: 0,
+        };
+        let (_, _, work) = builder.build(&mut prims, &mut inner, range);
         steps = work.steps;
         depth = work.depth;
     }
-    let bvh2 = Bvh2 {
-        nodes,
-        primitive_indices: prims,
-        ..Bvh2::default()
-    };
     Built {
-        bvh2,
+        tree: BinaryBvh {
+            inner,
+            leaves: prims,
+        },
         scale,
         steps,
         depth,
     }
+}
+
+/// The bounds of the boxes and of their centroids, in one pass.
+fn bounds_of(prims: &[Prim]) -> (Aabb, Aabb) {
+    let mut bounds = Aabb::empty();
+    let mut centroid_bounds = Aabb::empty();
+    for p in prims {
+        bounds = bounds.union(&p.aabb());
+        let c = p.centroid();
+        centroid_bounds = centroid_bounds.union(&Aabb::new(c, c));
+    }
+    (bounds, centroid_bounds)
 }
 
 /// Steps taken and depth reached below one node.
@@ -142,164 +290,254 @@ struct Work {
     depth: u32,
 }
 
-struct Input<'a> {
-    boxes: &'a [Aabb],
-    centroids: &'a [Vec3A],
+/// A range of primitives to build a subtree over, with what its parent knows of it.
+#[derive(Clone, Copy)]
+struct Range {
+    bounds: Aabb,
+    centroid_bounds: Aabb,
+    /// Where the range starts among the leaves, and where its inner nodes start.
+    first_leaf: u32,
+    first_inner: u32,
+    depth: u32,
 }
 
-impl Input<'_> {
-    /// Builds the subtree over `prims` (which start at `prim_offset` in the final order) and
-    /// returns its root. Its descendants go into `region`, which starts at node index
-    /// `region_offset` and holds exactly `2·len − 2` nodes: the two children first, then the
-    /// left child's descendants, then the right child's. The layout depends only on the
-    /// input, so the result is the same on any number of threads.
+struct Builder {
+    /// The node id of leaf 0: the number of inner nodes.
+    leaf_base: u32,
+}
+
+impl Builder {
+    /// Builds the subtree over `prims` (the range's primitives) and returns its root's node
+    /// id and its seven conversion costs. Its inner nodes go into `inner`, which holds
+    /// exactly `len − 1` nodes: the root, then the left child's inner nodes, then the
+    /// right child's. The layout depends only on the input, so the result is the same on
+    /// any number of threads.
     fn build(
         &self,
-        prims: &mut [u32],
-        prim_offset: u32,
-        region: &mut [Bvh2Node],
-        region_offset: u32,
-        depth: u32,
-    ) -> (Bvh2Node, Work) {
-        // One pass for the node's box and the bounds of its centroids.
-        let mut bounds = Aabb::empty();
-        let mut centroid_bounds = Aabb::empty();
-        for &p in prims.iter() {
-            bounds = bounds.union(&self.boxes[p as usize]);
-            let c = self.centroids[p as usize];
-            centroid_bounds = centroid_bounds.union(&Aabb::new(c, c));
-        }
-        if prims.len() <= 1 {
-            let work = Work { steps: 1, depth };
-            return (Bvh2Node::new(bounds, 1, prim_offset), work);
-        }
+        prims: &mut [Prim],
+        inner: &mut [Inner],
+        range: Range,
+    ) -> (u32, [f32; 7], Work) {
         let len = prims.len();
-        let left_len = self.split(prims, &centroid_bounds, depth);
+        if len <= 1 {
+            let work = Work {
+                steps: 1,
+                depth: range.depth,
+            };
+            let id = self.leaf_base + range.first_leaf;
+            return (id, leaf_costs(range.bounds.half_area()), work);
+        }
+        let split = split(prims, &range.centroid_bounds, range.depth);
+        let left_len = split.left_len;
         let (left_prims, right_prims) = prims.split_at_mut(left_len);
-        let (children, below) = region.split_at_mut(2);
-        let (left_region, right_region) = below.split_at_mut(2 * left_len - 2);
-        let left_offset = region_offset + 2;
-        let right_offset = left_offset + left_region.len() as u32;
-        let right_prim_offset = prim_offset + left_len as u32;
-        let mut build_left =
-            move || self.build(left_prims, prim_offset, left_region, left_offset, depth + 1);
-        let mut build_right = move || {
-            self.build(
-                right_prims,
-                right_prim_offset,
-                right_region,
-                right_offset,
-                depth + 1,
-            )
+        let Some((node, below)) = inner.split_first_mut() else {
+            unreachable!("a range of two or more has an inner node");
         };
-        let ((left, left_work), (right, right_work)) = if len >= PARALLEL_RANGE {
-            rayon::join(build_left, build_right)
-        } else {
-            (build_left(), build_right())
+        let (left_inner, right_inner) = below.split_at_mut(left_len - 1);
+        let left = Range {
+            bounds: split.left_bounds,
+            centroid_bounds: split.left_centroids,
+            first_leaf: range.first_leaf,
+            first_inner: range.first_inner + 1,
+            depth: range.depth + 1,
         };
-        children[0] = left;
-        children[1] = right;
+        let right = Range {
+            bounds: split.right_bounds,
+            centroid_bounds: split.right_centroids,
+            first_leaf: range.first_leaf + left_len as u32,
+            first_inner: left.first_inner + left_inner.len() as u32,
+            depth: range.depth + 1,
+        };
+        let mut build_left = move || self.build(left_prims, left_inner, left);
+        let mut build_right = move || self.build(right_prims, right_inner, right);
+        let ((first, first_costs, left_work), (second, second_costs, right_work)) =
+            if len >= PARALLEL_RANGE {
+                rayon::join(build_left, build_right)
+            } else {
+                (build_left(), build_right())
+            };
+        let (costs, decisions) = decide(
+            range.bounds.half_area(),
+            &first_costs,
+            &second_costs,
+            len as u32,
+        );
+        *node = Inner {
+            min: range.bounds.min.to_array(),
+            first,
+            max: range.bounds.max.to_array(),
+            second,
+            decisions,
+        };
         let work = Work {
             steps: len as u64 + left_work.steps + right_work.steps,
             depth: left_work.depth.max(right_work.depth),
         };
-        (Bvh2Node::new(bounds, 0, region_offset), work)
-    }
-
-    /// Reorders `prims` into two non-empty parts and returns the length of the first.
-    fn split(&self, prims: &mut [u32], centroid_bounds: &Aabb, depth: u32) -> usize {
-        let lo = centroid_bounds.min;
-        let extent = centroid_bounds.max - lo;
-        let axis = extent.max_position();
-        if extent[axis] > 0.0 && depth < SAH_DEPTH_LIMIT {
-            if let Some(left_len) = self.sah_split(prims, lo, extent) {
-                return left_len;
-            }
-        }
-        self.median_split(prims, axis)
-    }
-
-    /// The cheapest bin boundary over the three axes, applied; `None` when no boundary
-    /// leaves both sides non-empty.
-    fn sah_split(&self, prims: &mut [u32], lo: Vec3A, extent: Vec3A) -> Option<usize> {
-        let bin_of = |c: Vec3A, axis: usize| -> usize {
-            let x = (c[axis] - lo[axis]) / extent[axis] * BINS as f32;
-            // `as` saturates, and NaN becomes 0.
-            (x as usize).min(BINS - 1)
-        };
-        // One pass bins every primitive on all three axes.
-        let mut counts = [[0u32; BINS]; 3];
-        let mut bin_boxes = [[Aabb::empty(); BINS]; 3];
-        for &p in prims.iter() {
-            let (c, aabb) = (self.centroids[p as usize], &self.boxes[p as usize]);
-            for axis in 0..3 {
-                let b = bin_of(c, axis);
-                counts[axis][b] += 1;
-                bin_boxes[axis][b] = bin_boxes[axis][b].union(aabb);
-            }
-        }
-        let mut best: Option<(f32, usize, usize)> = None;
-        for axis in 0..3 {
-            if extent[axis] <= 0.0 {
-                continue;
-            }
-            let (counts, boxes) = (&counts[axis], &bin_boxes[axis]);
-            // Right-to-left sweep of areas, then left to right for the costs.
-            let mut right_area = [0.0f32; BINS];
-            let mut acc = Aabb::empty();
-            for b in (1..BINS).rev() {
-                acc = acc.union(&boxes[b]);
-                right_area[b] = acc.half_area();
-            }
-            let (mut left_box, mut left_count) = (Aabb::empty(), 0u32);
-            for b in 0..BINS - 1 {
-                left_box = left_box.union(&boxes[b]);
-                left_count += counts[b];
-                let right_count = prims.len() as u32 - left_count;
-                if left_count == 0 || right_count == 0 {
-                    continue;
-                }
-                let cost = left_box.half_area() * left_count as f32
-                    + right_area[b + 1] * right_count as f32;
-                if best.is_none_or(|(c, ..)| cost < c) {
-                    best = Some((cost, axis, b));
-                }
-            }
-        }
-        let (_, axis, last_left_bin) = best?;
-        let left_len = partition(prims, |p| {
-            bin_of(self.centroids[p as usize], axis) <= last_left_bin
-        });
-        (left_len > 0 && left_len < prims.len()).then_some(left_len)
-    }
-
-    /// Halves `prims` at the median centroid along `axis` (ties by index, so the result is
-    /// a function of the input alone).
-    fn median_split(&self, prims: &mut [u32], axis: usize) -> usize {
-        let mid = prims.len() / 2;
-        prims.select_nth_unstable_by(mid, |&a, &b| {
-            let (ca, cb) = (self.centroids[a as usize], self.centroids[b as usize]);
-            ca[axis].total_cmp(&cb[axis]).then(a.cmp(&b))
-        });
-        mid
+        (range.first_inner, costs, work)
     }
 }
 
-/// Moves the elements for which `left` holds to the front (in place); returns their count.
-fn partition(prims: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
-    let mut first_right = 0;
-    for i in 0..prims.len() {
-        if left(prims[i]) {
-            prims.swap(i, first_right);
-            first_right += 1;
+/// Where a range was split and the bounds of its two parts.
+struct Split {
+    left_len: usize,
+    left_bounds: Aabb,
+    left_centroids: Aabb,
+    right_bounds: Aabb,
+    right_centroids: Aabb,
+}
+
+/// Reorders `prims` into two non-empty parts.
+fn split(prims: &mut [Prim], centroid_bounds: &Aabb, depth: u32) -> Split {
+    let lo = centroid_bounds.min;
+    let extent = centroid_bounds.max - lo;
+    let axis = extent.max_position();
+    if extent[axis] > 0.0 && depth < SAH_DEPTH_LIMIT {
+        if prims.len() == 2 {
+            return pair_split(prims, extent);
+        }
+        if let Some(split) = sah_split(prims, lo, extent) {
+            return split;
         }
     }
-    first_right
+    median_split(prims, axis)
+}
+
+/// [`sah_split`] of two primitives whose centroids differ, in closed form (half the
+/// ranges are pairs, and binning them costs far more than the pair): on every axis where
+/// the centroids differ the two fall into the first and the last bin, and the cost is the
+/// sum of their two half areas whatever the axis, so the first such axis wins and the
+/// primitive with the lower centroid on it goes first.
+fn pair_split(prims: &mut [Prim], extent: Vec3A) -> Split {
+    let axis = (0..3).find(|&a| extent[a] > 0.0).unwrap_or(0);
+    if prims[1].centroid()[axis] < prims[0].centroid()[axis] {
+        prims.swap(0, 1);
+    }
+    let side = |p: &Prim| {
+        let c = p.centroid();
+        (
+            Aabb::empty().union(&p.aabb()),
+            Aabb::empty().union(&Aabb::new(c, c)),
+        )
+    };
+    let (left_bounds, left_centroids) = side(&prims[0]);
+    let (right_bounds, right_centroids) = side(&prims[1]);
+    Split {
+        left_len: 1,
+        left_bounds,
+        left_centroids,
+        right_bounds,
+        right_centroids,
+    }
+}
+
+/// The cheapest bin boundary over the three axes, applied; `None` when no boundary leaves
+/// both sides non-empty.
+fn sah_split(prims: &mut [Prim], lo: Vec3A, extent: Vec3A) -> Option<Split> {
+    // A centroid's bin on each axis: `((c - lo) / extent * BINS) as usize`, at most the
+    // last bin, for the three axes at once. Clamping to [0, BINS − 1] first gives what
+    // `as` gives (it saturates, and makes NaN 0: so does `max` with 0, which returns its
+    // argument for NaN); the truncated bin plus 2^23 then holds the bin in its low
+    // mantissa bits, exactly, which spares three saturating conversions per primitive.
+    let bins = Vec3A::splat(BINS as f32);
+    let last_bin = Vec3A::splat((BINS - 1) as f32);
+    let two_to_23 = Vec3A::splat(8_388_608.0);
+    let bins_of = |c: Vec3A| -> [usize; 3] {
+        let x = ((c - lo) / extent * bins).max(Vec3A::ZERO).min(last_bin);
+        let shifted = x.trunc() + two_to_23;
+        shifted.to_array().map(|v| (v.to_bits() & 0xff) as usize)
+    };
+    // One pass bins every primitive on all three axes.
+    let mut counts = [[0u32; BINS]; 3];
+    let mut bin_boxes = [[Aabb::empty(); BINS]; 3];
+    for p in prims.iter() {
+        let (c, aabb) = (p.centroid(), p.aabb());
+        for (axis, b) in bins_of(c).into_iter().enumerate() {
+            counts[axis][b] += 1;
+            bin_boxes[axis][b] = bin_boxes[axis][b].union(&aabb);
+        }
+    }
+    let mut best: Option<(f32, usize, usize)> = None;
+    for axis in 0..3 {
+        if extent[axis] <= 0.0 {
+            continue;
+        }
+        let (counts, boxes) = (&counts[axis], &bin_boxes[axis]);
+        // Right-to-left sweep of areas, then left to right for the costs.
+        let mut right_area = [0.0f32; BINS];
+        let mut acc = Aabb::empty();
+        for b in (1..BINS).rev() {
+            acc = acc.union(&boxes[b]);
+            right_area[b] = acc.half_area();
+        }
+        let (mut left_box, mut left_count) = (Aabb::empty(), 0u32);
+        for b in 0..BINS - 1 {
+            left_box = left_box.union(&boxes[b]);
+            left_count += counts[b];
+            let right_count = prims.len() as u32 - left_count;
+            if left_count == 0 || right_count == 0 {
+                continue;
+            }
+            let cost =
+                left_box.half_area() * left_count as f32 + right_area[b + 1] * right_count as f32;
+            if best.is_none_or(|(c, ..)| cost < c) {
+                best = Some((cost, axis, b));
+            }
+        }
+    }
+    let (_, axis, last_left_bin) = best?;
+    // Moves the primitives of the bins up to `last_left_bin` to the front, in the order the
+    // index build moved its indices, and gathers the bounds of both sides on the way.
+    let mut split = Split {
+        left_len: 0,
+        left_bounds: Aabb::empty(),
+        left_centroids: Aabb::empty(),
+        right_bounds: Aabb::empty(),
+        right_centroids: Aabb::empty(),
+    };
+    for i in 0..prims.len() {
+        let p = prims[i];
+        let c = p.centroid();
+        if bins_of(c)[axis] <= last_left_bin {
+            split.left_bounds = split.left_bounds.union(&p.aabb());
+            split.left_centroids = split.left_centroids.union(&Aabb::new(c, c));
+            if i != split.left_len {
+                prims.swap(i, split.left_len);
+            }
+            split.left_len += 1;
+        } else {
+            split.right_bounds = split.right_bounds.union(&p.aabb());
+            split.right_centroids = split.right_centroids.union(&Aabb::new(c, c));
+        }
+    }
+    (split.left_len > 0 && split.left_len < prims.len()).then_some(split)
+}
+
+/// Halves `prims` at the median centroid along `axis` (ties by input index, so the result
+/// is a function of the input alone).
+fn median_split(prims: &mut [Prim], axis: usize) -> Split {
+    let mid = prims.len() / 2;
+    prims.select_nth_unstable_by(mid, |a, b| {
+        let (ca, cb) = (a.centroid(), b.centroid());
+        ca[axis].total_cmp(&cb[axis]).then(a.index.cmp(&b.index))
+    });
+    let (left, right) = prims.split_at(mid);
+    let (left_bounds, left_centroids) = bounds_of(left);
+    let (right_bounds, right_centroids) = bounds_of(right);
+    Split {
+        left_len: mid,
+        left_bounds,
+        left_centroids,
+        right_bounds,
+        right_centroids,
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bvh_wide::{convert, DecidedBvh2};
+    use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
+    use obvhs::cwbvh::node::CwBvhNode;
 
     fn unit_boxes_at(centers: impl Iterator<Item = Vec3A>) -> Vec<Aabb> {
         centers.map(|c| Aabb::new(c - 1.0, c + 1.0)).collect()
@@ -315,7 +553,7 @@ mod tests {
         );
         let bound = n as u64 * u64::from(SAH_DEPTH_LIMIT + log2 + 2);
         assert!(built.steps <= bound, "{} steps for {n}", built.steps);
-        assert_eq!(built.bvh2.primitive_indices.len(), n);
+        assert_eq!(built.tree.leaves.len(), n);
     }
 
     /// 40,000 coincident objects (`for i in 0..40000 { sphere { } }`) took 35 s with PLOC
@@ -350,29 +588,35 @@ mod tests {
     }
 
     /// A large build is a tree: each node's box holds its children's (and a leaf's its
-    /// primitive's scaled box), and every primitive is in exactly one leaf.
+    /// primitive's scaled box), every node but the root is the child of one node, and every
+    /// primitive is in exactly one leaf.
     #[test]
     fn large_builds_are_valid_trees() {
         let n = 50_000;
         let aabbs = scattered(n);
         let built = build_bvh2(&aabbs[..]);
         assert_n_log_n(&built, n);
-        let bvh2 = &built.bvh2;
+        let tree = &built.tree;
         let contains = |outer: &Aabb, inner: &Aabb| {
             outer.min.cmple(inner.min).all() && outer.max.cmpge(inner.max).all()
         };
-        let mut seen = vec![false; n];
-        for node in &bvh2.nodes {
-            if node.prim_count == 0 {
-                for child in [node.first_index, node.first_index + 1] {
-                    let child = &bvh2.nodes[child as usize];
-                    assert!(contains(node.aabb(), child.aabb()));
-                }
-            } else {
-                let prim = bvh2.primitive_indices[node.first_index as usize] as usize;
-                assert!(!std::mem::replace(&mut seen[prim], true), "{prim} twice");
-                assert!(contains(node.aabb(), &built.scale.scale_box(&aabbs[prim])));
+        let mut parents = vec![0u32; tree.node_count()];
+        for node in 0..tree.inner.len() as u32 {
+            let Some(children) = tree.children(node) else {
+                panic!("inner node {node} without children");
+            };
+            for child in children {
+                assert!(contains(&tree.aabb(node), &tree.aabb(child)));
+                parents[child as usize] += 1;
             }
+        }
+        assert_eq!(parents[0], 0);
+        assert!(parents[1..].iter().all(|&p| p == 1));
+        let mut seen = vec![false; n];
+        for leaf in &tree.leaves {
+            let prim = leaf.index as usize;
+            assert!(!std::mem::replace(&mut seen[prim], true), "{prim} twice");
+            assert_eq!(leaf.aabb(), built.scale.scale_box(&aabbs[prim]));
         }
         assert!(seen.iter().all(|&s| s));
     }
@@ -387,26 +631,16 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .unwrap_or_else(|e| panic!("no pool: {e}"));
-            pool.install(|| build_bvh2(&aabbs[..])).bvh2
+            pool.install(|| build_bvh2(&aabbs[..])).tree
         };
         let one = build_on(1);
         let three = build_on(3);
-        assert_eq!(one.primitive_indices, three.primitive_indices);
-        let key = |b: &Bvh2| -> Vec<_> {
-            b.nodes
-                .iter()
-                .map(|n| {
-                    (
-                        n.aabb().min.to_array(),
-                        n.aabb().max.to_array(),
-                        n.prim_count,
-                        n.first_index,
-                    )
-                })
-                .collect()
-        };
         assert!(
-            key(&one) == key(&three),
+            one.leaves == three.leaves,
+            "1 and 3 threads order leaves differently"
+        );
+        assert!(
+            one.inner == three.inner,
             "1 and 3 threads build different trees"
         );
     }
@@ -433,6 +667,175 @@ mod tests {
                     assert!(f64::from(scaled.min[axis]) <= f64::from(b.min[axis]) * scale.factor());
                     assert!(f64::from(scaled.max[axis]) >= f64::from(b.max[axis]) * scale.factor());
                 }
+            }
+        }
+    }
+
+    /// The wide nodes and primitive order from this build, and from the index-moving build
+    /// it replaced through obvhs's own converter: the walk's order must not change.
+    #[test]
+    fn builds_the_tree_of_the_index_build() {
+        for (name, aabbs) in crate::bvh_wide::tests::inputs() {
+            let tree = build_bvh2(&aabbs[..]).tree;
+            let Some((nodes, order)) = convert(&tree, |n: &CwBvhNode| Some(*n)) else {
+                panic!("{name}: no conversion");
+            };
+            let reference = bvh2_to_cwbvh(&index_build::build(&aabbs), 3, true, false);
+            assert_eq!(order, reference.primitive_indices, "{name}");
+            // `==` on the origin: the two builds gather a node's bounds in different orders,
+            // which may differ in the sign of a zero (the walk's planes do not).
+            assert!(nodes == reference.nodes, "{name}");
+        }
+    }
+
+    /// obvhs's converter reads the tree given to it in obvhs's layout as this converter
+    /// reads it (the fallback when this converter gives up).
+    #[test]
+    fn the_obvhs_layout_holds_the_same_tree() {
+        for (name, aabbs) in crate::bvh_wide::tests::inputs() {
+            let tree = build_bvh2(&aabbs[..]).tree;
+            let bvh2 = tree.to_bvh2();
+            let ours = convert(&tree, |n: &CwBvhNode| Some(*n));
+            let theirs = convert(&DecidedBvh2::new(&bvh2), |n: &CwBvhNode| Some(*n));
+            assert!(ours.is_some() && ours == theirs, "{name}");
+        }
+    }
+
+    /// The build this module's replaced: indices moved through the partitions, each node's
+    /// bounds gathered from its own range, into obvhs's `Bvh2`.
+    mod index_build {
+        use super::*;
+
+        pub fn build(aabbs: &[Aabb]) -> Bvh2 {
+            let scale = BuildScale::for_boxes(aabbs);
+            let boxes: Vec<Aabb> = aabbs.iter().map(|b| scale.scale_box(b)).collect();
+            let centroids: Vec<Vec3A> = boxes.iter().map(|b| (b.min + b.max) * 0.5).collect();
+            let mut prims: Vec<u32> = (0..boxes.len() as u32).collect();
+            let mut nodes = vec![Bvh2Node::default(); (2 * boxes.len()).saturating_sub(1)];
+            if let Some((root, region)) = nodes.split_first_mut() {
+                let input = Input {
+                    boxes: &boxes,
+                    centroids: &centroids,
+                };
+                *root = input.build(&mut prims, 0, region, 1, 0);
+            }
+            Bvh2 {
+                nodes,
+                primitive_indices: prims,
+                ..Bvh2::default()
+            }
+        }
+
+        struct Input<'a> {
+            boxes: &'a [Aabb],
+            centroids: &'a [Vec3A],
+        }
+
+        impl Input<'_> {
+            fn build(
+                &self,
+                prims: &mut [u32],
+                prim_offset: u32,
+                region: &mut [Bvh2Node],
+                region_offset: u32,
+                depth: u32,
+            ) -> Bvh2Node {
+                let mut bounds = Aabb::empty();
+                let mut centroid_bounds = Aabb::empty();
+                for &p in prims.iter() {
+                    bounds = bounds.union(&self.boxes[p as usize]);
+                    let c = self.centroids[p as usize];
+                    centroid_bounds = centroid_bounds.union(&Aabb::new(c, c));
+                }
+                if prims.len() <= 1 {
+                    return Bvh2Node::new(bounds, 1, prim_offset);
+                }
+                let left_len = self.split(prims, &centroid_bounds, depth);
+                let (left_prims, right_prims) = prims.split_at_mut(left_len);
+                let (children, below) = region.split_at_mut(2);
+                let (left_region, right_region) = below.split_at_mut(2 * left_len - 2);
+                let left_offset = region_offset + 2;
+                let right_offset = left_offset + left_region.len() as u32;
+                children[0] =
+                    self.build(left_prims, prim_offset, left_region, left_offset, depth + 1);
+                children[1] = self.build(
+                    right_prims,
+                    prim_offset + left_len as u32,
+                    right_region,
+                    right_offset,
+                    depth + 1,
+                );
+                Bvh2Node::new(bounds, 0, region_offset)
+            }
+
+            fn split(&self, prims: &mut [u32], centroid_bounds: &Aabb, depth: u32) -> usize {
+                let lo = centroid_bounds.min;
+                let extent = centroid_bounds.max - lo;
+                let axis = extent.max_position();
+                if extent[axis] > 0.0 && depth < SAH_DEPTH_LIMIT {
+                    if let Some(left_len) = self.sah_split(prims, lo, extent) {
+                        return left_len;
+                    }
+                }
+                let mid = prims.len() / 2;
+                prims.select_nth_unstable_by(mid, |&a, &b| {
+                    let (ca, cb) = (self.centroids[a as usize], self.centroids[b as usize]);
+                    ca[axis].total_cmp(&cb[axis]).then(a.cmp(&b))
+                });
+                mid
+            }
+
+            fn sah_split(&self, prims: &mut [u32], lo: Vec3A, extent: Vec3A) -> Option<usize> {
+                let bin_of = |c: Vec3A, axis: usize| -> usize {
+                    let x = (c[axis] - lo[axis]) / extent[axis] * BINS as f32;
+                    (x as usize).min(BINS - 1)
+                };
+                let mut counts = [[0u32; BINS]; 3];
+                let mut bin_boxes = [[Aabb::empty(); BINS]; 3];
+                for &p in prims.iter() {
+                    let (c, aabb) = (self.centroids[p as usize], &self.boxes[p as usize]);
+                    for axis in 0..3 {
+                        let b = bin_of(c, axis);
+                        counts[axis][b] += 1;
+                        bin_boxes[axis][b] = bin_boxes[axis][b].union(aabb);
+                    }
+                }
+                let mut best: Option<(f32, usize, usize)> = None;
+                for axis in 0..3 {
+                    if extent[axis] <= 0.0 {
+                        continue;
+                    }
+                    let (counts, boxes) = (&counts[axis], &bin_boxes[axis]);
+                    let mut right_area = [0.0f32; BINS];
+                    let mut acc = Aabb::empty();
+                    for b in (1..BINS).rev() {
+                        acc = acc.union(&boxes[b]);
+                        right_area[b] = acc.half_area();
+                    }
+                    let (mut left_box, mut left_count) = (Aabb::empty(), 0u32);
+                    for b in 0..BINS - 1 {
+                        left_box = left_box.union(&boxes[b]);
+                        left_count += counts[b];
+                        let right_count = prims.len() as u32 - left_count;
+                        if left_count == 0 || right_count == 0 {
+                            continue;
+                        }
+                        let cost = left_box.half_area() * left_count as f32
+                            + right_area[b + 1] * right_count as f32;
+                        if best.is_none_or(|(c, ..)| cost < c) {
+                            best = Some((cost, axis, b));
+                        }
+                    }
+                }
+                let (_, axis, last_left_bin) = best?;
+                let mut first_right = 0;
+                for i in 0..prims.len() {
+                    if bin_of(self.centroids[prims[i] as usize], axis) <= last_left_bin {
+                        prims.swap(i, first_right);
+                        first_right += 1;
+                    }
+                }
+                (first_right > 0 && first_right < prims.len()).then_some(first_right)
             }
         }
     }

@@ -9,6 +9,7 @@
 mod bounds;
 mod bvh;
 mod bvh_build;
+mod bvh_wide;
 mod camera;
 mod csg;
 pub mod display;

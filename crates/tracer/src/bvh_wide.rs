@@ -1,0 +1,547 @@
+//! Converts the binary BVH into obvhs's compressed wide nodes exactly as obvhs's
+//! `bvh2_to_cwbvh(bvh2, 3, true, false)` does (same nodes, same `primitive_indices`), in
+//! less memory and time.
+//!
+//! The walk must visit primitives in obvhs's order (see `bvh.rs`), so this is a transcription
+//! of obvhs's converter (the cost table of Ylitie et al. 2017, the greedy octant ordering of
+//! children, the quantisation), with the same f32 and glam operations in the same order.
+//! What differs is what is kept: obvhs keeps a 56-byte cost table per binary node (7
+//! decisions with their costs) for the whole conversion, 112 MB for a million primitives.
+//! Here the binary build computes each inner node's costs on its way back up ([`decide`],
+//! from its children's, which are then dropped) and keeps only its 7 decisions, a byte
+//! each. Each wide node is handed to a caller's function as soon as it is complete, so the
+//! caller can store its own form of the node and never holds obvhs's.
+//! The test in `tests` compares the two converters node for node on many inputs.
+
+use glam::Vec3A;
+use obvhs::aabb::Aabb;
+#[cfg(test)]
+use obvhs::bvh2::Bvh2;
+use obvhs::cwbvh::node::CwBvhNode;
+
+/// What the converter reads of a binary BVH whose leaves hold one primitive each, with
+/// obvhs's conversion decisions for each node (see [`decide`]).
+pub trait BinaryTree {
+    /// Node ids are below this; the root is 0.
+    fn node_count(&self) -> usize;
+    fn aabb(&self, node: u32) -> Aabb;
+    /// The two children of an inner node; `None` for a leaf.
+    fn children(&self, node: u32) -> Option<[u32; 2]>;
+    /// The input index of a leaf's primitive.
+    fn primitive(&self, leaf: u32) -> u32;
+    /// Decision `i` of `node` ([`Decision::LEAF`] for a leaf).
+    fn decision(&self, node: u32, i: u8) -> Decision;
+}
+
+/// An obvhs `Bvh2` with its decisions, for converting trees made by other builders (the
+/// tests' reference build).
+#[cfg(test)]
+pub struct DecidedBvh2<'a> {
+    bvh2: &'a Bvh2,
+    decisions: Vec<[Decision; 7]>,
+}
+
+#[cfg(test)]
+impl DecidedBvh2<'_> {
+    pub fn new(bvh2: &Bvh2) -> DecidedBvh2<'_> {
+        let mut tree = DecidedBvh2 {
+            bvh2,
+            decisions: vec![[Decision::LEAF; 7]; bvh2.nodes.len()],
+        };
+        if !bvh2.nodes.is_empty() {
+            tree.costs(0);
+        }
+        tree
+    }
+
+    /// obvhs's `calculate_cost_impl` over the subtree of `node`: the decisions of its
+    /// nodes, and its costs and primitive count.
+    fn costs(&mut self, node: u32) -> ([f32; 7], u32) {
+        let half_area = self.aabb(node).half_area();
+        let Some([first, second]) = self.children(node) else {
+            return (leaf_costs(half_area), 1);
+        };
+        let (first_costs, first_count) = self.costs(first);
+        let (second_costs, second_count) = self.costs(second);
+        let count = first_count + second_count;
+        let (costs, decisions) = decide(half_area, &first_costs, &second_costs, count);
+        self.decisions[node as usize] = decisions;
+        (costs, count)
+    }
+}
+
+#[cfg(test)]
+impl BinaryTree for DecidedBvh2<'_> {
+    fn node_count(&self) -> usize {
+        self.bvh2.nodes.len()
+    }
+
+    fn aabb(&self, node: u32) -> Aabb {
+        *self.bvh2.nodes[node as usize].aabb()
+    }
+
+    fn children(&self, node: u32) -> Option<[u32; 2]> {
+        let node = &self.bvh2.nodes[node as usize];
+        (node.prim_count == 0).then_some([node.first_index, node.first_index + 1])
+    }
+
+    fn primitive(&self, leaf: u32) -> u32 {
+        self.bvh2.primitive_indices[self.bvh2.nodes[leaf as usize].first_index as usize]
+    }
+
+    fn decision(&self, node: u32, i: u8) -> Decision {
+        self.decisions[node as usize][usize::from(i)]
+    }
+}
+
+/// obvhs's cost of a primitive relative to a node visit.
+const PRIM_COST: f32 = 0.3;
+/// Most primitives in one wide leaf (the converter's `max_prims_per_leaf`).
+const MAX_PRIMS_PER_LEAF: u32 = 3;
+/// obvhs's `DENOM`: one over the quantisation's 255 steps.
+const DENOM: f32 = 1.0 / 255.0;
+
+/// One of obvhs's decisions in a byte: what the node is when it gets `i + 1` of a wide
+/// node's slots (`kind`), and how the slots are shared between its children (`left` and
+/// `right`, each below 7, or [`NONE`] when no finite cost chose them).
+#[derive(Clone, Copy, Default, PartialEq, Eq, Debug)]
+pub struct Decision(u8);
+
+const LEAF: u8 = 0;
+const INTERNAL: u8 = 1;
+const DISTRIBUTE: u8 = 2;
+/// obvhs's `INVALID` distribution, which it would use as an index if it ever read it.
+const NONE: u8 = 7;
+
+impl Decision {
+    /// A leaf's decisions: it stays a leaf whatever it gets.
+    pub const LEAF: Decision = Decision(0);
+
+    fn new(kind: u8, left: u8, right: u8) -> Decision {
+        Decision(kind << 6 | right.min(NONE) << 3 | left.min(NONE))
+    }
+
+    fn kind(self) -> u8 {
+        self.0 >> 6
+    }
+
+    fn left(self) -> u8 {
+        self.0 & 0b111
+    }
+
+    fn right(self) -> u8 {
+        (self.0 >> 3) & 0b111
+    }
+}
+
+/// Converts `tree` (rooted at node 0) into wide nodes, each turned into a `T` by `make` as
+/// soon as it is complete. Returns the nodes and `primitive_indices`, or `None` where
+/// obvhs's converter would read outside its tables (no finite cost chose a distribution)
+/// or `make` refuses a node.
+pub fn convert<T: Clone + Default>(
+    tree: &impl BinaryTree,
+    make: impl Fn(&CwBvhNode) -> Option<T>,
+) -> Option<(Vec<T>, Vec<u32>)> {
+    if tree.node_count() == 0 {
+        return Some((Vec::new(), Vec::new()));
+    }
+    let mut converter = Converter {
+        tree,
+        nodes: vec![T::default()],
+        primitive_indices: Vec::new(),
+        make,
+    };
+    converter.node(0, 0)?;
+    Some((converter.nodes, converter.primitive_indices))
+}
+
+/// obvhs's costs of a leaf of one primitive with this half area (the same for any number
+/// of wide slots).
+pub fn leaf_costs(half_area: f32) -> [f32; 7] {
+    [half_area * 1.0 * PRIM_COST; 7]
+}
+
+/// obvhs's `calculate_cost_impl` for an inner node of `num_primitives` primitives, from
+/// its children's costs: its costs and its decisions. Entry `i` is for the node getting
+/// `i + 1` slots of a wide node: a leaf or a wide node of its own (`i = 0`), or the slots
+/// shared between its children.
+pub fn decide(
+    half_area: f32,
+    first_costs: &[f32; 7],
+    second_costs: &[f32; 7],
+    num_primitives: u32,
+) -> ([f32; 7], [Decision; 7]) {
+    let mut cost = [0.0f32; 7];
+    let mut decided = [Decision::default(); 7];
+
+    let cost_leaf = if num_primitives <= MAX_PRIMS_PER_LEAF {
+        (num_primitives as f32) * half_area * PRIM_COST
+    } else {
+        f32::INFINITY
+    };
+    let mut cost_distribute = f32::INFINITY;
+    let (mut left, mut right) = (NONE, NONE);
+    for k in 0..7 {
+        let c = first_costs[k] + second_costs[6 - k];
+        if c < cost_distribute {
+            cost_distribute = c;
+            left = k as u8;
+            right = 6 - k as u8;
+        }
+    }
+    let cost_internal = cost_distribute + half_area;
+    if cost_leaf < cost_internal {
+        cost[0] = cost_leaf;
+        decided[0] = Decision::new(LEAF, left, right);
+    } else {
+        cost[0] = cost_internal;
+        decided[0] = Decision::new(INTERNAL, left, right);
+    }
+
+    for i in 1..7 {
+        let mut cost_distribute = cost[i - 1];
+        let mut chosen = None;
+        for k in 0..i {
+            let c = first_costs[k] + second_costs[i - k - 1];
+            if c < cost_distribute {
+                cost_distribute = c;
+                chosen = Some((k as u8, (i - k - 1) as u8));
+            }
+        }
+        cost[i] = cost_distribute;
+        decided[i] = match chosen {
+            Some((left, right)) => Decision::new(DISTRIBUTE, left, right),
+            None => decided[i - 1],
+        };
+    }
+    (cost, decided)
+}
+
+struct Converter<'a, Tree, T, Make> {
+    tree: &'a Tree,
+    nodes: Vec<T>,
+    primitive_indices: Vec<u32>,
+    make: Make,
+}
+
+impl<Tree: BinaryTree, T: Clone + Default, Make: Fn(&CwBvhNode) -> Option<T>>
+    Converter<'_, Tree, T, Make>
+{
+    /// obvhs's `convert_to_cwbvh_impl`: wide node `wide` from binary node `node`, then its
+    /// inner children, depth first.
+    fn node(&mut self, wide: usize, node: u32) -> Option<()> {
+        let aabb = self.tree.aabb(node);
+        let mut out = CwBvhNode::default();
+        let node_p = aabb.min;
+        out.p = node_p.into();
+        let e = ((aabb.max - aabb.min).max(Vec3A::splat(1e-20)) * DENOM)
+            .log2()
+            .ceil()
+            .exp2();
+        let rcp_e = 1.0 / e;
+        // Only the exponent bits of a power of two are set.
+        out.e = [e.x, e.y, e.z].map(|c| (c.to_bits() >> 23) as u8);
+
+        let mut children = [u32::MAX; 8];
+        let mut child_count = 0;
+        self.children(node, &mut children, &mut child_count, 0)?;
+        self.order_children(node, &mut children, child_count);
+
+        out.primitive_base_idx = self.primitive_indices.len() as u32;
+        out.child_base_idx = self.nodes.len() as u32;
+        let mut num_internal_nodes = 0;
+        let mut num_primitives = 0u32;
+        for (i, &child) in children.iter().enumerate() {
+            if child == u32::MAX {
+                continue;
+            }
+            let child_aabb = self.tree.aabb(child);
+            const PAD: f32 = 0.0;
+            let child_min = ((child_aabb.min - node_p - PAD) * rcp_e)
+                .floor()
+                .clamp(Vec3A::ZERO, Vec3A::splat(255.0));
+            let child_max = ((child_aabb.max - node_p + PAD) * rcp_e)
+                .ceil()
+                .clamp(Vec3A::ZERO, Vec3A::splat(255.0));
+            out.child_min_x[i] = child_min.x as u8;
+            out.child_min_y[i] = child_min.y as u8;
+            out.child_min_z[i] = child_min.z as u8;
+            out.child_max_x[i] = child_max.x as u8;
+            out.child_max_y[i] = child_max.y as u8;
+            out.child_max_z[i] = child_max.z as u8;
+            match self.tree.decision(child, 0).kind() {
+                LEAF => {
+                    let count = self.push_primitives(child);
+                    out.child_meta[i] = num_primitives as u8
+                        | match count {
+                            1 => 0b0010_0000,
+                            2 => 0b0110_0000,
+                            3 => 0b1110_0000,
+                            // obvhs panics here; no wide tree.
+                            _ => return None,
+                        };
+                    num_primitives += count;
+                }
+                _ => {
+                    out.imask |= 1 << i;
+                    out.child_meta[i] = (24 + i as u8) | 0b0010_0000;
+                    num_internal_nodes += 1;
+                }
+            }
+        }
+        let made = (self.make)(&out)?;
+        self.nodes
+            .resize(self.nodes.len() + num_internal_nodes, T::default());
+        self.nodes[wide] = made;
+
+        let mut offset = 0;
+        for (i, &child) in children.iter().enumerate() {
+            if child != u32::MAX && out.imask & (1 << i) != 0 {
+                self.node((out.child_base_idx + offset) as usize, child)?;
+                offset += 1;
+            }
+        }
+        Some(())
+    }
+
+    /// obvhs's `count_primitives`: appends the primitives below `node`, left first, and
+    /// returns how many.
+    fn push_primitives(&mut self, node: u32) -> u32 {
+        match self.tree.children(node) {
+            None => {
+                self.primitive_indices.push(self.tree.primitive(node));
+                1
+            }
+            Some([first, second]) => self.push_primitives(first) + self.push_primitives(second),
+        }
+    }
+
+    /// obvhs's `get_children`: the binary nodes that become the slots of a wide node when
+    /// `node` gets `i + 1` of them.
+    fn children(&self, node: u32, children: &mut [u32; 8], count: &mut usize, i: u8) -> Option<()> {
+        let Some([first, second]) = self.tree.children(node) else {
+            *children.get_mut(*count)? = node;
+            *count += 1;
+            return Some(());
+        };
+        let decision = self.tree.decision(node, i);
+        for (child, share) in [(first, decision.left()), (second, decision.right())] {
+            if share == NONE {
+                return None;
+            }
+            if self.tree.decision(child, share).kind() == DISTRIBUTE {
+                self.children(child, children, count, share)?;
+            } else {
+                *children.get_mut(*count)? = child;
+                *count += 1;
+            }
+        }
+        Some(())
+    }
+
+    /// obvhs's `order_children`: children to slots by a greedy assignment of the octant
+    /// directions, so that a ray's octant gives the order of visits.
+    fn order_children(&self, node: u32, children: &mut [u32; 8], child_count: usize) {
+        let p = self.tree.aabb(node).center();
+        let mut cost = [[f32::MAX; 8]; 8];
+        for (s, direction) in DIRECTIONS.iter().enumerate() {
+            for c in 0..child_count {
+                let v = self.tree.aabb(children[c]).center() - p;
+                cost[c][s] = direction.dot(v);
+            }
+        }
+        let mut assignment = [usize::MAX; 8];
+        let mut slot_filled = [false; 8];
+        loop {
+            let mut min_cost = f32::MAX;
+            let mut min_slot = usize::MAX;
+            let mut min_index = usize::MAX;
+            for c in 0..child_count {
+                if assignment[c] == usize::MAX {
+                    for (s, &filled) in slot_filled.iter().enumerate() {
+                        if !filled && cost[c][s] < min_cost {
+                            min_cost = cost[c][s];
+                            min_slot = s;
+                            min_index = c;
+                        }
+                    }
+                }
+            }
+            if min_slot == usize::MAX {
+                break;
+            }
+            slot_filled[min_slot] = true;
+            assignment[min_index] = min_slot;
+        }
+        let original = std::mem::replace(children, [u32::MAX; 8]);
+        for c in 0..child_count {
+            // obvhs asserts every child found a slot (costs are never NaN for finite boxes).
+            if let Some(slot) = children.get_mut(assignment[c]) {
+                *slot = original[c];
+            }
+        }
+    }
+}
+
+/// obvhs's `direction_lut`: slot `s` stands for the direction with a negative x, y, z
+/// where bits 2, 1, 0 of `s` are set.
+const DIRECTIONS: [Vec3A; 8] = {
+    let mut out = [Vec3A::ZERO; 8];
+    let mut s = 0;
+    while s < 8 {
+        out[s] = Vec3A::new(
+            if s & 0b100 != 0 { -1.0 } else { 1.0 },
+            if s & 0b010 != 0 { -1.0 } else { 1.0 },
+            if s & 0b001 != 0 { -1.0 } else { 1.0 },
+        );
+        s += 1;
+    }
+    out
+};
+
+#[cfg(test)]
+pub mod tests {
+    use super::*;
+    use crate::bvh_build::build_bvh2;
+    use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
+
+    /// A small xorshift generator, so the inputs are the same on every run.
+    struct Random(u32);
+
+    impl Random {
+        fn unit(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 17;
+            self.0 ^= self.0 << 5;
+            (self.0 >> 8) as f32 / (1u32 << 24) as f32
+        }
+
+        fn vec(&mut self) -> Vec3A {
+            Vec3A::new(self.unit(), self.unit(), self.unit())
+        }
+    }
+
+    fn boxes_at(centers: impl Iterator<Item = Vec3A>, half: f32) -> Vec<Aabb> {
+        centers.map(|c| Aabb::new(c - half, c + half)).collect()
+    }
+
+    /// Box sets of every kind the scenes make: random clouds of several sizes, coincident
+    /// boxes, regular grids and rows, a handful of boxes, huge and tiny coordinates, and
+    /// flat boxes.
+    pub fn inputs() -> Vec<(String, Vec<Aabb>)> {
+        let mut random = Random(0x2545_f491);
+        let mut out = Vec::new();
+        for n in [1usize, 2, 3, 4, 5, 7, 8, 9, 17, 100, 1000, 5000] {
+            let cloud = (0..n)
+                .map(|_| {
+                    let c = random.vec() * 40.0;
+                    let half = random.vec() * 1.5 + 0.05;
+                    Aabb::new(c - half, c + half)
+                })
+                .collect();
+            out.push((format!("cloud of {n}"), cloud));
+        }
+        for n in [2usize, 3, 9, 50, 2000] {
+            out.push((
+                format!("{n} coincident"),
+                boxes_at((0..n).map(|_| Vec3A::ONE), 0.5),
+            ));
+        }
+        let grid = boxes_at(
+            (0..40 * 40).map(|i| Vec3A::new((i % 40) as f32, 0.0, (i / 40) as f32)),
+            0.4,
+        );
+        out.push(("grid 40x40".into(), grid));
+        let cube = boxes_at(
+            (0..12 * 12 * 12)
+                .map(|i| Vec3A::new((i % 12) as f32, (i / 12 % 12) as f32, (i / 144) as f32) * 2.0),
+            1.0,
+        );
+        out.push(("touching cubes".into(), cube));
+        let row = boxes_at((0..777).map(|i| Vec3A::new(i as f32 * 3.0, 0.0, 0.0)), 1.0);
+        out.push(("row".into(), row));
+        for (name, scale) in [
+            ("huge", 1e30f32),
+            ("large", 1e15),
+            ("tiny", 1e-30),
+            ("small", 1e-12),
+        ] {
+            let scattered = (0..600)
+                .map(|_| {
+                    let c = (random.vec() - 0.5) * scale;
+                    Aabb::new(
+                        c - random.vec() * scale * 0.01,
+                        c + random.vec() * scale * 0.01,
+                    )
+                })
+                .collect();
+            out.push((format!("{name} coordinates"), scattered));
+        }
+        let mixed = vec![
+            Aabb::new(Vec3A::splat(-1e30), Vec3A::splat(1e30)),
+            Aabb::new(Vec3A::splat(-1.0), Vec3A::splat(1.0)),
+            Aabb::new(Vec3A::splat(1e-20), Vec3A::splat(2e-20)),
+            Aabb::new(Vec3A::new(5.0, 0.0, 0.0), Vec3A::new(6.0, 0.0, 0.0)),
+        ];
+        out.push(("huge and tiny together".into(), mixed));
+        let flat = (0..300)
+            .map(|_| {
+                let c = random.vec() * 10.0;
+                Aabb::new(
+                    Vec3A::new(c.x, 0.0, c.z),
+                    Vec3A::new(c.x + 0.5, 0.0, c.z + 0.5),
+                )
+            })
+            .collect();
+        out.push(("flat".into(), flat));
+        let nested = (1..200)
+            .map(|i| Aabb::new(Vec3A::splat(-(i as f32)), Vec3A::splat(i as f32)))
+            .collect();
+        out.push(("nested".into(), nested));
+        out
+    }
+
+    /// The conversion makes obvhs's `bvh2_to_cwbvh(bvh2, 3, true, false)` exactly: the same
+    /// nodes (every field, the origin to the bit) and the same primitive order.
+    #[test]
+    fn conversion_is_obvhs_conversion() {
+        for (name, aabbs) in inputs() {
+            let tree = build_bvh2(&aabbs[..]).tree;
+            let expected = bvh2_to_cwbvh(&tree.to_bvh2(), 3, true, false);
+            let Some((nodes, primitive_indices)) = convert(&tree, |node| Some(*node)) else {
+                panic!("{name}: no conversion");
+            };
+            assert_eq!(primitive_indices, expected.primitive_indices, "{name}");
+            assert_eq!(nodes.len(), expected.nodes.len(), "{name}");
+            for (i, (ours, theirs)) in nodes.iter().zip(&expected.nodes).enumerate() {
+                assert_eq!(ours, theirs, "{name}: node {i}");
+                assert_eq!(
+                    ours.p.to_array().map(f32::to_bits),
+                    theirs.p.to_array().map(f32::to_bits),
+                    "{name}: node {i}"
+                );
+            }
+        }
+    }
+
+    /// A refused node stops the conversion (the caller then falls back to obvhs's).
+    #[test]
+    fn a_refused_node_gives_no_conversion() {
+        let tree = build_bvh2(&inputs()[10].1[..]).tree;
+        let converted = convert(&tree, |node| (node.imask == 0).then_some(*node));
+        assert!(converted.is_none());
+    }
+
+    #[test]
+    fn decisions_keep_their_parts() {
+        for kind in [LEAF, INTERNAL, DISTRIBUTE] {
+            for left in 0..=NONE {
+                for right in 0..=NONE {
+                    let d = Decision::new(kind, left, right);
+                    assert_eq!((d.kind(), d.left(), d.right()), (kind, left, right));
+                }
+            }
+        }
+        assert_eq!(Decision::new(LEAF, u8::MAX, 3).left(), NONE);
+    }
+}
