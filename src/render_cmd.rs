@@ -375,10 +375,11 @@ impl Summary<'_> {
                 "render           {:.3} s on {} threads",
                 s.render_seconds, self.threads
             ),
-            format!(
-                "camera rays      {} ({} in packets)",
-                s.camera_rays, s.camera_rays_in_packets
-            ),
+            // Packets need a BVH: a scene of a few objects traces every ray alone.
+            match s.camera_rays_in_packets {
+                0 => format!("camera rays      {}", s.camera_rays),
+                packed => format!("camera rays      {} ({packed} in packets)", s.camera_rays),
+            },
             format!("shadow rays      {}", s.shadow_rays),
             format!("reflected rays   {}", s.reflected_rays),
             format!("transmitted rays {}", s.transmitted_rays),
