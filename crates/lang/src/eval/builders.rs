@@ -192,11 +192,14 @@ pub(super) struct MaterialBuilder {
 
 /// The block whose properties are being set right now.
 pub(super) enum Target {
-    Object(ObjectBuilder),
+    /// The big builders are boxed: a loop's million objects each push and pop a `Target`,
+    /// and moving a pointer costs less than copying a builder (compiling the 1M-sphere grid
+    /// went 0.50 -> 0.48 s).
+    Object(Box<ObjectBuilder>),
     Modifiers(Placement, PropSet),
     Settings,
     Camera(CameraBuilder),
     Light(LightBuilder),
-    Material(MaterialBuilder),
+    Material(Box<MaterialBuilder>),
     PatternTransform(DMat4),
 }

@@ -68,11 +68,12 @@ impl<'a> Evaluator<'a> {
         };
         self.check_material_budget(body.header, false)?;
         let errors_before = self.error_events;
-        self.targets.push(Target::Material(MaterialBuilder {
-            material,
-            pattern,
-            set: PropSet::new(),
-        }));
+        self.targets
+            .push(Target::Material(Box::new(MaterialBuilder {
+                material,
+                pattern,
+                set: PropSet::new(),
+            })));
         let result = self.items(&body.block.items);
         let builder = match self.targets.pop() {
             Some(Target::Material(builder)) => builder,

@@ -32,12 +32,12 @@ impl<'a> Evaluator<'a> {
         };
         self.check_sink(header)?;
         let errors_before = self.error_events;
-        self.targets.push(Target::Object(ObjectBuilder {
+        self.targets.push(Target::Object(Box::new(ObjectBuilder {
             tag,
             fields: ShapeFields::defaults(tag),
             placement: Placement::new(),
             set: PropSet::new(),
-        }));
+        })));
         if tag.is_container() {
             self.sinks.push(Sink::Collect(Vec::new()));
         }
