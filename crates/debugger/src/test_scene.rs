@@ -4,8 +4,9 @@
 use std::sync::Arc;
 
 use whitted_ir::{
-    validate, Attenuation, Camera, Color, DMat4, DVec3, FileId, Light, LightKind, Material, Object,
-    ObjectKind, Pattern, PatternKind, Projection, Scene, Shape, SourceFile, Span, ValidScene,
+    validate, Attenuation, Camera, Color, DMat4, DVec3, FileId, Handle, Light, LightKind, Material,
+    Object, ObjectKind, Pattern, PatternKind, Projection, Scene, Shape, SourceFile, Span,
+    ValidScene,
 };
 use whitted_tracer::ray_tree::{trace_pixel, RayTree, SampleChoice};
 use whitted_tracer::{PreparedScene, RenderOptions};
@@ -270,4 +271,16 @@ pub fn hall_of_mirrors() -> ValidScene {
         scene.roots.push(handle);
     }
     validate(scene).expect("the hall of mirrors is valid")
+}
+
+/// The material called `name` in `scene`; panics (a test's failure) when there is none.
+pub fn material_named(scene: &Scene, name: &str) -> Handle<Material> {
+    match scene
+        .materials
+        .iter()
+        .find(|(_, m)| m.name.as_deref() == Some(name))
+    {
+        Some((handle, _)) => handle,
+        None => panic!("no material `{name}` in the test scene"),
+    }
 }

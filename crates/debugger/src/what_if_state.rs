@@ -368,7 +368,9 @@ impl WhatIfJob {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_scene::{glass_pixel_tree, whitted_scene, GLASS_PIXEL, SCENE_TEXT};
+    use crate::test_scene::{
+        glass_pixel_tree, material_named, whitted_scene, GLASS_PIXEL, SCENE_TEXT,
+    };
     use ratatui::crossterm::event::KeyModifiers;
     use whitted_explain::diff::Change;
     use whitted_tracer::ray_tree::{trace_pixel, SampleChoice};
@@ -378,19 +380,10 @@ mod tests {
         KeyEvent::new(code, KeyModifiers::NONE)
     }
 
-    fn material(scene: &whitted_ir::Scene, name: &str) -> Handle<Material> {
-        scene
-            .materials
-            .iter()
-            .find(|(_, m)| m.name.as_deref() == Some(name))
-            .map(|(h, _)| h)
-            .unwrap()
-    }
-
     /// The popup on the glass pixel with the glass material listed (and selected).
     fn popup() -> WhatIf {
         let loaded = LoadedScene::new(whitted_scene());
-        let glass = material(&loaded.scene, "glass");
+        let glass = material_named(&loaded.scene, "glass");
         WhatIf::open(loaded, glass_pixel_tree(), Some(glass), 100_000)
     }
 
@@ -420,7 +413,7 @@ mod tests {
 
         // The oracle: the IR edited by hand, traced through trace_pixel.
         let mut edited = whitted_scene().into_inner();
-        let glass = material(&edited, "glass");
+        let glass = material_named(&edited, "glass");
         edited.materials.get_mut(glass).unwrap().ior = 1.0;
         let edited = whitted_ir::validate(edited).unwrap();
         let prepared = PreparedScene::new(&edited);
@@ -513,7 +506,7 @@ mod tests {
 
         // The mirror writes no ior: the line to add, and where.
         let loaded = LoadedScene::new(whitted_scene());
-        let mirror = material(&loaded.scene, "mirror");
+        let mirror = material_named(&loaded.scene, "mirror");
         let mut what_if = WhatIf::open(loaded, glass_pixel_tree(), Some(mirror), 100_000);
         change_to(&mut what_if, "1.3");
         let (_, effects) = what_if.handle_key(key(KeyCode::Char('W')));

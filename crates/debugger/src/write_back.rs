@@ -424,18 +424,9 @@ fn operand_end(bytes: &[u8], code: &[bool], i: usize, end: usize) -> Option<usiz
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::test_scene::{whitted_scene, SCENE_TEXT};
+    use crate::test_scene::{material_named, whitted_scene, SCENE_TEXT};
     use crate::what_if::{value_text, Param, Value};
-    use whitted_ir::{Handle, Material};
-
-    fn material(scene: &Scene, name: &str) -> Handle<Material> {
-        scene
-            .materials
-            .iter()
-            .find(|(_, m)| m.name.as_deref() == Some(name))
-            .map(|(h, _)| h)
-            .unwrap()
-    }
+    use whitted_ir::Handle;
 
     /// The lines of `a` and `b` that differ, as (line number, a's, b's).
     fn changed_lines(a: &str, b: &str) -> Vec<(usize, String, String)> {
@@ -451,7 +442,7 @@ mod tests {
     #[test]
     fn the_glass_ior_is_replaced_on_its_line_and_nothing_else_changes() {
         let scene = whitted_scene();
-        let glass = material(&scene, "glass");
+        let glass = material_named(&scene, "glass");
         let WriteBack::Edit {
             path,
             contents,
@@ -507,7 +498,7 @@ mod tests {
     #[test]
     fn a_default_property_yields_the_line_to_add_and_where() {
         let scene = whitted_scene();
-        let mirror = material(&scene, "mirror");
+        let mirror = material_named(&scene, "mirror");
         assert_eq!(
             write_back(&scene, Param::Ior(mirror), "1.3"),
             WriteBack::Add {
@@ -533,7 +524,7 @@ mod tests {
             "OrthographicCamera { center 0 0 10 }\nMaterials { numMaterials 1 }\n",
         ));
         scene.sources = sources;
-        let glass = material(&scene, "glass");
+        let glass = material_named(&scene, "glass");
         for param in [Param::Ior(glass), Param::MaxDepth] {
             let WriteBack::Refused(why) = write_back(&scene, param, "1") else {
                 panic!("refused");

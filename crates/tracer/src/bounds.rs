@@ -113,18 +113,12 @@ pub fn segment_touches_box(
     tmin: f32,
     tmax: f32,
 ) -> bool {
-    let t1 = (aabb.min - ray.origin) * inv_direction;
-    let t2 = (aabb.max - ray.origin) * inv_direction;
-    let near = t1.min(t2);
-    let far = t1.max(t2);
-    let enter = near.x.max(near.y).max(near.z).max(tmin);
-    let exit = far.x.min(far.y).min(far.z).min(tmax);
-    enter <= exit
+    segment_entry(aabb, ray, inv_direction, tmin, tmax).is_some()
 }
 
 /// Where the ray's segment `[tmin, tmax]` first touches the box (`tmin` when it starts
-/// inside), or `None` when it does not touch it: the same slab test as
-/// [`segment_touches_box`].
+/// inside), or `None` when it does not touch it (the slab test behind
+/// [`segment_touches_box`]).
 #[inline]
 pub fn segment_entry(
     aabb: &Aabb,

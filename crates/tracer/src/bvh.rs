@@ -334,22 +334,9 @@ impl Bvh {
         if self.nodes.is_empty() {
             return true;
         }
-        let test = PerRayTest::new(rays, tmin);
-        self.traverse_packet_octants(&test, rays.len(), tmax, stack, visit, octant);
-        true
-    }
-
-    /// The packet walk for the octant code `octant`, each a walk of its own.
-    #[inline(always)]
-    fn traverse_packet_octants(
-        &self,
-        test: &PerRayTest,
-        count: usize,
-        tmax: &mut [f32; PACKET],
-        stack: &mut Vec<PacketEntry>,
-        visit: impl FnMut(usize, u32, f32) -> Step,
-        octant: u32,
-    ) {
+        let test = &PerRayTest::new(rays, tmin);
+        let count = rays.len();
+        // As in `traverse`: a walk per octant, its near and far planes constants.
         match octant & 0b111 {
             0 => self.traverse_packet_octant::<0>(test, count, tmax, stack, visit),
             1 => self.traverse_packet_octant::<1>(test, count, tmax, stack, visit),
@@ -360,6 +347,7 @@ impl Bvh {
             6 => self.traverse_packet_octant::<6>(test, count, tmax, stack, visit),
             _ => self.traverse_packet_octant::<7>(test, count, tmax, stack, visit),
         }
+        true
     }
 
     /// [`Bvh::traverse_packet`] for rays whose `octant_inv4` code is `OCT` in every byte.

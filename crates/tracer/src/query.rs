@@ -169,14 +169,7 @@ impl PreparedScene {
         tmax: f32,
         scratch: &mut Scratch,
     ) -> Option<Hit> {
-        let mut best = None;
-        let mut tmax = tmax;
-        for (i, item) in self.unbounded.iter().enumerate() {
-            if let Some(found) = item_hit(item, ray, tmin, tmax, &mut scratch.csg) {
-                tmax = found.0;
-                best = Some(Hit::new(ItemRef::Unbounded(i as u32), found));
-            }
-        }
+        let (mut best, mut tmax) = self.nearest_unbounded(ray, tmin, tmax, &mut scratch.csg);
         match self.walk_bvh() {
             Some(bvh) => self.intersect_bvh(bvh, ray, tmin, tmax, scratch).or(best),
             None => {
@@ -189,6 +182,27 @@ impl PreparedScene {
                 best
             }
         }
+    }
+
+    /// The closest hit among unbounded items, tested one by one (a later one must be
+    /// strictly nearer), and the distance bounded items must now beat.
+    #[inline(always)]
+    fn nearest_unbounded(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        csg: &mut CsgScratch,
+    ) -> (Option<Hit>, f32) {
+        let mut best = None;
+        let mut tmax = tmax;
+        for (i, item) in self.unbounded.iter().enumerate() {
+            if let Some(found) = item_hit(item, ray, tmin, tmax, csg) {
+                tmax = found.0;
+                best = Some(Hit::new(ItemRef::Unbounded(i as u32), found));
+            }
+        }
+        (best, tmax)
     }
 
     /// The closest hit among bounded items, through the BVH.
@@ -254,12 +268,7 @@ impl PreparedScene {
         let mut tmax = [f32::INFINITY; PACKET];
         let mut unbounded_best: [Option<Hit>; PACKET] = [None; PACKET];
         for ((ray, tmax), best) in rays.iter().zip(&mut tmax).zip(&mut unbounded_best) {
-            for (i, item) in self.unbounded.iter().enumerate() {
-                if let Some(found) = item_hit(item, ray, tmin, *tmax, csg) {
-                    *tmax = found.0;
-                    *best = Some(Hit::new(ItemRef::Unbounded(i as u32), found));
-                }
-            }
+            (*best, *tmax) = self.nearest_unbounded(ray, tmin, f32::INFINITY, csg);
         }
         let mut bounded_best: [Option<Hit>; PACKET] = [None; PACKET];
         let walked = bvh.traverse_packet(rays, tmin, &mut tmax, packet_stack, |r, id, tmax| {

@@ -563,8 +563,7 @@ fn build_bvh(items: Vec<Item>, aabbs: Vec<Aabb>) -> (Vec<Item>, Option<Bvh>) {
     }
     let count = items.len();
     let (bvh, primitive_indices) = Bvh::build_from_vec(aabbs);
-    let ordered = permute(items, &primitive_indices);
-    match ordered {
+    match permute(items, &primitive_indices) {
         Ok(ordered) if ordered.len() == count => (ordered, Some(bvh)),
         // Not a permutation (obvhs never does this without spatial splits): keep every item
         // once and test them all, which is slow but right.

@@ -77,6 +77,16 @@ pub fn centered(area: ratatui::layout::Rect, width: u16, height: u16) -> ratatui
     )
 }
 
+/// `inner` less its first column: a popup's text starts one space in from its border.
+pub fn left_padded(inner: ratatui::layout::Rect) -> ratatui::layout::Rect {
+    ratatui::layout::Rect::new(
+        inner.x + 1,
+        inner.y,
+        inner.width.saturating_sub(1),
+        inner.height,
+    )
+}
+
 /// `text` in lines of at most `width` characters, broken between words; a word longer than a
 /// line is cut, and an empty text is one empty line (so a message always has a row).
 pub fn wrap_words(text: &str, width: usize) -> Vec<String> {

@@ -32,12 +32,7 @@ pub fn draw(area: Rect, scroll: u16, buf: &mut Buffer) {
         .title(title);
     let inner = block.inner(popup);
     block.render(popup, buf);
-    let padded = Rect::new(
-        inner.x + 1,
-        inner.y,
-        inner.width.saturating_sub(1),
-        inner.height,
-    );
+    let padded = super::format::left_padded(inner);
     Paragraph::new(lines)
         .scroll((scroll, 0))
         .render(padded, buf);

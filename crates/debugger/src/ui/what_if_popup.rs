@@ -40,12 +40,7 @@ pub fn draw(what_if: &WhatIf, depth: ColorDepth, area: Rect, buf: &mut Buffer) {
         );
     let inner = block.inner(popup);
     block.render(popup, buf);
-    let inner = Rect::new(
-        inner.x + 1,
-        inner.y,
-        inner.width.saturating_sub(1),
-        inner.height,
-    );
+    let inner = super::format::left_padded(inner);
     let lines = lines(what_if, depth, inner.width, usize::from(inner.height));
     Paragraph::new(lines).render(inner, buf);
 }
