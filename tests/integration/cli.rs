@@ -332,10 +332,37 @@ fn stats_report_ray_counts_as_text_and_json() {
         "-o",
         out.to_str().unwrap(),
     ]);
+    // Three objects need no BVH: every camera ray is traced alone, and the line says no more.
     assert!(
-        stdout(&output).contains("camera rays      768"),
+        stdout(&output).contains("camera rays      768\n"),
         "{}",
         stdout(&output)
+    );
+    // A thousand spheres walk the BVH: camera rays go in packets, and the line counts them.
+    let output = run(&[
+        "render",
+        "scenes/bench/spheres1000.scene",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--stats",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let text = stdout(&output);
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("camera rays"))
+        .unwrap_or_else(|| panic!("no camera rays line:\n{text}"));
+    let packed: u64 = line
+        .split(['(', ' '])
+        .filter_map(|w| w.parse().ok())
+        .nth(1)
+        .unwrap_or_else(|| panic!("no packet count in `{line}`"));
+    assert!(
+        line.ends_with(" in packets)") && packed > 0 && packed <= 768,
+        "{line}"
     );
 }
 
