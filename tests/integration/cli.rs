@@ -406,3 +406,62 @@ fn an_image_too_large_for_memory_is_refused_before_rendering() {
     assert!(stderr(&output).contains("0..=256"), "{}", stderr(&output));
     assert!(!out.exists());
 }
+
+/// `--threads N` bounds the whole run, the scene's preparation and BVH build included, not
+/// only the render: a user who asks for one thread on a shared machine gets one. Watched
+/// from outside, as a user would see it: the process's worker threads (unnamed, so they
+/// carry the program's name; the signal and compiler threads are named), polled while it
+/// runs (Linux only: `/proc`). Preparing on rayon's global pool, as `render` once did, added
+/// a worker per core beside the render's own.
+#[test]
+fn threads_bound_the_scene_preparation_too() {
+    if !Path::new("/proc/self/task").exists() {
+        eprintln!("skipped: no /proc to count threads in");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("grid.png");
+    let mut child = whitted()
+        .args([
+            "render",
+            "scenes/bench/grid.scene",
+            "-D",
+            "N=300",
+            "--threads",
+            "1",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "-q",
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .spawn()
+        .expect("the whitted binary runs");
+    let pid = child.id().to_string();
+    let tasks = PathBuf::from(format!("/proc/{pid}/task"));
+    // The most workers alive at once (a named thread carries the program's name for a moment
+    // after it starts, so threads are counted at each look, not collected over the run).
+    let mut most = 0;
+    let status = loop {
+        let workers = std::fs::read_dir(&tasks)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .filter(|task| {
+                let name = std::fs::read_to_string(task.path().join("comm")).unwrap_or_default();
+                task.file_name().to_string_lossy() != pid.as_str() && name.trim() == "whitted"
+            })
+            .count();
+        most = most.max(workers);
+        match child.try_wait() {
+            Ok(Some(status)) => break status,
+            Ok(None) => std::thread::sleep(std::time::Duration::from_millis(2)),
+            Err(e) => panic!("waiting for whitted: {e}"),
+        }
+    };
+    assert!(status.success());
+    assert!(out.exists());
+    assert_eq!(most, 1, "{most} worker threads at once with --threads 1");
+}
