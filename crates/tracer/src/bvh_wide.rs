@@ -18,6 +18,7 @@ use obvhs::aabb::Aabb;
 #[cfg(test)]
 use obvhs::bvh2::Bvh2;
 use obvhs::cwbvh::node::CwBvhNode;
+use rayon::prelude::*;
 
 /// What the converter reads of a binary BVH whose leaves hold one primitive each, with
 /// obvhs's conversion decisions for each node (see [`decide`]).
@@ -138,21 +139,43 @@ impl Decision {
 /// soon as it is complete. Returns the nodes and `primitive_indices`, or `None` where
 /// obvhs's converter would read outside its tables (no finite cost chose a distribution)
 /// or `make` refuses a node.
-pub fn convert<T: Clone + Default>(
-    tree: &impl BinaryTree,
-    make: impl Fn(&CwBvhNode) -> Option<T>,
+pub fn convert<T: Clone + Default + Send + Sync>(
+    tree: &(impl BinaryTree + Sync),
+    make: impl Fn(&CwBvhNode) -> Option<T> + Sync,
+) -> Option<(Vec<T>, Vec<u32>)> {
+    convert_with(tree, make, tree.node_count() >= PARALLEL_NODES)
+}
+
+/// Trees of at least this many binary nodes have the subtrees below their root converted
+/// in parallel.
+const PARALLEL_NODES: usize = 1 << 16;
+
+/// [`convert`], with the root's inner children's subtrees converted in parallel (on the
+/// current rayon pool) when `parallel`. Each is first counted (its wide nodes and
+/// primitives), so that it can be written straight to where the depth-first conversion
+/// would put it: the result is the same either way, and no subtree is copied.
+pub fn convert_with<T: Clone + Default + Send + Sync>(
+    tree: &(impl BinaryTree + Sync),
+    make: impl Fn(&CwBvhNode) -> Option<T> + Sync,
+    parallel: bool,
 ) -> Option<(Vec<T>, Vec<u32>)> {
     if tree.node_count() == 0 {
         return Some((Vec::new(), Vec::new()));
     }
-    let mut converter = Converter {
-        tree,
+    let converter = Converter { tree, make: &make };
+    let mut out = Appended {
         nodes: vec![T::default()],
-        primitive_indices: Vec::new(),
-        make,
+        primitives: Vec::new(),
     };
-    converter.node(0, 0)?;
-    Some((converter.nodes, converter.primitive_indices))
+    let root = converter.node(&mut out, 0, 0)?;
+    if parallel {
+        converter.subtrees_in_parallel(&mut out, &root)?;
+    } else {
+        for (offset, &child) in root.inner_children().iter().enumerate() {
+            converter.subtree(&mut out, root.child_base + offset, child)?;
+        }
+    }
+    Some((out.nodes, out.primitives))
 }
 
 /// obvhs's costs of a leaf of one primitive with this half area (the same for any number
@@ -217,19 +240,222 @@ pub fn decide(
     (cost, decided)
 }
 
-struct Converter<'a, Tree, T, Make> {
-    tree: &'a Tree,
-    nodes: Vec<T>,
-    primitive_indices: Vec<u32>,
-    make: Make,
+/// Where the converter writes: wide nodes by their index in the whole tree, and the
+/// primitives in order.
+trait Output<T> {
+    /// The index the next block of nodes gets.
+    fn node_len(&self) -> usize;
+    /// Reserves the next `count` nodes (a node's block of inner children).
+    fn grow(&mut self, count: usize);
+    fn set(&mut self, index: usize, node: T) -> Option<()>;
+    /// How many primitives precede the next one.
+    fn primitive_len(&self) -> usize;
+    fn push_primitive(&mut self, primitive: u32) -> Option<()>;
 }
 
-impl<Tree: BinaryTree, T: Clone + Default, Make: Fn(&CwBvhNode) -> Option<T>>
-    Converter<'_, Tree, T, Make>
-{
-    /// obvhs's `convert_to_cwbvh_impl`: wide node `wide` from binary node `node`, then its
-    /// inner children, depth first.
-    fn node(&mut self, wide: usize, node: u32) -> Option<()> {
+/// The whole tree's arrays, grown as the conversion goes.
+struct Appended<T> {
+    nodes: Vec<T>,
+    primitives: Vec<u32>,
+}
+
+impl<T: Clone + Default> Output<T> for Appended<T> {
+    fn node_len(&self) -> usize {
+        self.nodes.len()
+    }
+    fn grow(&mut self, count: usize) {
+        self.nodes.resize(self.nodes.len() + count, T::default());
+    }
+    fn set(&mut self, index: usize, node: T) -> Option<()> {
+        *self.nodes.get_mut(index)? = node;
+        Some(())
+    }
+    fn primitive_len(&self) -> usize {
+        self.primitives.len()
+    }
+    fn push_primitive(&mut self, primitive: u32) -> Option<()> {
+        self.primitives.push(primitive);
+        Some(())
+    }
+}
+
+/// One subtree's share of the whole tree's arrays: its root's slot (in its parent's
+/// block), the nodes below it (from index `node_base`) and its primitives (from
+/// `primitive_base`), filled in order.
+struct InPlace<'a, T> {
+    root_index: usize,
+    root: &'a mut T,
+    nodes: &'a mut [T],
+    node_base: usize,
+    nodes_used: usize,
+    primitives: &'a mut [u32],
+    primitive_base: usize,
+    primitives_used: usize,
+}
+
+impl<T> Output<T> for InPlace<'_, T> {
+    fn node_len(&self) -> usize {
+        self.node_base + self.nodes_used
+    }
+    fn grow(&mut self, count: usize) {
+        self.nodes_used += count;
+    }
+    fn set(&mut self, index: usize, node: T) -> Option<()> {
+        if index == self.root_index {
+            *self.root = node;
+        } else {
+            *self.nodes[..self.nodes_used].get_mut(index.checked_sub(self.node_base)?)? = node;
+        }
+        Some(())
+    }
+    fn primitive_len(&self) -> usize {
+        self.primitive_base + self.primitives_used
+    }
+    fn push_primitive(&mut self, primitive: u32) -> Option<()> {
+        *self.primitives.get_mut(self.primitives_used)? = primitive;
+        self.primitives_used += 1;
+        Some(())
+    }
+}
+
+/// A wide node just made: where its block of inner children starts, and the binary nodes
+/// that become them, in slot order.
+struct Made {
+    child_base: usize,
+    inner_children: [u32; 8],
+    inner_count: usize,
+}
+
+impl Made {
+    fn inner_children(&self) -> &[u32] {
+        &self.inner_children[..self.inner_count]
+    }
+}
+
+struct Converter<'a, Tree, Make> {
+    tree: &'a Tree,
+    make: &'a Make,
+}
+
+impl<Tree: BinaryTree + Sync, Make> Converter<'_, Tree, Make> {
+    /// Converts the subtree of wide nodes rooted at binary node `node` into slot `wide`,
+    /// depth first.
+    fn subtree<T: Clone + Default>(
+        &self,
+        out: &mut impl Output<T>,
+        wide: usize,
+        node: u32,
+    ) -> Option<()>
+    where
+        Make: Fn(&CwBvhNode) -> Option<T>,
+    {
+        let made = self.node(out, wide, node)?;
+        for (offset, &child) in made.inner_children().iter().enumerate() {
+            self.subtree(out, made.child_base + offset, child)?;
+        }
+        Some(())
+    }
+
+    /// The subtrees of `root`'s inner children, each counted and then converted in place,
+    /// in parallel.
+    fn subtrees_in_parallel<T: Clone + Default + Send + Sync>(
+        &self,
+        out: &mut Appended<T>,
+        root: &Made,
+    ) -> Option<()>
+    where
+        Make: Fn(&CwBvhNode) -> Option<T> + Sync,
+    {
+        let counts: Vec<Option<(usize, usize)>> = root
+            .inner_children()
+            .par_iter()
+            .map(|&child| self.count(child))
+            .collect();
+        let counts: Vec<(usize, usize)> = counts.into_iter().collect::<Option<_>>()?;
+        let (node_start, primitive_start) = (out.nodes.len(), out.primitives.len());
+        let below: usize = counts.iter().map(|&(nodes, _)| nodes - 1).sum();
+        let primitives: usize = counts.iter().map(|&(_, primitives)| primitives).sum();
+        out.nodes.resize(node_start + below, T::default());
+        out.primitives.resize(primitive_start + primitives, 0);
+        // Hands each subtree its root's slot and its disjoint ranges of both arrays.
+        let (head, mut nodes_left) = out.nodes.split_at_mut(node_start);
+        let mut roots = head.get_mut(root.child_base..)?.iter_mut();
+        let mut primitives_left = &mut out.primitives[primitive_start..];
+        let (mut node_base, mut primitive_base) = (node_start, primitive_start);
+        let mut jobs = Vec::with_capacity(counts.len());
+        for (offset, (&child, &(node_count, primitive_count))) in
+            root.inner_children().iter().zip(&counts).enumerate()
+        {
+            let (nodes, rest) = std::mem::take(&mut nodes_left).split_at_mut(node_count - 1);
+            nodes_left = rest;
+            let (primitives, rest) =
+                std::mem::take(&mut primitives_left).split_at_mut(primitive_count);
+            primitives_left = rest;
+            let place = InPlace {
+                root_index: root.child_base + offset,
+                root: roots.next()?,
+                nodes,
+                node_base,
+                nodes_used: 0,
+                primitives,
+                primitive_base,
+                primitives_used: 0,
+            };
+            jobs.push((child, place));
+            node_base += node_count - 1;
+            primitive_base += primitive_count;
+        }
+        jobs.into_par_iter()
+            .map(|(child, mut place)| {
+                let wide = place.root_index;
+                self.subtree(&mut place, wide, child)?;
+                // The count and the conversion must agree to the node.
+                (place.nodes_used == place.nodes.len()
+                    && place.primitives_used == place.primitives.len())
+                .then_some(())
+            })
+            .collect::<Option<()>>()
+    }
+
+    /// The wide nodes and primitives of the subtree rooted at binary node `node`, as
+    /// [`Converter::subtree`] would write them.
+    fn count(&self, node: u32) -> Option<(usize, usize)> {
+        let mut children = [u32::MAX; 8];
+        let mut child_count = 0;
+        self.children(node, &mut children, &mut child_count, 0)?;
+        let (mut nodes, mut primitives) = (1, 0);
+        for &child in &children[..child_count] {
+            if self.tree.decision(child, 0).kind() == LEAF {
+                primitives += self.leaf_count(child);
+            } else {
+                let (n, p) = self.count(child)?;
+                nodes += n;
+                primitives += p;
+            }
+        }
+        Some((nodes, primitives))
+    }
+
+    /// The primitives below binary node `node`.
+    fn leaf_count(&self, node: u32) -> usize {
+        match self.tree.children(node) {
+            None => 1,
+            Some([first, second]) => self.leaf_count(first) + self.leaf_count(second),
+        }
+    }
+
+    /// obvhs's `convert_to_cwbvh_impl` for one node: wide node `wide` from binary node
+    /// `node`, its leaf children's primitives appended, its inner children's block
+    /// reserved (for the caller to fill).
+    fn node<T: Clone + Default>(
+        &self,
+        output: &mut impl Output<T>,
+        wide: usize,
+        node: u32,
+    ) -> Option<Made>
+    where
+        Make: Fn(&CwBvhNode) -> Option<T>,
+    {
         let aabb = self.tree.aabb(node);
         let mut out = CwBvhNode::default();
         let node_p = aabb.min;
@@ -247,9 +473,13 @@ impl<Tree: BinaryTree, T: Clone + Default, Make: Fn(&CwBvhNode) -> Option<T>>
         self.children(node, &mut children, &mut child_count, 0)?;
         self.order_children(node, &mut children, child_count);
 
-        out.primitive_base_idx = self.primitive_indices.len() as u32;
-        out.child_base_idx = self.nodes.len() as u32;
-        let mut num_internal_nodes = 0;
+        out.primitive_base_idx = output.primitive_len() as u32;
+        out.child_base_idx = output.node_len() as u32;
+        let mut made = Made {
+            child_base: output.node_len(),
+            inner_children: [u32::MAX; 8],
+            inner_count: 0,
+        };
         let mut num_primitives = 0u32;
         for (i, &child) in children.iter().enumerate() {
             if child == u32::MAX {
@@ -271,7 +501,7 @@ impl<Tree: BinaryTree, T: Clone + Default, Make: Fn(&CwBvhNode) -> Option<T>>
             out.child_max_z[i] = child_max.z as u8;
             match self.tree.decision(child, 0).kind() {
                 LEAF => {
-                    let count = self.push_primitives(child);
+                    let count = self.push_primitives(output, child)?;
                     out.child_meta[i] = num_primitives as u8
                         | match count {
                             1 => 0b0010_0000,
@@ -285,34 +515,28 @@ impl<Tree: BinaryTree, T: Clone + Default, Make: Fn(&CwBvhNode) -> Option<T>>
                 _ => {
                     out.imask |= 1 << i;
                     out.child_meta[i] = (24 + i as u8) | 0b0010_0000;
-                    num_internal_nodes += 1;
+                    made.inner_children[made.inner_count] = child;
+                    made.inner_count += 1;
                 }
             }
         }
-        let made = (self.make)(&out)?;
-        self.nodes
-            .resize(self.nodes.len() + num_internal_nodes, T::default());
-        self.nodes[wide] = made;
-
-        let mut offset = 0;
-        for (i, &child) in children.iter().enumerate() {
-            if child != u32::MAX && out.imask & (1 << i) != 0 {
-                self.node((out.child_base_idx + offset) as usize, child)?;
-                offset += 1;
-            }
-        }
-        Some(())
+        let wide_node = (self.make)(&out)?;
+        output.grow(made.inner_count);
+        output.set(wide, wide_node)?;
+        Some(made)
     }
 
     /// obvhs's `count_primitives`: appends the primitives below `node`, left first, and
     /// returns how many.
-    fn push_primitives(&mut self, node: u32) -> u32 {
+    fn push_primitives<T>(&self, output: &mut impl Output<T>, node: u32) -> Option<u32> {
         match self.tree.children(node) {
             None => {
-                self.primitive_indices.push(self.tree.primitive(node));
-                1
+                output.push_primitive(self.tree.primitive(node))?;
+                Some(1)
             }
-            Some([first, second]) => self.push_primitives(first) + self.push_primitives(second),
+            Some([first, second]) => {
+                Some(self.push_primitives(output, first)? + self.push_primitives(output, second)?)
+            }
         }
     }
 
@@ -402,7 +626,7 @@ const DIRECTIONS: [Vec3A; 8] = {
 #[cfg(test)]
 pub mod tests {
     use super::*;
-    use crate::bvh_build::build_bvh2;
+    use crate::bvh_build::{build_bvh2, build_bvh2_with};
     use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
 
     /// A small xorshift generator, so the inputs are the same on every run.
@@ -502,34 +726,62 @@ pub mod tests {
     }
 
     /// The conversion makes obvhs's `bvh2_to_cwbvh(bvh2, 3, true, false)` exactly: the same
-    /// nodes (every field, the origin to the bit) and the same primitive order.
+    /// nodes (every field, the origin to the bit) and the same primitive order, for trees
+    /// of both builds (the binned SAH's and the Morton-topped), converted in one piece and
+    /// with the root's subtrees in parallel, on one thread and on three.
     #[test]
     fn conversion_is_obvhs_conversion() {
-        for (name, aabbs) in inputs() {
-            let tree = build_bvh2(&aabbs[..]).tree;
-            let expected = bvh2_to_cwbvh(&tree.to_bvh2(), 3, true, false);
-            let Some((nodes, primitive_indices)) = convert(&tree, |node| Some(*node)) else {
-                panic!("{name}: no conversion");
-            };
-            assert_eq!(primitive_indices, expected.primitive_indices, "{name}");
-            assert_eq!(nodes.len(), expected.nodes.len(), "{name}");
-            for (i, (ours, theirs)) in nodes.iter().zip(&expected.nodes).enumerate() {
-                assert_eq!(ours, theirs, "{name}: node {i}");
-                assert_eq!(
-                    ours.p.to_array().map(f32::to_bits),
-                    theirs.p.to_array().map(f32::to_bits),
-                    "{name}: node {i}"
-                );
+        let mut all = inputs();
+        let mut random = Random(99);
+        let large = (0..40_000)
+            .map(|_| {
+                let c = random.vec() * 300.0;
+                Aabb::new(c, c + random.vec() * 4.0 + 0.01)
+            })
+            .collect();
+        all.push(("large".into(), large));
+        for (name, aabbs) in all {
+            for morton_min in [usize::MAX, 2] {
+                let tree = build_bvh2_with(&aabbs[..], morton_min).tree;
+                let expected = bvh2_to_cwbvh(&tree.to_bvh2(), 3, true, false);
+                for (threads, parallel) in [(1, false), (1, true), (3, true)] {
+                    let case = format!(
+                        "{name}, Morton from {morton_min}, {threads} threads, parallel {parallel}"
+                    );
+                    let pool = rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .unwrap_or_else(|e| panic!("no pool: {e}"));
+                    let converted =
+                        pool.install(|| convert_with(&tree, |node| Some(*node), parallel));
+                    let Some((nodes, primitive_indices)) = converted else {
+                        panic!("{case}: no conversion");
+                    };
+                    assert_eq!(primitive_indices, expected.primitive_indices, "{case}");
+                    assert_eq!(nodes.len(), expected.nodes.len(), "{case}");
+                    for (i, (ours, theirs)) in nodes.iter().zip(&expected.nodes).enumerate() {
+                        assert_eq!(ours, theirs, "{case}: node {i}");
+                        assert_eq!(
+                            ours.p.to_array().map(f32::to_bits),
+                            theirs.p.to_array().map(f32::to_bits),
+                            "{case}: node {i}"
+                        );
+                    }
+                }
             }
         }
     }
 
-    /// A refused node stops the conversion (the caller then falls back to obvhs's).
+    /// A refused node stops the conversion (the caller then falls back to obvhs's), in a
+    /// subtree converted in parallel too.
     #[test]
     fn a_refused_node_gives_no_conversion() {
         let tree = build_bvh2(&inputs()[10].1[..]).tree;
-        let converted = convert(&tree, |node| (node.imask == 0).then_some(*node));
-        assert!(converted.is_none());
+        for parallel in [false, true] {
+            let converted =
+                convert_with(&tree, |node| (node.imask == 0).then_some(*node), parallel);
+            assert!(converted.is_none());
+        }
     }
 
     #[test]
