@@ -567,11 +567,16 @@ impl<Tree: BinaryTree + Sync, Make> Converter<'_, Tree, Make> {
     /// directions, so that a ray's octant gives the order of visits.
     fn order_children(&self, node: u32, children: &mut [u32; 8], child_count: usize) {
         let p = self.tree.aabb(node).center();
+        // Each child's offset once (obvhs recomputes it for each of the 8 directions; the
+        // value is the same).
+        let mut offsets = [Vec3A::ZERO; 8];
+        for (offset, &child) in offsets.iter_mut().zip(&children[..child_count]) {
+            *offset = self.tree.aabb(child).center() - p;
+        }
         let mut cost = [[f32::MAX; 8]; 8];
         for (s, direction) in DIRECTIONS.iter().enumerate() {
             for c in 0..child_count {
-                let v = self.tree.aabb(children[c]).center() - p;
-                cost[c][s] = direction.dot(v);
+                cost[c][s] = direction.dot(offsets[c]);
             }
         }
         let mut assignment = [usize::MAX; 8];

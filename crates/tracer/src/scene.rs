@@ -218,18 +218,24 @@ impl Shapes {
             reach_before.push(reach);
             reach = chunk.iter().map(|h| h.index()).chain(reach).max();
         }
-        let mut chunks = Vec::with_capacity(reach_before.len());
+        // The chunks come last first, so the arrays are filled backwards (each chunk's
+        // items reversed, straight into the arrays' spare room) and turned round at the
+        // end, in place: no chunk is held apart and copied.
+        let mut reversed = (
+            Vec::with_capacity(roots.len()),
+            Vec::with_capacity(roots.len()),
+        );
         for (chunk, reach) in roots.chunks(chunk_len).zip(reach_before).rev() {
-            chunks.push(prepare_items(&scene, &shared, chunk));
+            reversed.par_extend(chunk.par_iter().rev().map(|&handle| {
+                let (item, bound) = prepare_item(&scene, &shared, handle);
+                (item, bound_as_box(bound))
+            }));
             scene.objects.truncate(reach.map_or(0, |last| last + 1));
         }
         drop(scene);
-        let mut items = Vec::with_capacity(roots.len());
-        let mut aabbs = Vec::with_capacity(roots.len());
-        for (chunk_items, chunk_aabbs) in chunks.into_iter().rev() {
-            items.extend(chunk_items);
-            aabbs.extend(chunk_aabbs);
-        }
+        let (mut items, mut aabbs): (Vec<Item>, Vec<Aabb>) = reversed;
+        items.reverse();
+        aabbs.reverse();
         shapes.with_items(items, aabbs)
     }
 
