@@ -316,6 +316,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         objects,
         compile_seconds,
         build_seconds: prepared.build_seconds(),
+        shapes_seconds: prepared.shapes_seconds(),
         stats: &stats,
         render_cpu_seconds,
         wall_seconds: started.elapsed().as_secs_f64(),
@@ -347,6 +348,8 @@ struct Summary<'a> {
     objects: usize,
     compile_seconds: f64,
     build_seconds: f64,
+    /// The part of `build_seconds` that prepared the shapes; the rest built the BVH.
+    shapes_seconds: f64,
     stats: &'a RenderStats,
     /// The CPU time the render's threads spent on it, summed over the threads (each
     /// thread's own clock, so time other programs took on the machine is not counted).
@@ -370,7 +373,12 @@ impl Summary<'_> {
             ),
             format!("objects          {}", self.objects),
             format!("compile          {:.3} s", self.compile_seconds),
-            format!("bvh build        {:.3} s", self.build_seconds),
+            format!(
+                "bvh build        {:.3} s (shapes {:.3} s, tree {:.3} s)",
+                self.build_seconds,
+                self.shapes_seconds,
+                self.build_seconds - self.shapes_seconds
+            ),
             format!(
                 "render           {:.3} s on {} threads",
                 s.render_seconds, self.threads
@@ -417,6 +425,7 @@ impl Summary<'_> {
             "objects": self.objects,
             "compile_seconds": self.compile_seconds,
             "build_seconds": self.build_seconds,
+            "shapes_seconds": self.shapes_seconds,
             "render_seconds": s.render_seconds,
             "camera_rays": s.camera_rays,
             "shadow_rays": s.shadow_rays,

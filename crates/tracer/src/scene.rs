@@ -93,6 +93,7 @@ pub struct PreparedScene {
     mesh_triangles: usize,
     mesh_bvh_nodes: usize,
     build_seconds: f64,
+    shapes_seconds: f64,
 }
 
 impl PreparedScene {
@@ -111,7 +112,9 @@ impl PreparedScene {
     /// explanations need its names, spans and provenance).
     pub fn new(valid: &ValidScene) -> PreparedScene {
         let started = Instant::now();
-        Shapes::new(valid.scene()).finish(started)
+        let shapes = Shapes::new(valid.scene());
+        let shapes_seconds = started.elapsed().as_secs_f64();
+        shapes.finish(started, shapes_seconds)
     }
 
     /// [`PreparedScene::new`] for a caller that needs nothing of the IR afterwards (`render`
@@ -123,12 +126,19 @@ impl PreparedScene {
         let mut scene = valid.into_inner();
         scene.provenance = Default::default();
         let shapes = Shapes::new_releasing(scene, RELEASE_CHUNK);
-        shapes.finish(started)
+        let shapes_seconds = started.elapsed().as_secs_f64();
+        shapes.finish(started, shapes_seconds)
     }
 
     /// Seconds spent in [`PreparedScene::new`]: shape preparation and the BVH build.
     pub fn build_seconds(&self) -> f64 {
         self.build_seconds
+    }
+
+    /// The part of [`PreparedScene::build_seconds`] spent preparing the shapes (and, for a
+    /// released IR, freeing it); the rest built the BVH.
+    pub fn shapes_seconds(&self) -> f64 {
+        self.shapes_seconds
     }
 
     pub fn settings(&self) -> &Settings {
@@ -310,7 +320,7 @@ impl Shapes {
     }
 
     /// Builds the BVH and puts the bounded items in its primitive order.
-    fn finish(self, started: Instant) -> PreparedScene {
+    fn finish(self, started: Instant, shapes_seconds: f64) -> PreparedScene {
         let Shapes {
             settings,
             camera,
@@ -342,6 +352,7 @@ impl Shapes {
             nested_media,
             settings,
             build_seconds: started.elapsed().as_secs_f64(),
+            shapes_seconds,
         }
     }
 }
