@@ -20,15 +20,16 @@
 //!
 //! Scenes of [`MORTON_MIN_PRIMITIVES`] or more get a cheaper top instead (a fast build for a
 //! large scene, as the issue on performance asks): the primitives are sorted by the Morton
-//! codes of their centroids (a 30-bit code, three radix passes), each range is halved at
-//! the highest bit in which its codes differ (one binary search, no pass over the range)
-//! until it holds at most [`MORTON_SWEEP_RANGE`] primitives, and those are split where the
-//! surface area heuristic is lowest along the Morton order (an exact sweep of at most 63
-//! positions). A range whose codes are all equal (coincident objects, a dense cell) goes to
-//! the binned SAH below. Measured on one thread: the 1M-sphere grid sorts and builds its
-//! binary tree in 0.15 s instead of 0.50 s and renders as fast; 300,000 random spheres of mixed sizes
-//! seen from inside build in 0.21 s instead of 0.35 s and render 1-2% slower (a pure Morton
-//! split down to pairs rendered 18% slower). The nodes' bounds are gathered on the way up.
+//! codes of their boxes' centroids (a 30-bit code, three radix passes) and made as leaves
+//! in that order; each range is halved at the highest bit in which its codes differ (one
+//! binary search, no pass over the range) until it holds at most [`MORTON_SWEEP_RANGE`]
+//! primitives, and those are split where the surface area heuristic is lowest along the
+//! Morton order (an exact sweep of at most 63 positions). A range whose codes are all
+//! equal (coincident objects, a dense cell) goes to the binned SAH below. The nodes' bounds
+//! are gathered on the way up. Measured on one thread: the 1M-sphere grid sorts and builds
+//! its binary tree in 0.15 s instead of 0.50 s and renders as fast; 300,000 random spheres
+//! of mixed sizes seen from inside build their BVH in 0.13 s instead of 0.35 s and render
+//! within 2% (a pure Morton split down to pairs rendered 18% slower).
 //!
 //! For a million objects the build is bound by memory traffic, so the primitives' boxes
 //! (with their input index) are moved through the partitions rather than indices to them:
@@ -270,13 +271,19 @@ fn morton_min_primitives() -> usize {
 pub fn build_bvh2_with(aabbs: impl Into<Vec<Aabb>>, morton_min: usize) -> Built {
     let aabbs: Vec<Aabb> = aabbs.into();
     let scale = BuildScale::for_boxes(&aabbs);
-    // Each box's scaling stands alone: in parallel, in input order.
-    let mut prims: Vec<Prim> = aabbs
-        .par_iter()
-        .with_min_len(PARALLEL_RANGE)
-        .enumerate()
-        .map(|(i, b)| Prim::new(&scale.scale_box(b), i as u32))
-        .collect();
+    let (mut prims, codes) = if aabbs.len() >= morton_min {
+        let (prims, codes) = morton_sorted_prims(&aabbs, scale);
+        (prims, Some(codes))
+    } else {
+        // Each box's scaling stands alone: in parallel, in input order.
+        let prims = aabbs
+            .par_iter()
+            .with_min_len(PARALLEL_RANGE)
+            .enumerate()
+            .map(|(i, b)| Prim::new(&scale.scale_box(b), i as u32))
+            .collect();
+        (prims, None)
+    };
     drop(aabbs);
     // Filled in parallel too: for a million objects this is 40 MB of fresh pages.
     let mut inner: Vec<Inner> = (0..prims.len().saturating_sub(1))
@@ -287,24 +294,26 @@ pub fn build_bvh2_with(aabbs: impl Into<Vec<Aabb>>, morton_min: usize) -> Built 
     let mut steps = 0;
     let mut depth = 0;
     if !prims.is_empty() {
-        let (bounds, centroid_bounds) = bounds_of(&prims);
         let builder = Builder {
             leaf_base: inner.len() as u32,
         };
-        let range = Range {
-            bounds,
-            centroid_bounds,
-            first_leaf: 0,
-            first_inner: 0,
-            depth: 0,
-        };
-        let (_, _, work) = if prims.len() >= morton_min {
-            let codes = morton_order(&mut prims, &centroid_bounds);
-            let (id, costs, work, _) =
-                builder.build_morton(&mut prims, &codes, &mut inner, 0, 0, 0);
-            (id, costs, work)
-        } else {
-            builder.build(&mut prims, &mut inner, range)
+        let (_, _, work) = match codes {
+            Some(codes) => {
+                let (id, costs, work, _) =
+                    builder.build_morton(&mut prims, &codes, &mut inner, 0, 0, 0);
+                (id, costs, work)
+            }
+            None => {
+                let (bounds, centroid_bounds) = bounds_of(&prims);
+                let range = Range {
+                    bounds,
+                    centroid_bounds,
+                    first_leaf: 0,
+                    first_inner: 0,
+                    depth: 0,
+                };
+                builder.build(&mut prims, &mut inner, range)
+            }
         };
         steps = work.steps;
         depth = work.depth;
@@ -703,32 +712,44 @@ fn morton_code(c: Vec3A, lo: Vec3A, cells_per_unit: f32) -> u32 {
     spread_bits(q.x as u32) | spread_bits(q.y as u32) << 1 | spread_bits(q.z as u32) << 2
 }
 
-/// Sorts `prims` by the Morton codes of their centroids (ties in input order) and returns
-/// the sorted codes. The codes divide a cube whose side is the centroids' bounds' longest,
-/// so each level of the code halves space evenly whatever the scene's proportions.
-fn morton_order(prims: &mut Vec<Prim>, centroid_bounds: &Aabb) -> Vec<u32> {
+/// The leaves in the order of the Morton codes of their boxes' centroids (ties in input
+/// order), made straight in that order, with the sorted codes. The codes are taken from
+/// the boxes as given (the order only needs to be a function of the input); the leaves
+/// hold the boxes scaled into build space. The codes divide a cube whose side is the
+/// centroids' bounds' longest, so each level of the code halves space evenly whatever the
+/// scene's proportions.
+fn morton_sorted_prims(aabbs: &[Aabb], scale: BuildScale) -> (Vec<Prim>, Vec<u32>) {
+    // Halves first: the sum of two huge corners would overflow.
+    let centroid = |b: &Aabb| b.min * 0.5 + b.max * 0.5;
+    let centroid_bounds = aabbs.iter().fold(Aabb::empty(), |bounds, b| {
+        let c = centroid(b);
+        bounds.union(&Aabb::new(c, c))
+    });
     let lo = centroid_bounds.min;
     let side = (centroid_bounds.max - lo).max_element();
-    let cells_per_unit = if side > 0.0 {
+    let cells_per_unit = if side > 0.0 && side.is_finite() {
         (1u32 << MORTON_BITS) as f32 / side
     } else {
         0.0
     };
-    // A key is the code above the primitive's position: 8 bytes, sorted by the code alone.
-    let mut keys: Vec<u64> = prims
+    // A key is the code above the box's input index: 8 bytes, sorted by the code alone.
+    let mut keys: Vec<u64> = aabbs
         .par_iter()
         .with_min_len(PARALLEL_RANGE)
         .enumerate()
-        .map(|(i, p)| u64::from(morton_code(p.centroid(), lo, cells_per_unit)) << 32 | i as u64)
+        .map(|(i, b)| u64::from(morton_code(centroid(b), lo, cells_per_unit)) << 32 | i as u64)
         .collect();
     radix_sort_codes(&mut keys);
-    let sorted: Vec<Prim> = keys
+    let prims = keys
         .par_iter()
         .with_min_len(PARALLEL_RANGE)
-        .map(|&key| prims[key as u32 as usize])
+        .map(|&key| {
+            let i = key as u32;
+            Prim::new(&scale.scale_box(&aabbs[i as usize]), i)
+        })
         .collect();
-    *prims = sorted;
-    keys.into_iter().map(|key| (key >> 32) as u32).collect()
+    let codes = keys.into_iter().map(|key| (key >> 32) as u32).collect();
+    (prims, codes)
 }
 
 /// A stable least-significant-digit radix sort of keys by their upper 32 bits, in which
