@@ -11,6 +11,10 @@
 //! from its children's, which are then dropped) and keeps only its 7 decisions, a byte
 //! each. Each wide node is handed to a caller's function as soon as it is complete, so the
 //! caller can store its own form of the node and never holds obvhs's.
+//! Large trees are converted on several threads: the conversion is depth first, so each of
+//! the root's subtrees fills a contiguous range of the nodes and of the primitives; they are
+//! counted, then converted in parallel straight into their ranges (no copies, the same
+//! result).
 //! The test in `tests` compares the two converters node for node on many inputs.
 
 use glam::Vec3A;
@@ -304,7 +308,11 @@ impl<T> Output<T> for InPlace<'_, T> {
         if index == self.root_index {
             *self.root = node;
         } else {
-            *self.nodes[..self.nodes_used].get_mut(index.checked_sub(self.node_base)?)? = node;
+            // Only a reserved node: a count that fell short gives no tree, never a panic.
+            let local = index
+                .checked_sub(self.node_base)
+                .filter(|&i| i < self.nodes_used)?;
+            *self.nodes.get_mut(local)? = node;
         }
         Some(())
     }
