@@ -90,7 +90,7 @@ impl PreparedMesh {
                     }
                 })
                 .collect();
-            let (built, order) = Bvh::build(&aabbs);
+            let (built, order) = Bvh::build_binned_sah(&aabbs);
             if built.node_count() > 0 && order.len() == triangles.len() {
                 triangles = order.iter().map(|&i| triangles[i as usize]).collect();
                 if !corners.is_empty() {

@@ -481,3 +481,26 @@ fn filtered_shadows_cross_a_mesh_solid_at_each_surface() {
         }
     }
 }
+
+/// A mesh keeps the binned SAH's tree at any size (its triangles render faster through it):
+/// with the Morton top forced on for every build on this thread, a mesh's triangles still
+/// come in the binned SAH's order, while a scene-level BVH over the same boxes changes.
+#[test]
+fn meshes_keep_the_binned_sah_tree() {
+    use crate::bvh::Bvh;
+    use crate::bvh_build::{MORTON_MIN_FOR_TESTS, MORTON_MIN_PRIMITIVES};
+    let mesh = terrain(40, &mut Rng(17));
+    let sah = PreparedMesh::new(&mesh);
+    MORTON_MIN_FOR_TESTS.set(2);
+    let forced = PreparedMesh::new(&mesh);
+    let corners: Vec<Vec3A> = sah.triangles.iter().map(|t| Vec3A::from(t.a)).collect();
+    let aabbs: Vec<obvhs::aabb::Aabb> = corners
+        .iter()
+        .map(|&a| obvhs::aabb::Aabb::new(a, a + 1.0))
+        .collect();
+    let (_, morton_order) = Bvh::build(&aabbs);
+    MORTON_MIN_FOR_TESTS.set(MORTON_MIN_PRIMITIVES);
+    let (_, sah_order) = Bvh::build(&aabbs);
+    assert_eq!(forced.triangles, sah.triangles);
+    assert_ne!(morton_order, sah_order, "the Morton top was not forced");
+}
