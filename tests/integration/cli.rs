@@ -166,31 +166,35 @@ fn a_failed_render_leaves_the_old_image_alone() {
     assert!(leftovers.is_empty(), "{leftovers:?}");
 }
 
+/// Also for a scene big enough (131,769 objects) for the Morton-topped BVH build and the
+/// parallel wide conversion, whose work is split between the threads.
 #[test]
 fn the_image_is_byte_identical_for_any_thread_count() {
     let dir = tempfile::tempdir().unwrap();
-    let mut images = Vec::new();
-    for threads in ["1", "2", "3"] {
-        let out = dir.path().join(format!("t{threads}.png"));
-        let output = run(&[
-            "render",
+    let scenes: [(&str, &[&str]); 2] = [
+        (
             "scenes/whitted.scene",
-            "--width",
-            "96",
-            "--height",
-            "72",
-            "--spp",
-            "4",
-            "--threads",
-            threads,
-            "-o",
-            out.to_str().unwrap(),
-        ]);
-        assert!(output.status.success(), "{}", stderr(&output));
-        images.push(std::fs::read(&out).unwrap());
+            &["--width", "96", "--height", "72", "--spp", "4"],
+        ),
+        (
+            "scenes/bench/grid.scene",
+            &["-D", "N=363", "--width", "64", "--height", "48"],
+        ),
+    ];
+    for (scene, options) in scenes {
+        let mut images = Vec::new();
+        for threads in ["1", "2", "3"] {
+            let out = dir.path().join(format!("t{threads}.png"));
+            let mut args = vec!["render", scene, "--threads", threads, "-o"];
+            args.push(out.to_str().unwrap());
+            args.extend_from_slice(options);
+            let output = run(&args);
+            assert!(output.status.success(), "{}", stderr(&output));
+            images.push(std::fs::read(&out).unwrap());
+        }
+        assert_eq!(images[0], images[1], "{scene}: 1 and 2 threads differ");
+        assert_eq!(images[0], images[2], "{scene}: 1 and 3 threads differ");
     }
-    assert_eq!(images[0], images[1], "1 and 2 threads differ");
-    assert_eq!(images[0], images[2], "1 and 3 threads differ");
 }
 
 #[test]
