@@ -914,6 +914,7 @@ mod tests {
                 unit_boxes_at((0..n).map(|i| Vec3A::splat(1.0005f32.powi(i as i32)))),
             ),
             ("far outlier", far),
+            ("huge", huge_and_tiny(n)),
         ];
         for (name, aabbs) in cases {
             let built = build_bvh2_with(&aabbs[..], 2);
@@ -925,6 +926,21 @@ mod tests {
             let steps_bound = n as u64 * u64::from(depth_bound + 2);
             assert!(built.steps <= steps_bound, "{name}: {} steps", built.steps);
         }
+    }
+
+    /// Boxes near both ends of f32's range among ordinary ones: their centroids' spread
+    /// overflows to infinity, so every code is equal and the SAH takes the whole range.
+    fn huge_and_tiny(n: usize) -> Vec<Aabb> {
+        (0..n)
+            .map(|i| match i % 3 {
+                0 => Aabb::new(Vec3A::splat(3e38), Vec3A::splat(3.3e38)),
+                1 => Aabb::new(Vec3A::splat(-3.3e38), Vec3A::splat(-3e38)),
+                _ => {
+                    let c = Vec3A::new(i as f32 * 1e-30, 0.0, 0.0);
+                    Aabb::new(c, c + 1e-31)
+                }
+            })
+            .collect()
     }
 
     fn assert_valid_tree(built: &Built, aabbs: &[Aabb]) {
