@@ -702,7 +702,7 @@ fn median_split(prims: &mut [Prim], axis: usize) -> Split {
     }
 }
 
-/// Scenes of at least this many primitives get a Morton-ordered top (see [`morton_order`]):
+/// Scenes of at least this many primitives get a Morton-ordered top (see [`morton_sorted_prims`]):
 /// below it every split is the binned SAH's, as the golden scenes and benchmarks were built.
 pub const MORTON_MIN_PRIMITIVES: usize = 1 << 17;
 
