@@ -286,17 +286,21 @@ fn set_replaces_a_setting_for_every_command_and_reports_mistakes_in_its_text() {
 fn stats_report_ray_counts_as_text_and_json() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("s.png");
-    let output = run(&[
-        "render",
-        "scenes/whitted.scene",
-        "--width",
-        "32",
-        "--height",
-        "24",
-        "--stats=json",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    // A 32x24 render of `scene` with `--stats` in `format`.
+    let render_stats = |scene: &str, format: &str| {
+        run(&[
+            "render",
+            scene,
+            "--width",
+            "32",
+            "--height",
+            "24",
+            format,
+            "-o",
+            out.to_str().unwrap(),
+        ])
+    };
+    let output = render_stats("scenes/whitted.scene", "--stats=json");
     assert!(output.status.success(), "{}", stderr(&output));
     let stats: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
     assert_eq!(stats["camera_rays"], 32 * 24);
@@ -324,36 +328,33 @@ fn stats_report_ray_counts_as_text_and_json() {
         "{per_cpu} rays per cpu-second over {cpu} s"
     );
     assert!(stats["peak_memory_kib"].as_u64().unwrap() > 0);
+    // The build's time, of which preparing the shapes is a part.
+    let build = stats["build_seconds"].as_f64().unwrap();
+    let shapes = stats["shapes_seconds"].as_f64().unwrap();
+    assert!(
+        0.0 <= shapes && shapes <= build,
+        "shapes {shapes} s of {build} s"
+    );
 
-    let output = run(&[
-        "render",
-        "scenes/whitted.scene",
-        "--width",
-        "32",
-        "--height",
-        "24",
-        "--stats",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let output = render_stats("scenes/whitted.scene", "--stats");
     // Three objects need no BVH: every camera ray is traced alone, and the line says no more.
     assert!(
         stdout(&output).contains("camera rays      768\n"),
         "{}",
         stdout(&output)
     );
+    // The build line names its two parts.
+    let text = stdout(&output);
+    let build_line = text
+        .lines()
+        .find(|l| l.starts_with("bvh build"))
+        .unwrap_or("");
+    assert!(
+        build_line.contains(" s (shapes ") && build_line.ends_with(" s)"),
+        "{text}"
+    );
     // A thousand spheres walk the BVH: camera rays go in packets, and the line counts them.
-    let output = run(&[
-        "render",
-        "scenes/bench/spheres1000.scene",
-        "--width",
-        "32",
-        "--height",
-        "24",
-        "--stats",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let output = render_stats("scenes/bench/spheres1000.scene", "--stats");
     let text = stdout(&output);
     let line = text
         .lines()

@@ -623,6 +623,7 @@ fn dequantise(node: &CwBvhNode, build_scale: BuildScale) -> NodePlanes {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bvh_wide::tests::Random;
     use obvhs::cwbvh::node::extract_byte64;
 
     /// The walk as it was first written, straight from obvhs's `traverse!` (hit masks from
@@ -728,20 +729,9 @@ mod tests {
     /// rays in every octant, with and without a visitor that shrinks `tmax` or stops.
     #[test]
     fn the_walk_visits_in_obvhs_order() {
-        let mut state = 0x9e37_79b9u32;
-        let mut random = move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            (state >> 8) as f32 / (1u32 << 24) as f32
-        };
-        let aabbs: Vec<Aabb> = (0..3000)
-            .map(|_| {
-                let c = Vec3A::new(random(), random(), random()) * 40.0;
-                let half = Vec3A::new(random(), random(), random()) * 1.5 + 0.05;
-                Aabb::new(c - half, c + half)
-            })
-            .collect();
+        let mut rng = Random(0x9e37_79b9);
+        let aabbs = rng.cloud(3000);
+        let mut random = move || rng.unit();
         let (cwbvh, scale) = build_cwbvh(&aabbs);
         let (bvh, _) = Bvh::from_cwbvh(cwbvh.clone(), scale);
         assert!(bvh.node_count() > 100);
@@ -781,20 +771,9 @@ mod tests {
     /// directions and negative zeros among them.
     #[test]
     fn a_packet_walk_shows_each_ray_its_single_walk() {
-        let mut state = 0x2545_f491u32;
-        let mut random = move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            (state >> 8) as f32 / (1u32 << 24) as f32
-        };
-        let aabbs: Vec<Aabb> = (0..4000)
-            .map(|_| {
-                let c = Vec3A::new(random(), random(), random()) * 40.0;
-                let half = Vec3A::new(random(), random(), random()) * 1.5 + 0.05;
-                Aabb::new(c - half, c + half)
-            })
-            .collect();
+        let mut rng = Random(0x2545_f491);
+        let aabbs = rng.cloud(4000);
+        let mut random = move || rng.unit();
         let (bvh, _) = Bvh::build(&aabbs);
         let mut stack = Vec::new();
         let mut packet_stack = Vec::new();

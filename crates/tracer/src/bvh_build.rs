@@ -438,23 +438,14 @@ impl Builder {
             } else {
                 (build_left(), build_right())
             };
-        let (costs, decisions) = decide(
-            range.bounds.half_area(),
-            &first_costs,
-            &second_costs,
-            len as u32,
+        let (costs, work) = join(
+            node,
+            &range.bounds,
+            (first, &first_costs, left_work),
+            (second, &second_costs, right_work),
+            len,
+            len as u64,
         );
-        *node = Inner {
-            min: range.bounds.min.to_array(),
-            first,
-            max: range.bounds.max.to_array(),
-            second,
-            decisions,
-        };
-        let work = Work {
-            steps: len as u64 + left_work.steps + right_work.steps,
-            depth: left_work.depth.max(right_work.depth),
-        };
         (range.first_inner, costs, work)
     }
 
@@ -530,21 +521,42 @@ impl Builder {
             (build_left(), build_right())
         };
         let bounds = left_bounds.union(&right_bounds);
-        let (costs, decisions) =
-            decide(bounds.half_area(), &first_costs, &second_costs, len as u32);
-        *node = Inner {
-            min: bounds.min.to_array(),
-            first,
-            max: bounds.max.to_array(),
-            second,
-            decisions,
-        };
-        let work = Work {
-            steps: 1 + left_work.steps + right_work.steps,
-            depth: left_work.depth.max(right_work.depth),
-        };
+        let (costs, work) = join(
+            node,
+            &bounds,
+            (first, &first_costs, left_work),
+            (second, &second_costs, right_work),
+            len,
+            1,
+        );
         (first_inner, costs, work, bounds)
     }
+}
+
+/// Writes the inner node over `len` primitives within `bounds` whose children are built,
+/// each as (node id, conversion costs, work), with its conversion decisions; returns its
+/// costs and the work below it (`steps` of its own).
+fn join(
+    node: &mut Inner,
+    bounds: &Aabb,
+    (first, first_costs, left_work): (u32, &[f32; 7], Work),
+    (second, second_costs, right_work): (u32, &[f32; 7], Work),
+    len: usize,
+    steps: u64,
+) -> ([f32; 7], Work) {
+    let (costs, decisions) = decide(bounds.half_area(), first_costs, second_costs, len as u32);
+    *node = Inner {
+        min: bounds.min.to_array(),
+        first,
+        max: bounds.max.to_array(),
+        second,
+        decisions,
+    };
+    let work = Work {
+        steps: steps + left_work.steps + right_work.steps,
+        depth: left_work.depth.max(right_work.depth),
+    };
+    (costs, work)
 }
 
 /// Where a range was split and the bounds of its two parts.
@@ -844,6 +856,7 @@ fn morton_split(codes: &[u32]) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bvh_wide::tests::Random;
     use crate::bvh_wide::{convert, DecidedBvh2};
     use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
     use obvhs::cwbvh::node::CwBvhNode;
@@ -1031,13 +1044,8 @@ mod tests {
                     | ((z >> bit) & 1) << (3 * bit + 2)
             })
         };
-        let mut state = 1u32;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state % 1024
-        };
+        let mut rng = Random(1);
+        let mut next = || rng.next_u32() % 1024;
         for _ in 0..10_000 {
             let (x, y, z) = (next(), next(), next());
             let c = Vec3A::new(x as f32, y as f32, z as f32) + 0.5;
@@ -1058,13 +1066,8 @@ mod tests {
     /// codes and on keys whose digits are all equal in some passes (which it skips).
     #[test]
     fn the_radix_sort_is_a_stable_sort_by_code() {
-        let mut state = 7u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut rng = Random(7);
+        let mut next = || u64::from(rng.next_u32());
         let code_sets: [Box<dyn Fn(u64) -> u64>; 4] = [
             Box::new(|r| r & 0x3fff_ffff),
             Box::new(|r| r % 7),
@@ -1116,13 +1119,8 @@ mod tests {
     /// f32's limits) and every exponent a build can pick and beyond.
     #[test]
     fn the_f32_scaling_is_the_f64_scaling() {
-        let mut state = 0x9e37_79b9u32;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state
-        };
+        let mut rng = Random(0x9e37_79b9);
+        let mut next = || rng.next_u32();
         let mut values = vec![
             0.0f32,
             -0.0,

@@ -647,19 +647,36 @@ pub mod tests {
     use crate::bvh_build::{build_bvh2, build_bvh2_with};
     use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
 
-    /// A small xorshift generator, so the inputs are the same on every run.
-    struct Random(u32);
+    /// A small xorshift generator, so the inputs are the same on every run (the BVH tests
+    /// of `bvh` and `bvh_build` use it too).
+    pub(crate) struct Random(pub(crate) u32);
 
     impl Random {
-        fn unit(&mut self) -> f32 {
+        pub(crate) fn next_u32(&mut self) -> u32 {
             self.0 ^= self.0 << 13;
             self.0 ^= self.0 >> 17;
             self.0 ^= self.0 << 5;
-            (self.0 >> 8) as f32 / (1u32 << 24) as f32
+            self.0
         }
 
-        fn vec(&mut self) -> Vec3A {
+        /// Uniform in `[0, 1)`.
+        pub(crate) fn unit(&mut self) -> f32 {
+            (self.next_u32() >> 8) as f32 / (1u32 << 24) as f32
+        }
+
+        pub(crate) fn vec(&mut self) -> Vec3A {
             Vec3A::new(self.unit(), self.unit(), self.unit())
+        }
+
+        /// `n` boxes of random sizes in a 40-unit cube, overlapping.
+        pub(crate) fn cloud(&mut self, n: usize) -> Vec<Aabb> {
+            (0..n)
+                .map(|_| {
+                    let c = self.vec() * 40.0;
+                    let half = self.vec() * 1.5 + 0.05;
+                    Aabb::new(c - half, c + half)
+                })
+                .collect()
         }
     }
 

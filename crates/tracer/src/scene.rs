@@ -236,10 +236,12 @@ impl Shapes {
             Vec::with_capacity(roots.len()),
         );
         for (chunk, reach) in roots.chunks(chunk_len).zip(reach_before).rev() {
-            reversed.par_extend(chunk.par_iter().rev().map(|&handle| {
-                let (item, bound) = prepare_item(&scene, &shared, handle);
-                (item, bound_as_box(bound))
-            }));
+            reversed.par_extend(
+                chunk
+                    .par_iter()
+                    .rev()
+                    .map(|&handle| prepare_boxed_item(&scene, &shared, handle)),
+            );
             scene.objects.truncate(reach.map_or(0, |last| last + 1));
         }
         drop(scene);
@@ -406,11 +408,14 @@ fn prepare_items(
 ) -> (Vec<Item>, Vec<Aabb>) {
     roots
         .par_iter()
-        .map(|&handle| {
-            let (item, bound) = prepare_item(scene, shared, handle);
-            (item, bound_as_box(bound))
-        })
+        .map(|&handle| prepare_boxed_item(scene, shared, handle))
         .unzip()
+}
+
+/// An item beside its bound stored as a box (see [`bound_as_box`]).
+fn prepare_boxed_item(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (Item, Aabb) {
+    let (item, bound) = prepare_item(scene, shared, handle);
+    (item, bound_as_box(bound))
 }
 
 /// What every item's preparation reads: the prepared materials and meshes.
