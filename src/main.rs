@@ -25,6 +25,7 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use clap::Parser;
+use whitted_tracer::TraversalPath;
 
 use cli::{Cli, Command};
 
@@ -46,10 +47,31 @@ impl From<std::io::Error> for Failure {
     }
 }
 
+/// Where the BVH walk's child test may be forced, to compare the paths' speed or to rule
+/// one out: every path renders the same image.
+const TRAVERSAL_VARIABLE: &str = "WHITTED_TRAVERSAL";
+
+/// Forces the BVH walk named by `WHITTED_TRAVERSAL` (baseline, avx2 or avx512), if set.
+fn force_traversal_from_env() -> Result<(), Failure> {
+    // Unset or empty (`WHITTED_TRAVERSAL= whitted …`): the fastest path.
+    let Some(value) = std::env::var_os(TRAVERSAL_VARIABLE).filter(|v| !v.is_empty()) else {
+        return Ok(());
+    };
+    let names = TraversalPath::ALL.map(TraversalPath::name).join(", ");
+    let name = value.to_string_lossy();
+    let path = TraversalPath::from_name(&name).ok_or_else(|| {
+        Failure::Usage(format!(
+            "{TRAVERSAL_VARIABLE}={name:?} names no BVH walk; use one of {names}"
+        ))
+    })?;
+    whitted_tracer::force_traversal_path(Some(path))
+        .map_err(|e| Failure::Message(format!("{TRAVERSAL_VARIABLE}={name}: {e}")))
+}
+
 fn main() -> ExitCode {
     allocator::configure();
     let cli = Cli::parse();
-    let result = match cli.command {
+    let result = force_traversal_from_env().and_then(|()| match cli.command {
         Command::Check(args) => scene_input::check(&args),
         Command::Ir(args) => scene_input::ir(&args),
         Command::Render(args) => render_cmd::render(&args),
@@ -62,7 +84,7 @@ fn main() -> ExitCode {
         Command::Explain(args) => explain_cmd::explain_pixel(&args),
         Command::Debug(args) => debug_cmd::debug(&args),
         Command::Mit6837(args) => mit6837_cmd::mit6837(&args.args),
-    };
+    });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::SceneErrors) => ExitCode::from(1),

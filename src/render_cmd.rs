@@ -6,7 +6,9 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use whitted_ir::{limits, Settings, SourceMap};
-use whitted_tracer::{PreparedScene, RenderObserver, RenderOptions, RenderStats, TileResult};
+use whitted_tracer::{
+    PreparedScene, RenderObserver, RenderOptions, RenderStats, TileResult, TraversalPath,
+};
 
 use crate::cli::{ImageFormat, RenderArgs, RenderOverrides, StatsFormat};
 use crate::image_output::{write_image, Pixels};
@@ -317,6 +319,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         compile_seconds,
         build_seconds: prepared.build_seconds(),
         shapes_seconds: prepared.shapes_seconds(),
+        traversal: TraversalPath::chosen(),
         stats: &stats,
         render_cpu_seconds,
         wall_seconds: started.elapsed().as_secs_f64(),
@@ -350,6 +353,8 @@ struct Summary<'a> {
     build_seconds: f64,
     /// The part of `build_seconds` that prepared the shapes; the rest built the BVH.
     shapes_seconds: f64,
+    /// The BVH walk's child test (every path gives the same image).
+    traversal: TraversalPath,
     stats: &'a RenderStats,
     /// The CPU time the render's threads spent on it, summed over the threads (each
     /// thread's own clock, so time other programs took on the machine is not counted).
@@ -379,6 +384,7 @@ impl Summary<'_> {
                 self.shapes_seconds,
                 self.build_seconds - self.shapes_seconds
             ),
+            format!("bvh walk         {}", self.traversal.name()),
             format!(
                 "render           {:.3} s on {} threads",
                 s.render_seconds, self.threads
@@ -426,6 +432,7 @@ impl Summary<'_> {
             "compile_seconds": self.compile_seconds,
             "build_seconds": self.build_seconds,
             "shapes_seconds": self.shapes_seconds,
+            "bvh_walk": self.traversal.name(),
             "render_seconds": s.render_seconds,
             "camera_rays": s.camera_rays,
             "shadow_rays": s.shadow_rays,

@@ -21,3 +21,4 @@ mod ray_trees;
 mod reshade;
 mod tidy;
 mod trace_cli;
+mod traversal_paths;

@@ -5,6 +5,9 @@
 //! `cargo run --release -p whitted-tracer --example bench [-- WHICH [GRID_N]]` where WHICH is
 //! `whitted`, `spheres`, `grid` or `all` (the default), and GRID_N defaults to 1000.
 //!
+//! `WHITTED_TRAVERSAL=baseline` (or `avx2`, `avx512`) forces the BVH walk's child test, to
+//! compare the paths; by default the fastest the CPU runs is used.
+//!
 //! Besides the best wall time it prints rays per CPU-second (process CPU time over at least
 //! a second of repeated renders), which stays honest when other work shares the machine.
 // A program, not a library: it prints its results and sets its exit status.
@@ -13,7 +16,10 @@
 use std::time::Instant;
 
 use whitted_tracer::testing::{reflective_spheres, sphere_grid, whitted_classic, SceneBuilder};
-use whitted_tracer::{render, NoObserver, PreparedScene, RenderOptions, RenderStats};
+use whitted_tracer::{
+    force_traversal_path, render, NoObserver, PreparedScene, RenderOptions, RenderStats,
+    TraversalPath,
+};
 
 fn options(scene: &PreparedScene) -> RenderOptions {
     let mut options = RenderOptions::from_settings(scene.settings());
@@ -109,6 +115,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .and_then(|s| s.parse().ok())
         .unwrap_or(1000);
     let wanted = |name: &str| which == "all" || which == name;
+    if let Ok(name) = std::env::var("WHITTED_TRAVERSAL") {
+        let path = TraversalPath::from_name(&name)
+            .ok_or_else(|| format!("WHITTED_TRAVERSAL: baseline, avx2 or avx512, not {name:?}"))?;
+        force_traversal_path(Some(path))?;
+    }
+    println!("BVH walk: {}", TraversalPath::chosen().name());
 
     if wanted("whitted") {
         let (whitted, _) = prepare(whitted_classic())?;

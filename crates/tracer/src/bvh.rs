@@ -26,6 +26,13 @@
 //!
 //! Up to eight rays of one octant can also walk together ([`Bvh::traverse_packet`]), each
 //! seeing exactly its single walk's visits; camera rays use it.
+//!
+//! The child test has three implementations with bit-identical results
+//! ([`TraversalPath`]): two 4-lane SSE2 halves, which every x86-64 has, and AVX2 and
+//! AVX-512 ones (`bvh_simd`). Each BVH takes the fastest the CPU offers when it is built
+//! (or the one [`force_traversal_path`] names), so one binary runs anywhere.
+
+use std::sync::atomic::{AtomicU8, Ordering};
 
 use glam::{UVec2, Vec3A, Vec4};
 use obvhs::aabb::Aabb;
@@ -34,20 +41,36 @@ use obvhs::cwbvh::CwBvh;
 
 use crate::bounds::inverse_direction;
 use crate::bvh_build::{build_bvh2, build_bvh2_with, round_down, round_up, BuildScale, Built};
+use crate::bvh_simd;
 use crate::bvh_wide;
 use crate::ray::Ray;
 
-/// Children's box planes of one node, four children per half: `halves[h][axis * 2]` holds
-/// the minima along `axis` of children `4h..4h + 4`, `halves[h][axis * 2 + 1]` the maxima.
+/// Children's box planes of one node, a row of eight children per plane: `rows[axis * 2]`
+/// holds the minima along `axis`, `rows[axis * 2 + 1]` the maxima. A row is two 16-byte
+/// loads for the baseline's 4-lane test, one 32-byte load for AVX2's 8-lane test, and an
+/// axis's two rows are one 64-byte load for AVX-512 (`bvh_simd`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct NodePlanes {
-    halves: [[Vec4; 6]; 2],
+#[repr(C, align(64))]
+pub(crate) struct NodePlanes {
+    pub(crate) rows: [[f32; 8]; 6],
 }
 
 impl NodePlanes {
     #[cfg(test)]
     fn get(&self, slot: usize, child: usize) -> f32 {
-        self.halves[child / 4][slot][child % 4]
+        self.rows[slot][child]
+    }
+
+    /// Children `4·half..4·half + 4` of row `slot`.
+    #[inline(always)]
+    fn quarter(&self, slot: usize, half: usize) -> Vec4 {
+        let row = &self.rows[slot];
+        Vec4::new(
+            row[half * 4],
+            row[half * 4 + 1],
+            row[half * 4 + 2],
+            row[half * 4 + 3],
+        )
     }
 }
 
@@ -56,8 +79,8 @@ impl NodePlanes {
 /// shift, and a node never straddles a fifth line).
 #[derive(Clone, Debug, Default, PartialEq)]
 #[repr(align(64))]
-struct WideNode {
-    planes: NodePlanes,
+pub(crate) struct WideNode {
+    pub(crate) planes: NodePlanes,
     /// What leaf child `c` adds to obvhs's hit mask when the segment touches its box: its
     /// unary primitive count shifted to its primitive offset (below bit 24); 0 for inner
     /// and empty children.
@@ -105,6 +128,151 @@ impl WideNode {
 #[derive(Clone, Debug)]
 pub struct Bvh {
     nodes: Vec<WideNode>,
+    /// The child test this BVH's walks use, fixed when it is built.
+    path: ChildTestPath,
+}
+
+/// How a walk tests a node's eight children against a ray. Every path computes each
+/// child's slab test with the same operations on the same operands in the same order, so
+/// they touch the same children: the same visits, hits and image, bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TraversalPath {
+    /// Two 4-lane halves with SSE2, which every x86-64 has.
+    Baseline,
+    /// All eight children in one 8-lane register (AVX2).
+    Avx2,
+    /// Each axis's near and far planes of all eight children in one 16-lane register, and
+    /// the compare straight into a mask register (AVX-512 F, VL and DQ).
+    Avx512,
+}
+
+impl TraversalPath {
+    pub const ALL: [TraversalPath; 3] = [
+        TraversalPath::Baseline,
+        TraversalPath::Avx2,
+        TraversalPath::Avx512,
+    ];
+
+    /// The fastest path this CPU runs (asked at run time), which new BVHs use unless a
+    /// path is forced ([`force_traversal_path`]).
+    pub fn fastest() -> TraversalPath {
+        ChildTestPath::fastest().public()
+    }
+
+    /// The path BVHs built now get: the forced one ([`force_traversal_path`]), else the
+    /// fastest.
+    pub fn chosen() -> TraversalPath {
+        ChildTestPath::choose().public()
+    }
+
+    /// Whether this CPU can run the path.
+    pub fn available(self) -> bool {
+        ChildTestPath::of(self).is_some()
+    }
+
+    /// The name `--stats` and the bench print, and `WHITTED_TRAVERSAL` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            TraversalPath::Baseline => "baseline",
+            TraversalPath::Avx2 => "avx2",
+            TraversalPath::Avx512 => "avx512",
+        }
+    }
+
+    /// The path named `name` ([`TraversalPath::name`]).
+    pub fn from_name(name: &str) -> Option<TraversalPath> {
+        TraversalPath::ALL.into_iter().find(|p| p.name() == name)
+    }
+}
+
+/// The CPU lacks what a forced [`TraversalPath`] needs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PathUnavailable(pub TraversalPath);
+
+impl std::fmt::Display for PathUnavailable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "this CPU cannot run the {} BVH traversal (it lacks the instructions)",
+            self.0.name()
+        )
+    }
+}
+
+impl std::error::Error for PathUnavailable {}
+
+/// The path [`force_traversal_path`] asked for: 0 for none, else 1 + its index in
+/// [`TraversalPath::ALL`].
+static FORCED_PATH: AtomicU8 = AtomicU8::new(0);
+
+/// Makes every BVH built from now on in this process walk with `path`, or with the fastest
+/// the CPU runs when `None` (the default); BVHs already built keep theirs. For tests and for
+/// comparing the paths' speed: the image does not depend on the choice.
+pub fn force_traversal_path(path: Option<TraversalPath>) -> Result<(), PathUnavailable> {
+    let code = match path {
+        None => 0,
+        Some(path) => {
+            if !path.available() {
+                return Err(PathUnavailable(path));
+            }
+            1 + TraversalPath::ALL
+                .iter()
+                .position(|&p| p == path)
+                .unwrap_or(0) as u8
+        }
+    };
+    FORCED_PATH.store(code, Ordering::Relaxed);
+    Ok(())
+}
+
+/// A [`TraversalPath`] with the proof that this CPU can run it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ChildTestPath {
+    Baseline,
+    Avx2(bvh_simd::Avx2),
+    Avx512(bvh_simd::Avx512),
+}
+
+impl ChildTestPath {
+    fn of(path: TraversalPath) -> Option<ChildTestPath> {
+        match path {
+            TraversalPath::Baseline => Some(ChildTestPath::Baseline),
+            TraversalPath::Avx2 => bvh_simd::Avx2::detect().map(ChildTestPath::Avx2),
+            TraversalPath::Avx512 => bvh_simd::Avx512::detect().map(ChildTestPath::Avx512),
+        }
+    }
+
+    fn fastest() -> ChildTestPath {
+        [TraversalPath::Avx512, TraversalPath::Avx2]
+            .into_iter()
+            .find_map(ChildTestPath::of)
+            .unwrap_or(ChildTestPath::Baseline)
+    }
+
+    /// The forced path, else the fastest; asked once per BVH, not per ray.
+    fn choose() -> ChildTestPath {
+        let forced = usize::from(FORCED_PATH.load(Ordering::Relaxed));
+        forced
+            .checked_sub(1)
+            .and_then(|i| TraversalPath::ALL.get(i))
+            .and_then(|&path| ChildTestPath::of(path))
+            .unwrap_or_else(ChildTestPath::fastest)
+    }
+
+    fn public(self) -> TraversalPath {
+        match self {
+            ChildTestPath::Baseline => TraversalPath::Baseline,
+            ChildTestPath::Avx2(_) => TraversalPath::Avx2,
+            ChildTestPath::Avx512(_) => TraversalPath::Avx512,
+        }
+    }
+}
+
+/// A node's child test, with the ray prepared once per query: which children's boxes the
+/// segment `(tmin, tmax)` touches, a bit per slot. Along an axis the ray travels towards
+/// −axis (`OCT` has a zero bit), the max plane is met first.
+pub(crate) trait ChildTest {
+    fn touched<const OCT: u32>(&self, node: &WideNode, tmax: f32) -> u32;
 }
 
 /// `INNER_BELOW[imask][slot]`: how many of the inner-child slots in `imask` are below
@@ -196,11 +364,18 @@ impl Bvh {
         Self::from_built(build_bvh2_with(aabbs.to_vec(), usize::MAX))
     }
 
+    fn new(nodes: Vec<WideNode>) -> Bvh {
+        Bvh {
+            nodes,
+            path: ChildTestPath::choose(),
+        }
+    }
+
     fn from_built(built: Built) -> (Bvh, Vec<u32>) {
         let scale = built.scale;
         let converted = bvh_wide::convert(&built.tree, |node| WideNode::new(node, scale));
         match converted {
-            Some((nodes, primitive_indices)) => (Bvh { nodes }, primitive_indices),
+            Some((nodes, primitive_indices)) => (Bvh::new(nodes), primitive_indices),
             // A tree obvhs's converter reads outside its tables on, or whose metadata the walk
             // does not expect: whatever obvhs makes of it, as before.
             None => {
@@ -219,9 +394,9 @@ impl Bvh {
             .map(|node| WideNode::new(node, scale))
             .collect();
         match nodes {
-            Some(nodes) => (Bvh { nodes }, cwbvh.primitive_indices),
+            Some(nodes) => (Bvh::new(nodes), cwbvh.primitive_indices),
             // Not the layout obvhs documents: no BVH, so the caller tests every item.
-            None => (Bvh { nodes: Vec::new() }, Vec::new()),
+            None => (Bvh::new(Vec::new()), Vec::new()),
         }
     }
 
@@ -239,17 +414,40 @@ impl Bvh {
         if self.nodes.is_empty() {
             return;
         }
+        match self.path {
+            ChildTestPath::Baseline => {
+                self.traverse_with(&NodeQuery::new(ray, tmin), ray, tmax, stack, visit);
+            }
+            ChildTestPath::Avx2(avx2) => {
+                bvh_simd::traverse_avx2(avx2, self, ray, tmin, tmax, stack, visit);
+            }
+            ChildTestPath::Avx512(avx512) => {
+                bvh_simd::traverse_avx512(avx512, self, ray, tmin, tmax, stack, visit);
+            }
+        }
+    }
+
+    /// [`Bvh::traverse`] with a given child test, whose query holds the ray and `tmin`.
+    #[inline(always)]
+    pub(crate) fn traverse_with(
+        &self,
+        query: &impl ChildTest,
+        ray: &Ray,
+        tmax: f32,
+        stack: &mut Vec<UVec2>,
+        visit: impl FnMut(u32, f32) -> Step,
+    ) {
         // One walk per octant of the direction, so that the near and far planes of each
         // axis and the order of inner children are constants inside the loop.
         match octant_inv4(ray.direction) & 0b111 {
-            0 => self.traverse_octant::<0>(ray, tmin, tmax, stack, visit),
-            1 => self.traverse_octant::<1>(ray, tmin, tmax, stack, visit),
-            2 => self.traverse_octant::<2>(ray, tmin, tmax, stack, visit),
-            3 => self.traverse_octant::<3>(ray, tmin, tmax, stack, visit),
-            4 => self.traverse_octant::<4>(ray, tmin, tmax, stack, visit),
-            5 => self.traverse_octant::<5>(ray, tmin, tmax, stack, visit),
-            6 => self.traverse_octant::<6>(ray, tmin, tmax, stack, visit),
-            _ => self.traverse_octant::<7>(ray, tmin, tmax, stack, visit),
+            0 => self.traverse_octant::<0>(query, tmax, stack, visit),
+            1 => self.traverse_octant::<1>(query, tmax, stack, visit),
+            2 => self.traverse_octant::<2>(query, tmax, stack, visit),
+            3 => self.traverse_octant::<3>(query, tmax, stack, visit),
+            4 => self.traverse_octant::<4>(query, tmax, stack, visit),
+            5 => self.traverse_octant::<5>(query, tmax, stack, visit),
+            6 => self.traverse_octant::<6>(query, tmax, stack, visit),
+            _ => self.traverse_octant::<7>(query, tmax, stack, visit),
         }
     }
 
@@ -257,13 +455,11 @@ impl Bvh {
     #[inline(always)]
     fn traverse_octant<const OCT: u32>(
         &self,
-        ray: &Ray,
-        tmin: f32,
+        query: &impl ChildTest,
         tmax: f32,
         stack: &mut Vec<UVec2>,
         mut visit: impl FnMut(u32, f32) -> Step,
     ) {
-        let query = NodeQuery::new(ray, tmin);
         let mut tmax = tmax;
         let inner_order = &INNER_ORDER[OCT as usize];
         stack.clear();
@@ -346,27 +542,54 @@ impl Bvh {
         if self.nodes.is_empty() {
             return true;
         }
-        let test = &PerRayTest::new(rays, tmin);
-        let count = rays.len();
-        // As in `traverse`: a walk per octant, its near and far planes constants.
-        match octant & 0b111 {
-            0 => self.traverse_packet_octant::<0>(test, count, tmax, stack, visit),
-            1 => self.traverse_packet_octant::<1>(test, count, tmax, stack, visit),
-            2 => self.traverse_packet_octant::<2>(test, count, tmax, stack, visit),
-            3 => self.traverse_packet_octant::<3>(test, count, tmax, stack, visit),
-            4 => self.traverse_packet_octant::<4>(test, count, tmax, stack, visit),
-            5 => self.traverse_packet_octant::<5>(test, count, tmax, stack, visit),
-            6 => self.traverse_packet_octant::<6>(test, count, tmax, stack, visit),
-            _ => self.traverse_packet_octant::<7>(test, count, tmax, stack, visit),
+        match self.path {
+            ChildTestPath::Baseline => {
+                let test = &PerRayTest::new(rays, |ray| NodeQuery::new(ray, tmin));
+                self.traverse_packet_with(test, rays, tmax, stack, visit);
+            }
+            ChildTestPath::Avx2(avx2) => {
+                bvh_simd::traverse_packet_avx2(avx2, self, rays, tmin, tmax, stack, visit);
+            }
+            ChildTestPath::Avx512(avx512) => {
+                bvh_simd::traverse_packet_avx512(avx512, self, rays, tmin, tmax, stack, visit);
+            }
         }
         true
     }
 
+    /// [`Bvh::traverse_packet`] of rays already checked to share an octant, with a given
+    /// child test, whose queries hold the rays and `tmin`.
+    #[inline(always)]
+    pub(crate) fn traverse_packet_with<Q: ChildTest>(
+        &self,
+        test: &PerRayTest<Q>,
+        rays: &[Ray],
+        tmax: &mut [f32; PACKET],
+        stack: &mut Vec<PacketEntry>,
+        visit: impl FnMut(usize, u32, f32) -> Step,
+    ) {
+        let Some(first) = rays.first() else {
+            return;
+        };
+        let count = rays.len();
+        // As in `traverse`: a walk per octant, its near and far planes constants.
+        match octant_inv4(first.direction) & 0b111 {
+            0 => self.traverse_packet_octant::<0, Q>(test, count, tmax, stack, visit),
+            1 => self.traverse_packet_octant::<1, Q>(test, count, tmax, stack, visit),
+            2 => self.traverse_packet_octant::<2, Q>(test, count, tmax, stack, visit),
+            3 => self.traverse_packet_octant::<3, Q>(test, count, tmax, stack, visit),
+            4 => self.traverse_packet_octant::<4, Q>(test, count, tmax, stack, visit),
+            5 => self.traverse_packet_octant::<5, Q>(test, count, tmax, stack, visit),
+            6 => self.traverse_packet_octant::<6, Q>(test, count, tmax, stack, visit),
+            _ => self.traverse_packet_octant::<7, Q>(test, count, tmax, stack, visit),
+        }
+    }
+
     /// [`Bvh::traverse_packet`] for rays whose `octant_inv4` code is `OCT` in every byte.
     #[inline(always)]
-    fn traverse_packet_octant<const OCT: u32>(
+    fn traverse_packet_octant<const OCT: u32, Q: ChildTest>(
         &self,
-        test: &PerRayTest,
+        test: &PerRayTest<Q>,
         count: usize,
         tmax: &mut [f32; PACKET],
         stack: &mut Vec<PacketEntry>,
@@ -452,26 +675,27 @@ impl Bvh {
 /// At most this many rays walk the BVH together ([`Bvh::traverse_packet`]).
 pub const PACKET: usize = 8;
 
-/// A packet's child test: each ray's own single-walk test ([`NodeQuery::touched`]), one
+/// A packet's child test: each ray's own single-walk test ([`ChildTest::touched`]), one
 /// ray after another. (An AVX2 test of one child against all eight rays at once visits the
 /// same and was measured no faster: see ARCHITECTURE.md.)
-struct PerRayTest {
-    queries: [NodeQuery; PACKET],
+pub(crate) struct PerRayTest<Q> {
+    queries: [Q; PACKET],
 }
 
-impl PerRayTest {
-    fn new(rays: &[Ray], tmin: f32) -> PerRayTest {
+impl<Q: ChildTest> PerRayTest<Q> {
+    /// The queries of up to [`PACKET`] rays (the last repeated to fill the packet; a
+    /// packet of no rays walks nothing, so any ray will do for it).
+    #[inline(always)]
+    pub(crate) fn new(rays: &[Ray], mut query: impl FnMut(&Ray) -> Q) -> PerRayTest<Q> {
         let last = rays.len().clamp(1, PACKET) - 1;
+        let spare = Ray::new(Vec3A::ZERO, Vec3A::X);
         PerRayTest {
-            queries: std::array::from_fn(|r| match rays.get(r.min(last)) {
-                Some(ray) => NodeQuery::new(ray, tmin),
-                None => NodeQuery::new(&Ray::new(Vec3A::ZERO, Vec3A::X), tmin),
-            }),
+            queries: std::array::from_fn(|r| query(rays.get(r.min(last)).unwrap_or(&spare))),
         }
     }
 }
 
-impl PerRayTest {
+impl<Q: ChildTest> PerRayTest<Q> {
     /// For each child slot of `node`, which of the `active` rays' segments
     /// `(tmin, tmax[r])` touch its box.
     #[inline(always)]
@@ -504,7 +728,7 @@ pub struct PacketEntry {
     rays: u8,
 }
 
-/// The ray, prepared once per query for the slab tests.
+/// The ray, prepared once per query for the baseline's slab tests.
 struct NodeQuery {
     origin: [Vec4; 3],
     inv_direction: [Vec4; 3],
@@ -525,20 +749,20 @@ impl NodeQuery {
             tmin: Vec4::splat(tmin),
         }
     }
+}
 
-    /// The node's children (a bit per slot) whose boxes the segment touches. Along an
-    /// axis the ray travels towards −axis (`OCT` has a zero bit), the max plane is met first.
+impl ChildTest for NodeQuery {
     #[inline(always)]
     fn touched<const OCT: u32>(&self, node: &WideNode, tmax: f32) -> u32 {
         let tmax = Vec4::splat(tmax);
         let mut touched = 0u32;
-        for (half, planes) in node.planes.halves.iter().enumerate() {
+        for half in 0..2 {
             let mut enter = self.tmin;
             let mut exit = tmax;
             for axis in 0..3 {
                 let backwards = usize::from(OCT & (4 >> axis) == 0);
-                let near_plane = planes[axis * 2 + backwards];
-                let far_plane = planes[axis * 2 + 1 - backwards];
+                let near_plane = node.planes.quarter(axis * 2 + backwards, half);
+                let far_plane = node.planes.quarter(axis * 2 + 1 - backwards, half);
                 let t_near = (near_plane - self.origin[axis]) * self.inv_direction[axis];
                 let t_far = (far_plane - self.origin[axis]) * self.inv_direction[axis];
                 enter = enter.max(t_near);
@@ -610,7 +834,7 @@ fn dequantise(node: &CwBvhNode, build_scale: BuildScale) -> NodePlanes {
         let scale = f64::from(f32::from_bits(u32::from(node.e[axis]) << 23));
         for child in 0..8 {
             let exact = (origin + scale * f64::from(bytes[child])) * unscale;
-            out.halves[child / 4][slot][child % 4] = if is_max {
+            out.rows[slot][child] = if is_max {
                 round_up(exact)
             } else {
                 round_down(exact)
@@ -676,14 +900,14 @@ mod tests {
                 let node = &cwbvh.nodes[index];
                 let planes = &bvh.nodes[index].planes;
                 let mut touched = 0u32;
-                for (half, planes) in planes.halves.iter().enumerate() {
+                for half in 0..2 {
                     let mut enter = query.tmin;
                     let mut exit = Vec4::splat(tmax);
-                    for axis in 0..3 {
-                        let b = usize::from(backwards[axis]);
-                        let t_near =
-                            (planes[axis * 2 + b] - query.origin[axis]) * query.inv_direction[axis];
-                        let t_far = (planes[axis * 2 + 1 - b] - query.origin[axis])
+                    for (axis, &backwards) in backwards.iter().enumerate() {
+                        let b = usize::from(backwards);
+                        let t_near = (planes.quarter(axis * 2 + b, half) - query.origin[axis])
+                            * query.inv_direction[axis];
+                        let t_far = (planes.quarter(axis * 2 + 1 - b, half) - query.origin[axis])
                             * query.inv_direction[axis];
                         enter = enter.max(t_near);
                         exit = exit.min(t_far);
@@ -828,6 +1052,121 @@ mod tests {
             }
         }
         assert!(compared > 20_000 && packets == 1200, "{compared} visits");
+    }
+
+    /// Rays that stress the slab test's edge cases against `aabbs`: from box corners and
+    /// face centres along the axes (both signs, and −0.0 in the other components), along a
+    /// face (grazing), corner to corner (touching boxes exactly at their edges), and random
+    /// rays through the set.
+    fn awkward_rays(aabbs: &[Aabb], random: &mut Random) -> Vec<Ray> {
+        let axes = [Vec3A::X, Vec3A::Y, Vec3A::Z];
+        let mut rays = Vec::new();
+        let step = (aabbs.len() / 40).max(1);
+        for (i, aabb) in aabbs.iter().enumerate().step_by(step) {
+            let (lo, hi) = (aabb.min, aabb.max);
+            let centre = (lo + hi) * 0.5;
+            let size = (hi - lo).max_element().max(1.0);
+            let other = &aabbs[(i * 7 + 3) % aabbs.len()];
+            for axis in axes {
+                let negative_zeros = Vec3A::select(axis.cmpeq(Vec3A::ZERO), -Vec3A::ZERO, axis);
+                let on_face = Vec3A::select(axis.cmpeq(Vec3A::ZERO), centre, lo);
+                for direction in [axis, -axis, negative_zeros] {
+                    rays.push(Ray::new(on_face, direction));
+                    rays.push(Ray::new(centre - direction * size * 4.0, direction));
+                }
+                let along_face = (Vec3A::ONE - axis).normalize();
+                rays.push(Ray::new(lo, along_face));
+                rays.push(Ray::new(hi, -along_face));
+            }
+            rays.push(Ray::new(lo, (other.max - lo).normalize_or(Vec3A::X)));
+            rays.push(Ray::new(hi, (other.min - hi).normalize_or(Vec3A::Y)));
+            let from = centre + (random.vec() - 0.5) * size * 8.0;
+            rays.push(Ray::new(from, (centre - from).normalize_or(Vec3A::Z)));
+        }
+        rays
+    }
+
+    /// Every traversal path this CPU runs visits exactly what the baseline visits, in the
+    /// same order with the same `tmax`, alone and in packets, on every kind of box set
+    /// (huge and tiny coordinates, flat and coincident boxes, shared faces), with awkward
+    /// rays and visitors that shrink `tmax` and stop. (The image test over every golden
+    /// scene is the integration test `traversal_paths`.)
+    #[test]
+    #[allow(clippy::print_stderr)]
+    fn every_traversal_path_visits_what_the_baseline_visits() {
+        let paths: Vec<ChildTestPath> = TraversalPath::ALL
+            .into_iter()
+            .filter_map(ChildTestPath::of)
+            .filter(|&p| p != ChildTestPath::Baseline)
+            .collect();
+        if paths.is_empty() {
+            eprintln!("SKIPPED: this CPU runs only the baseline BVH walk");
+            return;
+        }
+        let mut random = Random(0x5eed_1234);
+        let mut sets = crate::bvh_wide::tests::inputs();
+        // Boxes sharing faces and edges exactly, and a flat one across them.
+        let mut shared: Vec<Aabb> = (0..60)
+            .map(|i| {
+                let corner = Vec3A::new(i as f32, 20.0, (i % 3) as f32);
+                Aabb::new(corner, corner + 1.0)
+            })
+            .collect();
+        shared.push(Aabb::new(
+            Vec3A::new(-3.0, 19.0, 1.0),
+            Vec3A::new(63.0, 23.0, 1.0),
+        ));
+        sets.push(("shared faces".to_string(), shared));
+        let (mut stack, mut packet_stack) = (Vec::new(), Vec::new());
+        let mut compared = 0usize;
+        for (name, aabbs) in sets.iter().filter(|(_, a)| !a.is_empty()) {
+            let (mut bvh, _) = Bvh::build(aabbs);
+            let rays = awkward_rays(aabbs, &mut random);
+            for (mode, tmin) in (0..3u32).flat_map(|m| [(m, 0.0), (m, 1e-3)]) {
+                let mut logs = Vec::new();
+                for path in std::iter::once(ChildTestPath::Baseline).chain(paths.iter().copied()) {
+                    bvh.path = path;
+                    let mut alone: Vec<Vec<(u32, u32)>> = vec![Vec::new(); rays.len()];
+                    for (log, ray) in alone.iter_mut().zip(&rays) {
+                        bvh.traverse(ray, tmin, f32::INFINITY, &mut stack, |id, tmax| {
+                            logging_visit(log, mode, id, tmax)
+                        });
+                    }
+                    // The same rays in packets of neighbours that share an octant.
+                    let mut together: Vec<Vec<(u32, u32)>> = vec![Vec::new(); rays.len()];
+                    for (start, chunk) in rays.chunks(PACKET).enumerate() {
+                        let mut tmax = [f32::INFINITY; PACKET];
+                        let logs = &mut together[start * PACKET..];
+                        let walked = bvh.traverse_packet(
+                            chunk,
+                            tmin,
+                            &mut tmax,
+                            &mut packet_stack,
+                            |r, id, t| logging_visit(&mut logs[r], mode, id, t),
+                        );
+                        if !walked {
+                            logs[..chunk.len()].iter_mut().for_each(Vec::clear);
+                        }
+                    }
+                    logs.push((path, alone, together));
+                }
+                let (_, base_alone, base_together) = &logs[0];
+                for (path, alone, together) in &logs[1..] {
+                    for (k, ray) in rays.iter().enumerate() {
+                        assert_eq!(
+                            alone[k], base_alone[k],
+                            "{name}: {path:?} alone, ray {k} {ray:?}, mode {mode}, tmin {tmin}"
+                        );
+                        assert_eq!(
+                            together[k], base_together[k],
+                            "{name}: {path:?} in a packet, ray {k} {ray:?}, mode {mode}"
+                        );
+                    }
+                    compared += alone.iter().chain(together).map(Vec::len).sum::<usize>();
+                }
+            }
+        }
+        assert!(compared > 100_000, "{compared} visits compared");
     }
 
     /// Rays of different octants are refused, untouched, for the caller to walk alone.

@@ -9,6 +9,7 @@
 mod bounds;
 mod bvh;
 mod bvh_build;
+mod bvh_simd;
 mod bvh_wide;
 mod camera;
 mod csg;
@@ -35,6 +36,7 @@ mod trace;
 #[cfg(test)]
 mod tests;
 
+pub use bvh::{force_traversal_path, PathUnavailable, TraversalPath};
 pub use recorder::{
     Interface, LightSample, NoRecord, PixelStats, RayKind, RayStart, Recorder, ShadowRay,
     ShadowResult, SkippedRay, SurfaceHit, Termination, TerminationSet,

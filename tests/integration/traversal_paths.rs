@@ -1,0 +1,163 @@
+//! The BVH walk's child test has a baseline (SSE2) path and AVX2 and AVX-512 paths chosen
+//! at run time: every golden scene and the benchmark scenes must render bit for bit the same
+//! on each path this CPU runs, on one thread and on several, and the binary reports and
+//! honours a forced path.
+
+use std::process::Command;
+
+use whitted_tracer::{
+    force_traversal_path, render, NoObserver, PreparedScene, RenderOptions, TraversalPath,
+};
+
+use crate::ray_trees::load;
+
+/// The scenes of `tests/golden/manifest.toml`, and the benchmark scenes that need no `-D`.
+fn scene_paths() -> Vec<String> {
+    let manifest = std::fs::read_to_string("tests/golden/manifest.toml")
+        .unwrap_or_else(|e| panic!("tests/golden/manifest.toml: {e}"));
+    let mut paths: Vec<String> = manifest
+        .lines()
+        .filter_map(|line| line.strip_prefix("path = \""))
+        .filter_map(|rest| rest.strip_suffix('"'))
+        .map(str::to_string)
+        .collect();
+    assert!(
+        paths.len() > 20,
+        "the manifest lists {} scenes",
+        paths.len()
+    );
+    paths.extend(
+        [
+            "classic",
+            "spheres1000",
+            "grid",
+            "menger",
+            "union10k",
+            "crystals",
+        ]
+        .map(|name| format!("scenes/bench/{name}.scene")),
+    );
+    paths
+}
+
+/// The image's pixels as bits, rendered with `path` on `threads` threads.
+fn render_bits(
+    scene: &whitted_ir::ValidScene,
+    path: TraversalPath,
+    threads: usize,
+) -> Vec<[u32; 3]> {
+    // A BVH keeps the path it was built with, so prepare the scene again under the forced
+    // one. (Other tests building BVHs meanwhile get it too, which cannot change their
+    // results: that is what this test checks.)
+    force_traversal_path(Some(path)).unwrap_or_else(|e| panic!("{e}"));
+    let prepared = PreparedScene::new(scene);
+    force_traversal_path(None).unwrap_or_else(|e| panic!("{e}"));
+    let options = RenderOptions {
+        width: 96,
+        height: 72,
+        ..RenderOptions::from_settings(&scene.settings)
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap_or_else(|e| panic!("no pool: {e}"));
+    let (image, _) = pool
+        .install(|| render(&prepared, &options, &NoObserver))
+        .unwrap_or_else(|| panic!("cancelled"));
+    image.pixels.iter().map(|p| p.map(f32::to_bits)).collect()
+}
+
+#[test]
+fn every_traversal_path_renders_the_same_bits() {
+    let paths: Vec<TraversalPath> = TraversalPath::ALL
+        .into_iter()
+        .filter(|p| p.available())
+        .collect();
+    if paths.len() == 1 {
+        eprintln!("SKIPPED: this CPU runs only the baseline BVH walk");
+        return;
+    }
+    for scene in scene_paths() {
+        let loaded = load(&scene);
+        let baseline = render_bits(&loaded.scene, TraversalPath::Baseline, 1);
+        for &path in &paths {
+            for threads in [1, 3] {
+                if (path, threads) == (TraversalPath::Baseline, 1) {
+                    continue;
+                }
+                let image = render_bits(&loaded.scene, path, threads);
+                let differing = baseline.iter().zip(&image).filter(|(a, b)| a != b).count();
+                assert!(
+                    differing == 0 && image.len() == baseline.len(),
+                    "{scene}: {differing} pixels differ between the baseline walk on one \
+                     thread and the {} walk on {threads}",
+                    path.name()
+                );
+            }
+        }
+    }
+}
+
+/// `whitted render` with `WHITTED_TRAVERSAL` set to `value` (unset when `None`): its exit
+/// code, its stdout (the text stats) and stderr, and the PNG's bytes.
+fn render_with_env(value: Option<&str>, png: &std::path::Path) -> (i32, String, String, Vec<u8>) {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_whitted"));
+    command
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["render", "scenes/bench/spheres1000.scene", "--stats", "-o"])
+        .arg(png)
+        .env_remove("WHITTED_TRAVERSAL");
+    if let Some(value) = value {
+        command.env("WHITTED_TRAVERSAL", value);
+    }
+    let output = command.output().unwrap_or_else(|e| panic!("whitted: {e}"));
+    let bytes = std::fs::read(png).unwrap_or_default();
+    (
+        output.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+        String::from_utf8_lossy(&output.stderr).into_owned(),
+        bytes,
+    )
+}
+
+/// The binary says which walk it used, honours a forced one with the same image, and
+/// refuses a name that is no walk (or one this CPU cannot run) with a message naming the
+/// variable.
+#[test]
+fn the_binary_reports_and_honours_a_forced_walk() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let (code, stats, _, default_png) = render_with_env(None, &dir.path().join("default.png"));
+    assert_eq!(code, 0);
+    let fastest = TraversalPath::fastest().name();
+    assert!(
+        stats.contains(&format!("bvh walk         {fastest}\n")),
+        "{stats}"
+    );
+    for path in TraversalPath::ALL {
+        let png = dir.path().join(format!("{}.png", path.name()));
+        let (code, stats, stderr, bytes) = render_with_env(Some(path.name()), &png);
+        if path.available() {
+            assert_eq!(code, 0, "{stderr}");
+            assert!(stats.contains(&format!("bvh walk         {}\n", path.name())));
+            assert!(bytes == default_png, "{}: the image differs", path.name());
+        } else {
+            assert_eq!(code, 1);
+            assert!(stderr.contains("WHITTED_TRAVERSAL=") && stderr.contains("cannot run"));
+        }
+    }
+    let (code, _, stderr, _) = render_with_env(Some("sse9"), &dir.path().join("bad.png"));
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("WHITTED_TRAVERSAL=\"sse9\" names no BVH walk")
+            && stderr.contains("baseline, avx2, avx512"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("bad.png").exists());
+    // Empty is unset: the fastest walk.
+    let (code, stats, _, _) = render_with_env(Some(""), &dir.path().join("empty.png"));
+    assert_eq!(code, 0);
+    assert!(
+        stats.contains(&format!("bvh walk         {fastest}\n")),
+        "{stats}"
+    );
+}
