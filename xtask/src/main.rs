@@ -72,9 +72,16 @@ pub fn workspace_root() -> std::path::PathBuf {
 
 /// Runs a command in the workspace root, echoing it, and fails if it fails.
 pub fn run_cargo(args: &[&str]) -> anyhow::Result<()> {
-    eprintln!("$ cargo {}", args.join(" "));
+    run_cargo_with(args, &[])
+}
+
+/// [`run_cargo`] with environment variables set for the command.
+pub fn run_cargo_with(args: &[&str], env: &[(&str, &str)]) -> anyhow::Result<()> {
+    let shown: Vec<String> = env.iter().map(|(k, v)| format!("{k}={v} ")).collect();
+    eprintln!("$ {}cargo {}", shown.concat(), args.join(" "));
     let status = std::process::Command::new(cargo())
         .args(args)
+        .envs(env.iter().copied())
         .current_dir(workspace_root())
         .status()?;
     anyhow::ensure!(

@@ -47,10 +47,10 @@ use crate::ray::Ray;
 
 /// Children's box planes of one node, a row of eight children per plane: `rows[axis * 2]`
 /// holds the minima along `axis`, `rows[axis * 2 + 1]` the maxima. A row is two 16-byte
-/// loads for the baseline's 4-lane test, one 32-byte load for AVX2's 8-lane test, and an
-/// axis's two rows are one 64-byte load for AVX-512 (`bvh_simd`).
+/// loads for the baseline's 4-lane test and one 32-byte load for the 8-lane tests
+/// (`bvh_simd`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[repr(C, align(64))]
+#[repr(C, align(32))]
 pub(crate) struct NodePlanes {
     pub(crate) rows: [[f32; 8]; 6],
 }
@@ -141,8 +141,9 @@ pub enum TraversalPath {
     Baseline,
     /// All eight children in one 8-lane register (AVX2).
     Avx2,
-    /// Each axis's near and far planes of all eight children in one 16-lane register, and
-    /// the compare straight into a mask register (AVX-512 F, VL and DQ).
+    /// The AVX2 test's eight lanes with AVX-512's compare into a mask register, in a walk
+    /// compiled for AVX-512 F and VL (32 vector registers) but never using 512-bit ones,
+    /// which slow the other vector work and, on some CPUs, the clock.
     Avx512,
 }
 

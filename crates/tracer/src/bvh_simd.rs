@@ -60,15 +60,14 @@ impl Avx2 {
 }
 
 impl Avx512 {
-    /// `Some` when the CPU, asked at run time, has AVX-512 F, VL and DQ besides what the
-    /// AVX2 walk needs.
+    /// `Some` when the CPU, asked at run time, has AVX-512 F and VL besides what the AVX2
+    /// walk needs.
     pub(crate) fn detect() -> Option<Avx512> {
         #[cfg(target_arch = "x86_64")]
         {
             let present = Avx2::detect().is_some()
                 && std::arch::is_x86_feature_detected!("avx512f")
-                && std::arch::is_x86_feature_detected!("avx512vl")
-                && std::arch::is_x86_feature_detected!("avx512dq");
+                && std::arch::is_x86_feature_detected!("avx512vl");
             present.then_some(Avx512 { _private: () })
         }
         #[cfg(not(target_arch = "x86_64"))]
@@ -101,7 +100,7 @@ pub(crate) fn traverse_avx2(
     }
 }
 
-/// [`Bvh::traverse`] with the 16-lane child test.
+/// [`Bvh::traverse`] with the AVX-512 child test.
 #[inline]
 pub(crate) fn traverse_avx512(
     avx512: Avx512,
@@ -150,7 +149,7 @@ pub(crate) fn traverse_packet_avx2(
     }
 }
 
-/// [`Bvh::traverse_packet`] (after its checks) with the 16-lane child test.
+/// [`Bvh::traverse_packet`] (after its checks) with the AVX-512 child test.
 #[inline]
 pub(crate) fn traverse_packet_avx512(
     avx512: Avx512,
@@ -177,10 +176,8 @@ pub(crate) fn traverse_packet_avx512(
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use std::arch::x86_64::{
-        __m256, __m512, _mm256_cmp_ps, _mm256_cmp_ps_mask, _mm256_loadu_ps, _mm256_max_ps,
-        _mm256_min_ps, _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_sub_ps,
-        _mm512_castps512_ps256, _mm512_extractf32x8_ps, _mm512_loadu_ps, _mm512_mul_ps,
-        _mm512_set1_ps, _mm512_sub_ps, _CMP_LE_OS,
+        __m256, _mm256_cmp_ps, _mm256_cmp_ps_mask, _mm256_loadu_ps, _mm256_max_ps, _mm256_min_ps,
+        _mm256_movemask_ps, _mm256_mul_ps, _mm256_set1_ps, _mm256_sub_ps, _CMP_LE_OS,
     };
 
     use glam::UVec2;
@@ -216,7 +213,7 @@ mod x86 {
         bvh.traverse_packet_with(&test, rays, tmax, stack, visit);
     }
 
-    #[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,bmi1,lzcnt,popcnt")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,lzcnt,popcnt")]
     pub(super) fn walk_avx512(
         bvh: &Bvh,
         ray: &Ray,
@@ -225,10 +222,11 @@ mod x86 {
         stack: &mut Vec<UVec2>,
         visit: impl FnMut(u32, f32) -> Step,
     ) {
-        bvh.traverse_with(&SixteenLanes::new(ray, tmin), ray, tmax, stack, visit);
+        let query = MaskedLanes(EightLanes::new(ray, tmin));
+        bvh.traverse_with(&query, ray, tmax, stack, visit);
     }
 
-    #[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,bmi1,lzcnt,popcnt")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl,bmi1,lzcnt,popcnt")]
     pub(super) fn walk_packet_avx512(
         bvh: &Bvh,
         rays: &[Ray],
@@ -237,7 +235,7 @@ mod x86 {
         stack: &mut Vec<PacketEntry>,
         visit: impl FnMut(usize, u32, f32) -> Step,
     ) {
-        let test = PerRayTest::new(rays, |ray| SixteenLanes::new(ray, tmin));
+        let test = PerRayTest::new(rays, |ray| MaskedLanes(EightLanes::new(ray, tmin)));
         bvh.traverse_packet_with(&test, rays, tmax, stack, visit);
     }
 
@@ -268,10 +266,11 @@ mod x86 {
             }
         }
 
-        /// The baseline's test (`NodeQuery::touched`), eight lanes at a time.
+        /// The baseline's `NodeQuery::touched` up to the compare, eight lanes at a time:
+        /// where the segment enters and leaves each child's box.
         #[target_feature(enable = "avx2")]
         #[inline]
-        fn touched8<const OCT: u32>(&self, node: &WideNode, tmax: f32) -> u32 {
+        fn enter_exit<const OCT: u32>(&self, node: &WideNode, tmax: f32) -> (__m256, __m256) {
             let rows = &node.planes.rows;
             let mut enter = self.tmin;
             let mut exit = _mm256_set1_ps(tmax);
@@ -298,8 +297,24 @@ mod x86 {
                 enter = _mm256_max_ps(enter, t_near);
                 exit = _mm256_min_ps(exit, t_far);
             }
-            // glam's `cmple` is `cmpleps`, predicate LE_OS: a NaN lane is not touched.
+            (enter, exit)
+        }
+
+        /// The touched children: glam's `cmple` is `cmpleps`, predicate LE_OS, so a NaN
+        /// lane is not touched.
+        #[target_feature(enable = "avx2")]
+        #[inline]
+        fn touched8<const OCT: u32>(&self, node: &WideNode, tmax: f32) -> u32 {
+            let (enter, exit) = self.enter_exit::<OCT>(node, tmax);
             _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OS>(enter, exit)) as u32
+        }
+
+        /// [`EightLanes::touched8`] with AVX-512's compare straight into a mask register.
+        #[target_feature(enable = "avx512f,avx512vl")]
+        #[inline]
+        fn touched8_mask<const OCT: u32>(&self, node: &WideNode, tmax: f32) -> u32 {
+            let (enter, exit) = self.enter_exit::<OCT>(node, tmax);
+            u32::from(_mm256_cmp_ps_mask::<_CMP_LE_OS>(enter, exit))
         }
     }
 
@@ -307,76 +322,20 @@ mod x86 {
         #[inline(always)]
         fn touched<const OCT: u32>(&self, node: &WideNode, tmax: f32) -> u32 {
             // SAFETY: `EightLanes::new` is compiled for AVX2 and only called from the AVX2
-            // walks, which run only where `Avx2::detect` found it: a value exists only there.
+            // and AVX-512 walks, which run only where `Avx2::detect` found it.
             unsafe { self.touched8::<OCT>(node, tmax) }
         }
     }
 
-    /// The ray broadcast to sixteen lanes once per query: an axis's min and max planes of
-    /// all eight children are one 64-byte row pair, subtracted and scaled at once.
-    pub(super) struct SixteenLanes {
-        origin: [__m512; 3],
-        inv_direction: [__m512; 3],
-        tmin: __m256,
-    }
+    /// The AVX-512 walk's query: [`EightLanes`] whose compare writes a mask register.
+    pub(super) struct MaskedLanes(EightLanes);
 
-    impl SixteenLanes {
-        #[target_feature(enable = "avx512f")]
-        #[inline]
-        fn new(ray: &Ray, tmin: f32) -> SixteenLanes {
-            let inv = inverse_direction(ray.direction);
-            SixteenLanes {
-                origin: [
-                    _mm512_set1_ps(ray.origin.x),
-                    _mm512_set1_ps(ray.origin.y),
-                    _mm512_set1_ps(ray.origin.z),
-                ],
-                inv_direction: [
-                    _mm512_set1_ps(inv.x),
-                    _mm512_set1_ps(inv.y),
-                    _mm512_set1_ps(inv.z),
-                ],
-                tmin: _mm256_set1_ps(tmin),
-            }
-        }
-
-        /// The baseline's test (`NodeQuery::touched`): per axis, both planes of all eight
-        /// children in one 16-lane subtract and multiply, then the near and far halves into
-        /// the same max, min and compare, the compare straight into a mask register.
-        #[target_feature(enable = "avx512f,avx512vl,avx512dq")]
-        #[inline]
-        fn touched16<const OCT: u32>(&self, node: &WideNode, tmax: f32) -> u32 {
-            let rows = node.planes.rows.as_flattened();
-            let mut enter = self.tmin;
-            let mut exit = _mm256_set1_ps(tmax);
-            for axis in 0..3 {
-                let pair = &rows[axis * 16..axis * 16 + 16];
-                // SAFETY: `pair` is sixteen readable f32s (an axis's min row, then its max
-                // row); the load needs no alignment.
-                let planes = unsafe { _mm512_loadu_ps(pair.as_ptr()) };
-                let t = _mm512_mul_ps(
-                    _mm512_sub_ps(planes, self.origin[axis]),
-                    self.inv_direction[axis],
-                );
-                let (t_min_plane, t_max_plane) =
-                    (_mm512_castps512_ps256(t), _mm512_extractf32x8_ps::<1>(t));
-                let (t_near, t_far) = if OCT & (4 >> axis) == 0 {
-                    (t_max_plane, t_min_plane)
-                } else {
-                    (t_min_plane, t_max_plane)
-                };
-                enter = _mm256_max_ps(enter, t_near);
-                exit = _mm256_min_ps(exit, t_far);
-            }
-            u32::from(_mm256_cmp_ps_mask::<_CMP_LE_OS>(enter, exit))
-        }
-    }
-
-    impl ChildTest for SixteenLanes {
+    impl ChildTest for MaskedLanes {
         #[inline(always)]
         fn touched<const OCT: u32>(&self, node: &WideNode, tmax: f32) -> u32 {
-            // SAFETY: as for `EightLanes`, with `Avx512::detect`.
-            unsafe { self.touched16::<OCT>(node, tmax) }
+            // SAFETY: a `MaskedLanes` is made only in the AVX-512 walks, which run only
+            // where `Avx512::detect` found AVX-512 F and VL.
+            unsafe { self.0.touched8_mask::<OCT>(node, tmax) }
         }
     }
 }

@@ -10,7 +10,7 @@ use std::time::Instant;
 use anyhow::{bail, Context};
 use serde::Deserialize;
 
-use crate::{run_cargo, workspace_root};
+use crate::{run_cargo, run_cargo_with, workspace_root};
 
 mod mesh;
 mod programs;
@@ -119,6 +119,8 @@ struct Stats {
     render_cpu_seconds: f64,
     total_rays: u64,
     peak_memory_kib: Option<u64>,
+    /// The BVH walk's child test the binary chose (`baseline`, `avx2`, `avx512`).
+    bvh_walk: String,
 }
 
 pub fn run(args: &[String]) -> anyhow::Result<()> {
@@ -206,6 +208,27 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         "--",
         "spheres",
     ])?;
+
+    // The BVH walk's child test on each path (issue 14): the default is the fastest the CPU
+    // runs; every path renders the same bits (tests/integration/traversal_paths.rs).
+    println!("\nBVH walk paths (steady state, one thread and all cores; the same images)");
+    for path in ["baseline", "avx2", "avx512"] {
+        for scene in [&["spheres"][..], &["grid", "100"]] {
+            let mut args = vec![
+                "run",
+                "--quiet",
+                "--release",
+                "--locked",
+                "-p",
+                "whitted-tracer",
+                "--example",
+                "bench",
+                "--",
+            ];
+            args.extend_from_slice(scene);
+            run_cargo_with(&args, &[("WHITTED_TRAVERSAL", path)])?;
+        }
+    }
 
     if Path::new(POVRAY).exists() {
         println!("\nPOV-Ray 3.7 on the equivalent scenes ({width}x{height}, max_trace_level 5, no anti-aliasing)");
@@ -301,6 +324,7 @@ fn render_table<'c>(
         "scaling",
         "peak MiB"
     );
+    let mut walk = String::from("none");
     for case in cases {
         let mut one_thread_render = None;
         for threads in [1, cores.max(2)] {
@@ -399,8 +423,10 @@ fn render_table<'c>(
                 scaling,
                 peak
             );
+            walk = stats.bvh_walk;
         }
     }
+    println!("(BVH walk: {walk}; `WHITTED_TRAVERSAL=baseline|avx2|avx512` forces one)");
     Ok(())
 }
 
