@@ -328,18 +328,27 @@ impl PreparedScene {
     ) -> Option<Hit> {
         let Scratch { csg, bvh_stack, .. } = scratch;
         let mut blocker = None;
-        bvh.traverse(ray, tmin, tmax, bvh_stack, |id, tmax| {
-            let Some(item) = self.bounded.get(id as usize) else {
-                return Step::Continue;
-            };
-            match item_hit(item, ray, tmin, tmax, csg) {
-                Some(found) => {
-                    blocker = Some(Hit::new(ItemRef::Bounded(id), found));
-                    Step::Stop
+        // Inlined into the walk: as a call, each sphere test would spill the walk's vector
+        // registers (the AVX walks, compiled for other features, left it out of line).
+        bvh.traverse(
+            ray,
+            tmin,
+            tmax,
+            bvh_stack,
+            #[inline(always)]
+            |id, tmax| {
+                let Some(item) = self.bounded.get(id as usize) else {
+                    return Step::Continue;
+                };
+                match item_hit(item, ray, tmin, tmax, csg) {
+                    Some(found) => {
+                        blocker = Some(Hit::new(ItemRef::Bounded(id), found));
+                        Step::Stop
+                    }
+                    None => Step::Continue,
                 }
-                None => Step::Continue,
-            }
-        });
+            },
+        );
         blocker
     }
 
