@@ -41,7 +41,7 @@ use obvhs::cwbvh::CwBvh;
 
 use crate::bounds::inverse_direction;
 use crate::bvh_build::{build_bvh2, build_bvh2_with, round_down, round_up, BuildScale, Built};
-use crate::bvh_simd;
+use crate::bvh_simd::{self, SimdPath};
 use crate::bvh_wide;
 use crate::ray::Ray;
 
@@ -230,16 +230,14 @@ pub fn force_traversal_path(path: Option<TraversalPath>) -> Result<(), PathUnava
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum ChildTestPath {
     Baseline,
-    Avx2(bvh_simd::Avx2),
-    Avx512(bvh_simd::Avx512),
+    Simd(SimdPath),
 }
 
 impl ChildTestPath {
     fn of(path: TraversalPath) -> Option<ChildTestPath> {
         match path {
             TraversalPath::Baseline => Some(ChildTestPath::Baseline),
-            TraversalPath::Avx2 => bvh_simd::Avx2::detect().map(ChildTestPath::Avx2),
-            TraversalPath::Avx512 => bvh_simd::Avx512::detect().map(ChildTestPath::Avx512),
+            _ => SimdPath::detect(path).map(ChildTestPath::Simd),
         }
     }
 
@@ -263,8 +261,7 @@ impl ChildTestPath {
     fn public(self) -> TraversalPath {
         match self {
             ChildTestPath::Baseline => TraversalPath::Baseline,
-            ChildTestPath::Avx2(_) => TraversalPath::Avx2,
-            ChildTestPath::Avx512(_) => TraversalPath::Avx512,
+            ChildTestPath::Simd(simd) => simd.path(),
         }
     }
 }
@@ -419,11 +416,8 @@ impl Bvh {
             ChildTestPath::Baseline => {
                 self.traverse_with(&NodeQuery::new(ray, tmin), ray, tmax, stack, visit);
             }
-            ChildTestPath::Avx2(avx2) => {
-                bvh_simd::traverse_avx2(avx2, self, ray, tmin, tmax, stack, visit);
-            }
-            ChildTestPath::Avx512(avx512) => {
-                bvh_simd::traverse_avx512(avx512, self, ray, tmin, tmax, stack, visit);
+            ChildTestPath::Simd(simd) => {
+                bvh_simd::traverse(simd, self, ray, tmin, tmax, stack, visit);
             }
         }
     }
@@ -548,11 +542,8 @@ impl Bvh {
                 let test = &PerRayTest::new(rays, |ray| NodeQuery::new(ray, tmin));
                 self.traverse_packet_with(test, rays, tmax, stack, visit);
             }
-            ChildTestPath::Avx2(avx2) => {
-                bvh_simd::traverse_packet_avx2(avx2, self, rays, tmin, tmax, stack, visit);
-            }
-            ChildTestPath::Avx512(avx512) => {
-                bvh_simd::traverse_packet_avx512(avx512, self, rays, tmin, tmax, stack, visit);
+            ChildTestPath::Simd(simd) => {
+                bvh_simd::traverse_packet(simd, self, rays, tmin, tmax, stack, visit);
             }
         }
         true

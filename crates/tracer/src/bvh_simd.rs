@@ -14,71 +14,62 @@
 
 use glam::UVec2;
 
-use crate::bvh::{Bvh, PacketEntry, Step, PACKET};
+use crate::bvh::{Bvh, PacketEntry, Step, TraversalPath, PACKET};
 use crate::ray::Ray;
 
-/// An uninhabited type: off x86-64 no CPU-feature proof can exist.
-#[cfg(not(target_arch = "x86_64"))]
+/// A SIMD child test this CPU was found to run: only [`SimdPath::detect`] makes one, so
+/// holding one is the proof that its walk's instructions exist here.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Never {}
+pub(crate) struct SimdPath(Isa);
 
-/// Proof that this CPU has the features the AVX2 walk is compiled for: only
-/// [`Avx2::detect`] makes one.
+/// The instruction sets of the SIMD walks (none off x86-64, where no `SimdPath` exists).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Avx2 {
+enum Isa {
+    /// AVX2, with the bit instructions of its generation (`bmi1`, `lzcnt`, `popcnt`).
     #[cfg(target_arch = "x86_64")]
-    _private: (),
-    #[cfg(not(target_arch = "x86_64"))]
-    never: Never,
+    Avx2,
+    /// AVX2's, and AVX-512 F and VL.
+    #[cfg(target_arch = "x86_64")]
+    Avx512,
 }
 
-/// Proof that this CPU has the features the AVX-512 walk is compiled for: only
-/// [`Avx512::detect`] makes one.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Avx512 {
-    #[cfg(target_arch = "x86_64")]
-    _private: (),
-    #[cfg(not(target_arch = "x86_64"))]
-    never: Never,
-}
-
-impl Avx2 {
-    /// `Some` when the CPU, asked at run time, has AVX2 and the bit instructions the walk
-    /// is compiled with.
-    pub(crate) fn detect() -> Option<Avx2> {
+impl SimdPath {
+    /// `path` when this CPU, asked at run time, has every feature its walk is compiled
+    /// for; `None` for the baseline, which needs no proof.
+    pub(crate) fn detect(path: TraversalPath) -> Option<SimdPath> {
         #[cfg(target_arch = "x86_64")]
         {
-            let present = std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("bmi1")
-                && std::arch::is_x86_feature_detected!("lzcnt")
-                && std::arch::is_x86_feature_detected!("popcnt");
-            present.then_some(Avx2 { _private: () })
+            use std::arch::is_x86_feature_detected as has;
+            let avx2 = has!("avx2") && has!("bmi1") && has!("lzcnt") && has!("popcnt");
+            match path {
+                TraversalPath::Baseline => None,
+                TraversalPath::Avx2 => avx2.then_some(SimdPath(Isa::Avx2)),
+                TraversalPath::Avx512 => {
+                    (avx2 && has!("avx512f") && has!("avx512vl")).then_some(SimdPath(Isa::Avx512))
+                }
+            }
         }
         #[cfg(not(target_arch = "x86_64"))]
-        None
+        {
+            let _ = path;
+            None
+        }
+    }
+
+    pub(crate) fn path(self) -> TraversalPath {
+        match self.0 {
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => TraversalPath::Avx2,
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => TraversalPath::Avx512,
+        }
     }
 }
 
-impl Avx512 {
-    /// `Some` when the CPU, asked at run time, has AVX-512 F and VL besides what the AVX2
-    /// walk needs.
-    pub(crate) fn detect() -> Option<Avx512> {
-        #[cfg(target_arch = "x86_64")]
-        {
-            let present = Avx2::detect().is_some()
-                && std::arch::is_x86_feature_detected!("avx512f")
-                && std::arch::is_x86_feature_detected!("avx512vl");
-            present.then_some(Avx512 { _private: () })
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        None
-    }
-}
-
-/// [`Bvh::traverse`] with the 8-lane child test.
+/// [`Bvh::traverse`] with a SIMD child test.
 #[inline]
-pub(crate) fn traverse_avx2(
-    avx2: Avx2,
+pub(crate) fn traverse(
+    simd: SimdPath,
     bvh: &Bvh,
     ray: &Ray,
     tmin: f32,
@@ -86,49 +77,23 @@ pub(crate) fn traverse_avx2(
     stack: &mut Vec<UVec2>,
     visit: impl FnMut(u32, f32) -> Step,
 ) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        let Avx2 { _private: () } = avx2;
-        // SAFETY: an `Avx2` exists only once `Avx2::detect` has seen every feature that
-        // `x86::walk_avx2` is compiled for.
-        unsafe { x86::walk_avx2(bvh, ray, tmin, tmax, stack, visit) }
-    }
+    // Off x86-64 no `SimdPath` exists, so there is nothing to call.
     #[cfg(not(target_arch = "x86_64"))]
-    {
-        let _ = (bvh, ray, tmin, tmax, stack, visit);
-        match avx2.never {}
+    let _ = (bvh, ray, tmin, tmax, stack, visit);
+    // SAFETY (both calls): `simd` exists only once `SimdPath::detect` has seen every
+    // feature the walk is compiled for.
+    match simd.0 {
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::walk_avx2(bvh, ray, tmin, tmax, stack, visit) },
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::walk_avx512(bvh, ray, tmin, tmax, stack, visit) },
     }
 }
 
-/// [`Bvh::traverse`] with the AVX-512 child test.
+/// [`Bvh::traverse_packet`], after its checks, with a SIMD child test.
 #[inline]
-pub(crate) fn traverse_avx512(
-    avx512: Avx512,
-    bvh: &Bvh,
-    ray: &Ray,
-    tmin: f32,
-    tmax: f32,
-    stack: &mut Vec<UVec2>,
-    visit: impl FnMut(u32, f32) -> Step,
-) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        let Avx512 { _private: () } = avx512;
-        // SAFETY: an `Avx512` exists only once `Avx512::detect` has seen every feature
-        // that `x86::walk_avx512` is compiled for.
-        unsafe { x86::walk_avx512(bvh, ray, tmin, tmax, stack, visit) }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        let _ = (bvh, ray, tmin, tmax, stack, visit);
-        match avx512.never {}
-    }
-}
-
-/// [`Bvh::traverse_packet`] (after its checks) with the 8-lane child test.
-#[inline]
-pub(crate) fn traverse_packet_avx2(
-    avx2: Avx2,
+pub(crate) fn traverse_packet(
+    simd: SimdPath,
     bvh: &Bvh,
     rays: &[Ray],
     tmin: f32,
@@ -136,40 +101,14 @@ pub(crate) fn traverse_packet_avx2(
     stack: &mut Vec<PacketEntry>,
     visit: impl FnMut(usize, u32, f32) -> Step,
 ) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        let Avx2 { _private: () } = avx2;
-        // SAFETY: as in `traverse_avx2`.
-        unsafe { x86::walk_packet_avx2(bvh, rays, tmin, tmax, stack, visit) }
-    }
     #[cfg(not(target_arch = "x86_64"))]
-    {
-        let _ = (bvh, rays, tmin, tmax, stack, visit);
-        match avx2.never {}
-    }
-}
-
-/// [`Bvh::traverse_packet`] (after its checks) with the AVX-512 child test.
-#[inline]
-pub(crate) fn traverse_packet_avx512(
-    avx512: Avx512,
-    bvh: &Bvh,
-    rays: &[Ray],
-    tmin: f32,
-    tmax: &mut [f32; PACKET],
-    stack: &mut Vec<PacketEntry>,
-    visit: impl FnMut(usize, u32, f32) -> Step,
-) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        let Avx512 { _private: () } = avx512;
-        // SAFETY: as in `traverse_avx512`.
-        unsafe { x86::walk_packet_avx512(bvh, rays, tmin, tmax, stack, visit) }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        let _ = (bvh, rays, tmin, tmax, stack, visit);
-        match avx512.never {}
+    let _ = (bvh, rays, tmin, tmax, stack, visit);
+    // SAFETY (both calls): as in `traverse`.
+    match simd.0 {
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::walk_packet_avx2(bvh, rays, tmin, tmax, stack, visit) },
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::walk_packet_avx512(bvh, rays, tmin, tmax, stack, visit) },
     }
 }
 
@@ -322,7 +261,7 @@ mod x86 {
         #[inline(always)]
         fn touched<const OCT: u32>(&self, node: &WideNode, tmax: f32) -> u32 {
             // SAFETY: `EightLanes::new` is compiled for AVX2 and only called from the AVX2
-            // and AVX-512 walks, which run only where `Avx2::detect` found it.
+            // and AVX-512 walks, which run only where `SimdPath::detect` found AVX2.
             unsafe { self.touched8::<OCT>(node, tmax) }
         }
     }
@@ -334,7 +273,7 @@ mod x86 {
         #[inline(always)]
         fn touched<const OCT: u32>(&self, node: &WideNode, tmax: f32) -> u32 {
             // SAFETY: a `MaskedLanes` is made only in the AVX-512 walks, which run only
-            // where `Avx512::detect` found AVX-512 F and VL.
+            // where `SimdPath::detect` found AVX-512 F and VL.
             unsafe { self.0.touched8_mask::<OCT>(node, tmax) }
         }
     }

@@ -184,50 +184,15 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     // example renders the same scenes (built in Rust) repeatedly in one process: the
     // steady-state speed per core.
     println!("\nsteady state (same scenes rendered repeatedly in one process: crates/tracer/examples/bench.rs)");
-    run_cargo(&[
-        "run",
-        "--quiet",
-        "--release",
-        "--locked",
-        "-p",
-        "whitted-tracer",
-        "--example",
-        "bench",
-        "--",
-        "whitted",
-    ])?;
-    run_cargo(&[
-        "run",
-        "--quiet",
-        "--release",
-        "--locked",
-        "-p",
-        "whitted-tracer",
-        "--example",
-        "bench",
-        "--",
-        "spheres",
-    ])?;
+    run_bench_example(&["whitted"], None)?;
+    run_bench_example(&["spheres"], None)?;
 
     // The BVH walk's child test on each path (issue 14): the default is the fastest the CPU
     // runs; every path renders the same bits (tests/integration/traversal_paths.rs).
     println!("\nBVH walk paths (steady state, one thread and all cores; the same images)");
     for path in ["baseline", "avx2", "avx512"] {
-        for scene in [&["spheres"][..], &["grid", "100"]] {
-            let mut args = vec![
-                "run",
-                "--quiet",
-                "--release",
-                "--locked",
-                "-p",
-                "whitted-tracer",
-                "--example",
-                "bench",
-                "--",
-            ];
-            args.extend_from_slice(scene);
-            run_cargo_with(&args, &[("WHITTED_TRAVERSAL", path)])?;
-        }
+        run_bench_example(&["spheres"], Some(path))?;
+        run_bench_example(&["grid", "100"], Some(path))?;
     }
 
     if Path::new(POVRAY).exists() {
@@ -280,6 +245,25 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         println!("{:<34} {:>7.3}s {:>12}", case.label, wall, memory);
     }
     programs::run(&exe, &out_dir, RUNS)
+}
+
+/// Runs the tracer's bench example (`crates/tracer/examples/bench.rs`) with `args`, its BVH
+/// walk forced to `path` when given.
+fn run_bench_example(args: &[&str], path: Option<&str>) -> anyhow::Result<()> {
+    let mut command = vec![
+        "run",
+        "--quiet",
+        "--release",
+        "--locked",
+        "-p",
+        "whitted-tracer",
+        "--example",
+        "bench",
+        "--",
+    ];
+    command.extend_from_slice(args);
+    let env: Vec<(&str, &str)> = path.map(|p| ("WHITTED_TRAVERSAL", p)).into_iter().collect();
+    run_cargo_with(&command, &env)
 }
 
 /// Renders each case RUNS times on one thread and on every core (at least two) and prints
