@@ -1,7 +1,7 @@
 //! The BVH walk's child test has a baseline (SSE2) path and AVX2 and AVX-512 paths chosen
 //! at run time: every golden scene and the benchmark scenes must render bit for bit the same
-//! on each path this CPU runs, on one thread and on several, and the binary reports and
-//! honours a forced path.
+//! on each path this CPU runs, on one thread and on several; the binary reports and honours
+//! a forced path, and runs with the same image on older CPUs emulated by qemu.
 
 use std::process::Command;
 
@@ -160,4 +160,66 @@ fn the_binary_reports_and_honours_a_forced_walk() {
         stats.contains(&format!("bvh walk         {fastest}\n")),
         "{stats}"
     );
+}
+
+/// The one binary runs on a CPU without AVX, and on one with AVX2 but not AVX-512: under
+/// qemu's user-mode emulation of an older CPU (Nehalem: SSE4.2, no AVX; Haswell: AVX2) it
+/// picks the baseline and the AVX2 walk, renders the same bytes as natively, and refuses a
+/// forced walk the emulated CPU lacks. Skipped with a message where qemu-x86_64 is not
+/// installed (`.ci/run` installs it).
+#[test]
+fn the_binary_runs_on_older_cpus_with_the_same_image() {
+    let qemu = "qemu-x86_64";
+    if Command::new(qemu).arg("--version").output().is_err() {
+        eprintln!("SKIPPED: {qemu} is not installed (apt-get install qemu-user)");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let exe = env!("CARGO_BIN_EXE_whitted");
+    let render = |cpu: Option<&str>, force: Option<&str>, name: &str| {
+        let png = dir.path().join(name);
+        let mut command = match cpu {
+            Some(cpu) => {
+                let mut command = Command::new(qemu);
+                command.args(["-cpu", cpu, exe]);
+                command
+            }
+            None => Command::new(exe),
+        };
+        command
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(["render", "scenes/bench/spheres1000.scene", "--width", "64"])
+            .args(["--height", "48", "--stats", "-o"])
+            .arg(&png)
+            .env_remove("WHITTED_TRAVERSAL");
+        if let Some(force) = force {
+            command.env("WHITTED_TRAVERSAL", force);
+        }
+        let output = command.output().unwrap_or_else(|e| panic!("{e}"));
+        let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+        let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+        let bytes = std::fs::read(&png).unwrap_or_default();
+        (output.status.code(), stdout, stderr, bytes)
+    };
+    let (code, _, stderr, native) = render(None, None, "native.png");
+    assert_eq!(code, Some(0), "{stderr}");
+    for (cpu, walk) in [("Nehalem", "baseline"), ("Haswell", "avx2")] {
+        let (code, stats, stderr, bytes) = render(Some(cpu), None, &format!("{cpu}.png"));
+        assert_eq!(code, Some(0), "{cpu}: {stderr}");
+        assert!(
+            stats.contains(&format!("bvh walk         {walk}\n")),
+            "{cpu}: {stats}"
+        );
+        assert!(
+            bytes == native,
+            "{cpu}: the image differs from the native one"
+        );
+    }
+    let (code, _, stderr, _) = render(Some("Nehalem"), Some("avx2"), "forced.png");
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("WHITTED_TRAVERSAL=avx2: this CPU cannot run the avx2 BVH traversal"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("forced.png").exists());
 }
