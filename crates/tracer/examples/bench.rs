@@ -115,9 +115,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .and_then(|s| s.parse().ok())
         .unwrap_or(1000);
     let wanted = |name: &str| which == "all" || which == name;
-    if let Ok(name) = std::env::var("WHITTED_TRAVERSAL") {
-        let path = TraversalPath::from_name(&name)
-            .ok_or_else(|| format!("WHITTED_TRAVERSAL: baseline, avx2 or avx512, not {name:?}"))?;
+    // Unset or empty: the fastest path, as for the `whitted` binary.
+    if let Some(name) = std::env::var("WHITTED_TRAVERSAL")
+        .ok()
+        .filter(|n| !n.is_empty())
+    {
+        let path = TraversalPath::from_name(&name).ok_or_else(|| {
+            let names = TraversalPath::ALL.map(TraversalPath::name).join(", ");
+            format!("WHITTED_TRAVERSAL={name:?} names no BVH walk; use one of {names}")
+        })?;
         if let Err(unavailable) = force_traversal_path(Some(path)) {
             println!("BVH walk {name}: skipped, {unavailable}");
             return Ok(());

@@ -203,7 +203,7 @@ impl std::fmt::Display for PathUnavailable {
 impl std::error::Error for PathUnavailable {}
 
 /// The path [`force_traversal_path`] asked for: 0 for none, else 1 + its index in
-/// [`TraversalPath::ALL`].
+/// [`TraversalPath::ALL`] (its discriminant).
 static FORCED_PATH: AtomicU8 = AtomicU8::new(0);
 
 /// Makes every BVH built from now on in this process walk with `path`, or with the fastest
@@ -212,15 +212,8 @@ static FORCED_PATH: AtomicU8 = AtomicU8::new(0);
 pub fn force_traversal_path(path: Option<TraversalPath>) -> Result<(), PathUnavailable> {
     let code = match path {
         None => 0,
-        Some(path) => {
-            if !path.available() {
-                return Err(PathUnavailable(path));
-            }
-            1 + TraversalPath::ALL
-                .iter()
-                .position(|&p| p == path)
-                .unwrap_or(0) as u8
-        }
+        Some(path) if path.available() => 1 + path as u8,
+        Some(path) => return Err(PathUnavailable(path)),
     };
     FORCED_PATH.store(code, Ordering::Relaxed);
     Ok(())
@@ -1110,10 +1103,12 @@ mod tests {
         ));
         sets.push(("shared faces".to_string(), shared));
         let (mut stack, mut packet_stack) = (Vec::new(), Vec::new());
-        let mut compared = 0usize;
+        let (mut compared, mut packets) = (0usize, 0usize);
         for (name, aabbs) in sets.iter().filter(|(_, a)| !a.is_empty()) {
             let (mut bvh, _) = Bvh::build(aabbs);
-            let rays = awkward_rays(aabbs, &mut random);
+            let mut rays = awkward_rays(aabbs, &mut random);
+            // Grouped by octant (stably), so that nearly every packet below can walk.
+            rays.sort_by_key(|ray| octant_inv4(ray.direction));
             for (mode, tmin) in (0..3u32).flat_map(|m| [(m, 0.0), (m, 1e-3)]) {
                 let mut logs = Vec::new();
                 for path in std::iter::once(ChildTestPath::Baseline).chain(paths.iter().copied()) {
@@ -1124,7 +1119,8 @@ mod tests {
                             logging_visit(log, mode, id, tmax)
                         });
                     }
-                    // The same rays in packets of neighbours that share an octant.
+                    // The same rays in packets of up to eight neighbours; a packet that
+                    // straddles two octants is refused and compares as empty logs.
                     let mut together: Vec<Vec<(u32, u32)>> = vec![Vec::new(); rays.len()];
                     for (start, chunk) in rays.chunks(PACKET).enumerate() {
                         let mut tmax = [f32::INFINITY; PACKET];
@@ -1136,7 +1132,9 @@ mod tests {
                             &mut packet_stack,
                             |r, id, t| logging_visit(&mut logs[r], mode, id, t),
                         );
-                        if !walked {
+                        if walked {
+                            packets += 1;
+                        } else {
                             logs[..chunk.len()].iter_mut().for_each(Vec::clear);
                         }
                     }
@@ -1159,6 +1157,27 @@ mod tests {
             }
         }
         assert!(compared > 100_000, "{compared} visits compared");
+        // Each packet is counted once per path and mode; nearly all of them walked.
+        assert!(packets > 30_000, "only {packets} packets walked");
+    }
+
+    /// Forcing a path is what BVHs built next get and what `chosen` reports; a path the
+    /// CPU lacks is refused; `None` goes back to the fastest.
+    #[test]
+    fn a_forced_path_is_what_new_bvhs_walk_with() {
+        for path in TraversalPath::ALL {
+            if !path.available() {
+                assert_eq!(force_traversal_path(Some(path)), Err(PathUnavailable(path)));
+                continue;
+            }
+            assert_eq!(force_traversal_path(Some(path)), Ok(()));
+            assert_eq!(TraversalPath::chosen(), path);
+            assert_eq!(Bvh::build(&boxes(20)).0.path.public(), path);
+        }
+        assert_eq!(force_traversal_path(None), Ok(()));
+        assert_eq!(TraversalPath::chosen(), TraversalPath::fastest());
+        assert_eq!(TraversalPath::from_name("avx2"), Some(TraversalPath::Avx2));
+        assert_eq!(TraversalPath::from_name("AVX2"), None);
     }
 
     /// Rays of different octants are refused, untouched, for the caller to walk alone.
