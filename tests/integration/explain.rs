@@ -132,7 +132,21 @@ fn each_finding_kind_fires_on_its_scene_with_location_and_fix() {
             "18,6",
             "self_hit",
             "self-hit.scene:3:31",
-            "the surface offset `epsilon`",
+            "the surface offset `epsilon 1e-9`",
+        ),
+        (
+            "planet-acne",
+            "20,22",
+            "self_hit",
+            "planet-acne.scene:3:43",
+            "is smaller than this hit point's error bound",
+        ),
+        (
+            "rug-on-floor",
+            "20,15",
+            "coincident_surfaces",
+            "rug-on-floor.scene:8:1",
+            "move rug off floor",
         ),
         (
             "coincident",
@@ -182,6 +196,53 @@ fn each_finding_kind_fires_on_its_scene_with_location_and_fix() {
             "{scene}: the fix `{text}` lacks `{fix}`"
         );
         assert!(!finding["message"].as_str().unwrap_or("").is_empty());
+    }
+}
+
+/// Issue 26: on a planet-sized ground sphere at default settings, explain called the
+/// ground's own acne a blocker ("move planet or sun"). There is no acne there now, and
+/// with a too small `epsilon` (planet-acne.scene, above) it is called acne.
+#[test]
+fn a_planet_at_default_settings_has_no_acne_and_no_blocker() {
+    let json = explain_json("tests/explain/planet.scene", "20,22");
+    let findings = json["findings"].as_array().cloned().unwrap_or_default();
+    for finding in &findings {
+        assert!(
+            !matches!(
+                finding["kind"].as_str(),
+                Some("self_hit" | "shadow_blocked")
+            ),
+            "{finding:#?}"
+        );
+    }
+    let acne = explain_json("tests/explain/planet-acne.scene", "20,22");
+    let kinds: Vec<&str> = acne["findings"]
+        .as_array()
+        .map(|f| f.iter().filter_map(|f| f["kind"].as_str()).collect())
+        .unwrap_or_default();
+    assert_eq!(
+        kinds,
+        ["self_hit"],
+        "acne is acne, not a blocker: {acne:#?}"
+    );
+}
+
+/// The rug lies exactly in the floor's plane: the camera ray's hit is either surface by
+/// rounding, and explain names both, with their lines.
+#[test]
+fn a_rug_in_the_floor_is_coincident_with_it_for_the_camera_ray() {
+    let json = explain_json("tests/explain/rug-on-floor.scene", "20,15");
+    let findings = json["findings"].as_array().cloned().unwrap_or_default();
+    let Some(finding) = findings.iter().find(|f| f["kind"] == "coincident_surfaces") else {
+        panic!("no coincident_surfaces finding in {findings:#?}");
+    };
+    let message = finding["message"].as_str().unwrap_or("");
+    for part in [
+        "floor (tests/explain/rug-on-floor.scene:7:1)",
+        "rug (tests/explain/rug-on-floor.scene:8:1)",
+        "camera ray",
+    ] {
+        assert!(message.contains(part), "`{message}` lacks `{part}`");
     }
 }
 

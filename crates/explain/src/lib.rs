@@ -17,6 +17,7 @@ mod json;
 pub mod lint;
 mod locate;
 mod model;
+mod numbers;
 pub mod probe;
 pub mod query;
 pub mod regions;

@@ -36,11 +36,16 @@ pub fn setting_span(scene: &Scene, name: &str) -> Option<Span> {
     found
 }
 
-/// Where a setting is, or the start of the scene's first file when it is not written
-/// (the default applies; the fix says to add it there).
+/// Where a setting is, or else where it would go: the scene's `settings` block when it has
+/// one, the start of the scene's first file otherwise (the default applies; the fix says
+/// to add it there).
 pub fn setting_or_scene(scene: &Scene, name: &str) -> (String, bool) {
     match setting_location(scene, name) {
         Some(location) => (location, true),
+        None if setting_location(scene, "settings").is_some() => (
+            setting_location(scene, "settings").unwrap_or_default(),
+            false,
+        ),
         None => {
             let file = scene
                 .sources
@@ -83,7 +88,7 @@ mod tests {
         assert_eq!(setting_location(&only_scene, "min_weight"), None);
         assert_eq!(
             setting_or_scene(&only_scene, "min_weight"),
-            ("a.scene:1:1".to_string(), false)
+            ("a.scene:2:1".to_string(), false)
         );
     }
 }

@@ -14,6 +14,7 @@ mod bvh_wide;
 mod camera;
 mod csg;
 pub mod display;
+mod hit_error;
 mod light;
 mod material;
 mod media;
@@ -38,8 +39,8 @@ mod tests;
 
 pub use bvh::{force_traversal_path, PathUnavailable, TraversalPath};
 pub use recorder::{
-    Interface, LightSample, NoRecord, PixelStats, RayKind, RayStart, Recorder, ShadowRay,
-    ShadowResult, SkippedRay, SurfaceHit, Termination, TerminationSet,
+    CoincidentSurface, Interface, LightSample, NoRecord, PixelStats, RayKind, RayStart, Recorder,
+    ShadowRay, ShadowResult, SkippedRay, SurfaceHit, Termination, TerminationSet,
 };
 pub use render::{
     render, render_from, render_with_pixel_stats, trace_pixel_with, Image, NoObserver,

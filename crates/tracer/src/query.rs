@@ -12,6 +12,7 @@ use whitted_ir::{Handle, Material};
 
 use crate::bvh::{Bvh, PacketEntry, Step, PACKET};
 use crate::csg::CsgScratch;
+use crate::hit_error;
 use crate::ray::Ray;
 use crate::scene::{Item, Leaf, PreparedScene};
 use crate::shapes::{plane_first_hit, sphere_first_hit, unit_normal, Geometry, Part};
@@ -67,7 +68,11 @@ pub enum Shadow {
 /// Full data for one hit.
 #[derive(Clone, Copy, Debug)]
 pub struct Surface<'a> {
+    /// The hit point, placed on the surface where the shape allows it (`hit_error.rs`).
     pub point: Vec3A,
+    /// Per axis, how far `point` may be from the true surface: secondary and shadow rays
+    /// start just outside this box along the normal.
+    pub error: Vec3A,
     /// Outward unit normal of the solid (after the CSG flip).
     pub geometric_normal: Vec3A,
     /// The normal shading uses, on the same side: the geometric normal, except on smooth
@@ -453,6 +458,34 @@ impl PreparedScene {
         t: f32,
         window: f32,
         scratch: &mut Scratch,
+        found: impl FnMut(Hit) -> bool,
+    ) {
+        self.crossings_near(ray, tmin, t, window, true, scratch, found);
+    }
+
+    /// Every crossing of any surface strictly inside `(t − window, t + window)` (and beyond
+    /// `tmin`): the surfaces a recorded hit cannot be told apart from (z-fighting).
+    pub(crate) fn surface_crossings_near(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        t: f32,
+        window: f32,
+        scratch: &mut Scratch,
+        found: impl FnMut(Hit) -> bool,
+    ) {
+        self.crossings_near(ray, tmin, t, window, false, scratch, found);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn crossings_near(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        t: f32,
+        window: f32,
+        solids_only: bool,
+        scratch: &mut Scratch,
         mut found: impl FnMut(Hit) -> bool,
     ) {
         let Scratch { csg, bvh_stack, .. } = scratch;
@@ -460,7 +493,7 @@ impl PreparedScene {
         self.visit(ray, low, high, bvh_stack, |item_ref, item, _| {
             let mut from = low;
             while let Some((t, leaf, part, flip)) = item_hit(item, ray, from, high, csg) {
-                if item.leaf(leaf).geometry.is_solid() {
+                if !solids_only || item.leaf(leaf).geometry.is_solid() {
                     let hit = Hit {
                         t,
                         item: item_ref,
@@ -483,12 +516,19 @@ impl PreparedScene {
     pub(crate) fn surface(&self, ray: &Ray, hit: &Hit) -> Surface<'_> {
         let item = self.item(hit.item);
         let leaf = item.leaf(hit.leaf);
-        let point = ray.at(hit.t);
-        let normal = match &leaf.geometry {
-            Geometry::Sphere { center, .. } => (point - *center).normalize(),
+        let (bounded, normal) = match &leaf.geometry {
+            Geometry::Sphere { center, radius } => {
+                hit_error::on_sphere(*center, *radius, ray.at(hit.t))
+            }
             // What `Geometry::normal` computes for a plane, inline: floors are hit often.
-            Geometry::Plane { normal, .. } => unit_normal(*normal, ray),
-            geometry => geometry.normal(ray, hit.t, hit.part),
+            Geometry::Plane { normal, offset } => (
+                hit_error::on_plane(*normal, *offset, ray.at(hit.t)),
+                unit_normal(*normal, ray),
+            ),
+            geometry => (
+                geometry.bounded_point(ray, hit.t, hit.part),
+                geometry.normal(ray, hit.t, hit.part),
+            ),
         };
         let shading = match &leaf.geometry {
             Geometry::Mesh(_) => leaf
@@ -499,7 +539,8 @@ impl PreparedScene {
         };
         let sign = if hit.flip { -1.0 } else { 1.0 };
         Surface {
-            point,
+            point: bounded.point,
+            error: bounded.error,
             geometric_normal: sign * normal,
             shading_normal: sign * shading,
             item,

@@ -193,6 +193,24 @@ pub struct SurfaceHit {
     /// Beer-Lambert transmittance over this ray's path when it travels inside an
     /// absorbing solid (1 otherwise); the returned colour includes it.
     pub absorption: Vec3A,
+    /// How far the hit point may be from the true surface along the normal: its error
+    /// bound (`hit_error.rs`), whatever the scene's `epsilon`.
+    pub error_bound: f32,
+    /// How far this hit's shadow, reflected and transmitted rays start off the surface: the
+    /// scene's `epsilon`, or else a margin over `error_bound`.
+    pub offset: f32,
+}
+
+/// A surface within a hit's error bound along the ray: the other side of a z-fight.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CoincidentSurface {
+    /// Its distance along the ray (the hit's own `t` give or take rounding).
+    pub t: f32,
+    /// The top-level object and the shape whose surface it is.
+    pub object: Handle<Object>,
+    pub leaf: Handle<Object>,
+    /// The material in effect there, patterns resolved.
+    pub material: Handle<Material>,
 }
 
 /// What a shadow ray found.
@@ -282,6 +300,11 @@ pub trait Recorder {
     fn ray_started(&mut self, _ray: &RayStart) {}
     #[inline(always)]
     fn surface_hit(&mut self, _hit: &SurfaceHit) {}
+    /// Another surface crossed within the hit's error bound along the ray (after
+    /// `surface_hit`): the two cannot be told apart, and which one a ray meets is rounding
+    /// (z-fighting). Only looked for when [`Recorder::RECORDS`] is true.
+    #[inline(always)]
+    fn coincident_surface(&mut self, _other: &CoincidentSurface) {}
     #[inline(always)]
     fn ray_missed(&mut self, _background: Vec3A) {}
     /// The ambient term `ka·Ia·kd` at the hit.

@@ -16,10 +16,11 @@ use crate::bounds::Bound;
 use crate::bvh::Bvh;
 use crate::camera::PreparedCamera;
 use crate::csg::{ChildAccel, CsgNode, CsgTree, NO_ACCEL};
+use crate::hit_error;
 use crate::light::PreparedLight;
 use crate::material::{color, PatternFrame, PreparedMaterial, Snap};
 use crate::mesh::{MeshInstance, PreparedMesh};
-use crate::ray::Ray;
+use crate::query::Surface;
 use crate::shapes::Geometry;
 
 /// A primitive shape ready to intersect, with what shading needs to know about it.
@@ -97,13 +98,13 @@ pub struct PreparedScene {
 }
 
 impl PreparedScene {
-    /// How far a secondary ray starts off the surface at `point`, reached by `ray` at `t`:
-    /// the scene's explicit `epsilon`, or else the error bound of the hit point.
+    /// How far a secondary or shadow ray starts off `surface`: the scene's explicit
+    /// `epsilon`, or else just outside the hit point's error bound along the normal.
     #[inline]
-    pub(crate) fn offset_at(&self, ray: &Ray, t: f32, point: Vec3A) -> f32 {
+    pub(crate) fn offset_at(&self, surface: &Surface<'_>) -> f32 {
         match self.epsilon {
             Some(epsilon) => epsilon,
-            None => crate::optics::surface_offset(ray.origin, t, point),
+            None => hit_error::spawn_offset(surface.geometric_normal, surface.error),
         }
     }
 

@@ -12,6 +12,7 @@ use glam::{DAffine3, DMat3, DMat4, DVec3, DVec4, Mat3A, Vec3A};
 use whitted_ir::{Quadric, Shape};
 
 use crate::bounds::Bound;
+use crate::hit_error::{self, BoundedPoint};
 use crate::mesh::MeshInstance;
 use crate::ray::Ray;
 use crate::solve::{quadratic_f32, quadratic_f64};
@@ -113,6 +114,9 @@ pub enum Canonical {
 #[derive(Clone, Debug, PartialEq)]
 pub struct LocalGeometry {
     canonical_from_world: glam::Affine3A,
+    /// The inverse of `canonical_from_world`: a hit point placed on the canonical surface
+    /// goes back to world space through it, with its error bound.
+    world_from_canonical: glam::Affine3A,
     /// The transpose of `canonical_from_world`'s linear part: the inverse transpose of
     /// `world_from_canonical`, which carries normals correctly under non-uniform scale.
     normal_from_canonical: Mat3A,
@@ -336,6 +340,7 @@ impl Geometry {
         let canonical_from_world = world_from_canonical.inverse();
         Geometry::Local(Box::new(LocalGeometry {
             canonical_from_world: canonical_from_world.as_affine3a(),
+            world_from_canonical: world_from_canonical.as_affine3a(),
             normal_from_canonical: Mat3A::from(canonical_from_world.matrix3.transpose().as_mat3()),
             shape,
         }))
@@ -469,6 +474,83 @@ impl Geometry {
         };
         unit_normal(n, ray)
     }
+}
+
+impl Geometry {
+    /// The hit point at `t` on `part`, placed on the surface where the shape allows it,
+    /// with its error bound (`hit_error.rs`). Spheres and planes, the common case, are
+    /// handled inline by `PreparedScene::surface`.
+    pub fn bounded_point(&self, ray: &Ray, t: f32, part: Part) -> BoundedPoint {
+        match self {
+            Geometry::Sphere { center, radius } => {
+                hit_error::on_sphere(*center, *radius, ray.at(t)).0
+            }
+            Geometry::Plane { normal, offset } => hit_error::on_plane(*normal, *offset, ray.at(t)),
+            Geometry::Disk(disk) => {
+                hit_error::on_plane(disk.normal, disk.normal.dot(disk.center), ray.at(t))
+            }
+            Geometry::Triangle(tri) => match triangle_hit_uv(ray, tri.a, tri.edge1, tri.edge2) {
+                Some(uv) => hit_error::on_triangle(tri.a, tri.edge1, tri.edge2, uv),
+                None => hit_error::along_ray(ray.origin, ray.direction, t),
+            },
+            Geometry::Quadric(quadric) => hit_error::on_quadric(&quadric.matrix, ray.at(t)),
+            Geometry::Mesh(mesh) => mesh.bounded_point(ray, t, part),
+            Geometry::Local(local) => {
+                let o = local.canonical_from_world.transform_point3a(ray.origin);
+                let d = local.canonical_from_world.transform_vector3a(ray.direction);
+                match on_canonical(local.shape, o + t * d, part) {
+                    Some(canonical) => {
+                        hit_error::transformed(&local.world_from_canonical, canonical)
+                    }
+                    None => hit_error::along_ray(ray.origin, ray.direction, t),
+                }
+            }
+        }
+    }
+}
+
+/// A canonical shape's point moved onto its surface (`part` names the face), with the
+/// rounding of that move as its bound; `None` for the torus, whose quartic has no cheap
+/// projection.
+fn on_canonical(shape: Canonical, p: Vec3A, part: Part) -> Option<BoundedPoint> {
+    let radial = |p: Vec3A, radius: f32| {
+        let length = (p.x * p.x + p.y * p.y).sqrt();
+        if length > 0.0 && radius > 0.0 {
+            let k = radius / length;
+            Vec3A::new(p.x * k, p.y * k, p.z)
+        } else {
+            p
+        }
+    };
+    let point = match shape {
+        Canonical::Sphere => {
+            let length = p.length();
+            if length > 0.0 {
+                p / length
+            } else {
+                p
+            }
+        }
+        Canonical::Cube => {
+            let mut q = p;
+            q[(part / 2) as usize] = if part % 2 == 1 { 1.0 } else { -1.0 };
+            q
+        }
+        Canonical::Disk => Vec3A::new(p.x, p.y, 0.0),
+        Canonical::Cylinder { .. } | Canonical::Cone { .. } if part == BASE_CAP => {
+            Vec3A::new(p.x, p.y, 0.0)
+        }
+        Canonical::Cylinder { .. } | Canonical::Cone { .. } if part == APEX_CAP => {
+            Vec3A::new(p.x, p.y, 1.0)
+        }
+        Canonical::Cylinder { .. } => radial(p, 1.0),
+        Canonical::Cone { r0, r1, .. } => radial(p, r0 + (r1 - r0) * p.z),
+        Canonical::Torus { .. } => return None,
+    };
+    Some(BoundedPoint {
+        point,
+        error: hit_error::gamma(6) * point.abs(),
+    })
 }
 
 impl Geometry {

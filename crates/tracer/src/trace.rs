@@ -22,10 +22,19 @@ use crate::optics::{beer_lambert, fresnel_exact, max_channel, reflect, refract, 
 use crate::query::{Hit, Scratch, Shadow, Surface};
 use crate::ray::Ray;
 use crate::recorder::{
-    Interface, LightSample, RayKind, RayStart, Recorder, ShadowRay, ShadowResult, SkippedRay,
-    SurfaceHit, Termination,
+    CoincidentSurface, Interface, LightSample, RayKind, RayStart, Recorder, ShadowRay,
+    ShadowResult, SkippedRay, SurfaceHit, Termination,
 };
 use crate::scene::PreparedScene;
+
+/// Surfaces within this many error bounds of a hit along the ray are reported as
+/// coincident with it (the bound is a bound: rounding rarely reaches it, a z-fight's two
+/// surfaces are both within it).
+const COINCIDENT_BOUNDS: f32 = 4.0;
+
+/// The rounding of a hit's `t` in ulps of the distances it came from: two surfaces in one
+/// plane get distances this far apart from their own tests.
+const COINCIDENT_T_ULPS: f32 = 64.0;
 
 /// Ray counts kept by the tracer itself (cheap, always on).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -324,6 +333,7 @@ impl<'a> Tracer<'a> {
         };
         let point = surface.point;
         let m = &scene.materials[material_handle.index()];
+        let offset = scene.offset_at(&surface) * self.offset_scale;
         rec.surface_hit(&SurfaceHit {
             t: hit.t,
             point,
@@ -335,9 +345,13 @@ impl<'a> Tracer<'a> {
             material: surface.leaf.material,
             resolved_material: material_handle,
             absorption,
+            error_bound: crate::hit_error::error_along(surface.geometric_normal, surface.error),
+            offset,
         });
+        if R::RECORDS {
+            self.report_coincident(ray, &hit, &surface, rec);
+        }
 
-        let offset = scene.offset_at(ray, hit.t, point) * self.offset_scale;
         let outside = point + offset * n;
         let mut color = self.local_illumination(m, outside, n, -d, front_face, rec);
 
@@ -555,7 +569,7 @@ impl<'a> Tracer<'a> {
         const MOST: usize = MediumStack::CAPACITY;
         let scene = self.scene;
         // Surfaces closer together than the hit point's error bound cannot be told apart.
-        let window = scene.offset_at(ray, first.hit.t, first.surface.point);
+        let window = scene.offset_at(&first.surface);
         let resume = first.hit.t + window;
         let empty = NearCrossing {
             hit: first.hit,
@@ -763,6 +777,46 @@ impl<'a> Tracer<'a> {
             result: shadow_result(scene, shadow),
         });
         (passed, record)
+    }
+
+    /// Tells the recorder of every other surface the ray crosses within the hit's error
+    /// bound (z-fighting: which of them a ray meets is rounding). The window along the ray
+    /// is the error bound over the cosine of incidence, or the rounding of `t` itself if
+    /// larger. Only recorders pay for it; rendering never calls it.
+    #[cold]
+    #[inline(never)]
+    fn report_coincident<R: Recorder>(
+        &mut self,
+        ray: &Ray,
+        hit: &Hit,
+        surface: &Surface<'_>,
+        rec: &mut R,
+    ) {
+        let scene = self.scene;
+        let bound = crate::hit_error::error_along(surface.geometric_normal, surface.error);
+        let cos = surface.geometric_normal.dot(ray.direction).abs().max(0.01);
+        let rounding_of_t =
+            (hit.t + ray.origin.abs().max_element()) * f32::EPSILON * COINCIDENT_T_ULPS;
+        let window = (COINCIDENT_BOUNDS * bound / cos).max(rounding_of_t);
+        let mut near = [None; 4];
+        let mut count = 0;
+        scene.surface_crossings_near(ray, 0.0, hit.t, window, &mut self.scratch, |other| {
+            if other.item == hit.item && other.leaf == hit.leaf {
+                return true;
+            }
+            near[count] = Some(other);
+            count += 1;
+            count < near.len()
+        });
+        for other in near.iter().flatten() {
+            let found = scene.surface(ray, other);
+            rec.coincident_surface(&CoincidentSurface {
+                t: other.t,
+                object: found.item.object(),
+                leaf: found.leaf.object,
+                material: scene.resolve_material(found.leaf, found.point, other.part),
+            });
+        }
     }
 
     /// Traces a secondary ray unless a stopping criterion forbids it (then records why).

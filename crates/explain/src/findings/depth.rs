@@ -37,8 +37,9 @@ fn how_to_set(name: &str, value: &str, location: &str, written: bool) -> String 
         // Not written: the default (or, for a 6.837 scene, the course's flag) applies, and
         // the way to change it that works for every front end is the flag.
         format!(
-            "run with --set {name}={value} (a .scene file can say `settings {{ {name} {value} }}`; \
-             `whitted mit6837` takes -bounces and -weight)"
+            "run with --set {name}={value} ({name} is not written in the scene, so its default \
+             applies: a .scene file can add `{name} {value}` to its `settings` block, or write \
+             `settings {{ {name} {value} }}`; `whitted mit6837` takes -bounces and -weight)"
         )
     }
 }
@@ -134,15 +135,19 @@ fn weight_cutoff(context: &Context<'_>, findings: &mut Vec<Finding>) {
         return;
     };
     let min_weight = context.tree.min_weight;
-    let lower = (min_weight / 10.0).max(1e-6);
+    // Two digits, rounded down, so that the advice prints as written (`0.03`, never
+    // `0.030000001`) and still lowers the cut-off tenfold.
+    let value = crate::numbers::shortest_down((min_weight / 10.0).max(1e-6));
+    let lower: f32 = value.parse().unwrap_or(1e-6);
     let (location, written) = setting_or_scene(context.scene, "min_weight");
     let object = node
         .hit
         .as_ref()
         .map_or("the scene".to_string(), |h| h.object.label.clone());
     let message = format!(
-        "the weight cut-off (min_weight {min_weight}) dropped {count} ray{} that together carry \
+        "the weight cut-off (min_weight {}) dropped {count} ray{} that together carry \
          a path weight of {:.1}% of the pixel (the heaviest: a {} ray leaving {object})",
+        crate::numbers::shortest(min_weight),
         if count == 1 { "" } else { "s" },
         weight * 100.0,
         kind.name()
@@ -152,7 +157,6 @@ fn weight_cutoff(context: &Context<'_>, findings: &mut Vec<Finding>) {
         min_weight: lower,
         ..context.options.clone()
     };
-    let value = format!("{lower}");
     let fix = match color_with(context.prepared, &options, x, y) {
         Some(color) => format!(
             "lower min_weight to {value}: {}; the pixel then becomes {} (now {})",

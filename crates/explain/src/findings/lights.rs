@@ -110,14 +110,16 @@ fn blocked(context: &Context<'_>, node: &RayNode, findings: &mut Vec<Finding>) {
         let Some(blocker) = &shadow_ray.blocker else {
             continue;
         };
-        // A blocker met a hair from the surface is the surface itself or one in the same
-        // place: `self_hit` and `coincident_surfaces` say so, not this.
-        let scale = node
-            .hit
-            .as_ref()
-            .map_or(1.0, |h| h.point.iter().fold(1.0f32, |m, c| m.max(c.abs())));
-        if blocker.t < super::surfaces::TINY * scale {
-            continue;
+        // A blocker that is the surface itself, met through rounding, is acne:
+        // `self_hit` says so, not this. One met a hair away is another surface in the same
+        // place: `coincident_surfaces` says so.
+        if let Some(from) = &node.hit {
+            let scale = from.point.iter().fold(1.0f32, |m, c| m.max(c.abs()));
+            if super::surfaces::is_acne(scene, from, blocker.object.handle, blocker.t, true)
+                || blocker.t < super::surfaces::TINY * scale
+            {
+                continue;
+            }
         }
         let light = &shadow_ray.light;
         let inside = light_position(context, light.handle).is_some_and(|p| {

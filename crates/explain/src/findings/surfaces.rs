@@ -1,10 +1,14 @@
 //! Findings about surfaces met again at once: a secondary or shadow ray that hits its own
-//! surface a hair from where it left (`self_hit`: surface acne), or another surface there
-//! (`coincident_surfaces`: two surfaces in the same place).
+//! surface where it left (`self_hit`: surface acne), judged against the hit point's error
+//! bound and the object's shape rather than a fixed distance, or another surface there
+//! (`coincident_surfaces`: two surfaces in the same place), including the surfaces a ray
+//! could not tell apart from the one it hit (z-fighting, seen by camera rays too).
 
-use whitted_tracer::ray_tree::{HitInfo, ObjectRef, RayNode, ShadowOutcome};
+use whitted_tracer::ray_tree::{CoincidentInfo, HitInfo, ObjectRef, RayNode, ShadowOutcome};
 
-use whitted_ir::{Handle, Object, ObjectKind};
+use whitted_ir::{Handle, Material, Object, ObjectKind, QuadricForm, Scene, Shape};
+
+use crate::numbers::{shortest, shortest_up};
 
 use super::{material_of, push_unique, walk, weight_of, Context, SIGNIFICANT};
 use crate::locate::setting_location;
@@ -14,6 +18,11 @@ use crate::model::{Finding, FindingKind};
 /// is "at once": far more than the tracer's error-bounded offset, far less than any
 /// object's own size in a sensible scene.
 pub const TINY: f32 = 1e-4;
+
+/// A ray that meets the surface it left within this many of the hit point's error bounds
+/// met it again through rounding: acne, however large the object (a planet's bound is a
+/// thousandth where a ball's is a millionth).
+pub const ACNE_BOUNDS: f32 = 64.0;
 
 pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
     walk(context.tree, &mut |node, above| {
@@ -26,7 +35,8 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
         if weight_of(node) < SIGNIFICANT {
             return;
         }
-        if tiny(hit.t, from) {
+        let outward = node.kind.name() == "reflected" && from.front_face;
+        if is_acne(context.scene, from, hit.object.handle, hit.t, outward) {
             report(
                 context,
                 from,
@@ -43,6 +53,31 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
             // No ray can enter an opaque solid, so one that meets its inside started
             // there: the surface it left is inside that solid or on its surface.
             starts_inside(from, hit, node.kind.name(), weight_of(node), findings);
+        }
+    });
+    // Every ray, camera rays included: a surface the tracer could not tell apart from the
+    // one hit (z-fighting).
+    walk(context.tree, &mut |node, _| {
+        let Some(hit) = &node.hit else {
+            return;
+        };
+        if weight_of(node) < SIGNIFICANT {
+            return;
+        }
+        for other in &hit.coincident {
+            // Media given priorities are meant to touch (water in a glass): the tracer
+            // crosses both surfaces as one interface there.
+            let prioritised = |handle: u32| {
+                context
+                    .scene
+                    .materials
+                    .get(Handle::<Material>::from_index(handle as usize))
+                    .is_some_and(|m| m.priority > 0)
+            };
+            if prioritised(hit.resolved_material.handle) && prioritised(other.material.handle) {
+                continue;
+            }
+            z_fighting(hit, other, node.kind.name(), weight_of(node), findings);
         }
     });
     // Shadow rays leave from their parent's hit.
@@ -64,7 +99,7 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
             else {
                 continue;
             };
-            if tiny(blocker.t, from) {
+            if is_acne(context.scene, from, blocker.object.handle, blocker.t, true) {
                 report(
                     context,
                     from,
@@ -77,6 +112,52 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
             }
         }
     });
+}
+
+/// Two surfaces in one place along a ray: which one it meets is rounding, so neighbouring
+/// pixels alternate between them.
+fn z_fighting(
+    hit: &HitInfo,
+    other: &CoincidentInfo,
+    ray: &str,
+    weight: f32,
+    findings: &mut Vec<Finding>,
+) {
+    push_unique(
+        findings,
+        Finding {
+            kind: FindingKind::CoincidentSurfaces,
+            message: format!(
+                "{} ({}) and {} ({}) are in the same place here: the {ray} ray meets {} at \
+                 t = {} and {} at t = {}, within rounding of each other, so which one it shows \
+                 is chance and neighbouring pixels alternate (z-fighting): this pixel shows {} \
+                 ({}); with {} it would show {} ({})",
+                hit.object.label,
+                hit.object.location,
+                other.object.label,
+                other.object.location,
+                hit.object.label,
+                shortest(hit.t),
+                other.object.label,
+                shortest(other.t),
+                hit.resolved_material.label,
+                hit.object.label,
+                other.object.label,
+                other.material.label,
+                other.object.label
+            ),
+            location: other.object.location.clone(),
+            fix: format!(
+                "move {} off {} along the surface's normal by {} or more, so that one is in \
+                 front, or remove one of them",
+                other.object.label,
+                hit.object.label,
+                shortest_up((1000.0 * hit.error_bound).max(1e-3))
+            ),
+            weight,
+            source_line: None,
+        },
+    );
 }
 
 /// Whether the hit object is a solid whose material lets no light through.
@@ -127,8 +208,9 @@ fn starts_inside(
 }
 
 /// Whether `node` (a secondary or shadow ray cast from `parent`'s hit) met the very surface
-/// it left at once (surface acne): the object it hit, or the shadow ray's blocker, is the
-/// parent's object, closer than [`TINY`]. The debugger's `{`/`}` stop at such rays.
+/// it left within [`ACNE_BOUNDS`] error bounds of the hit point (or a hair by the scene's
+/// scale): surface acne as the tree alone shows it, without the scene's shapes (see
+/// [`is_acne`]). The debugger's `{`/`}` stop at such rays.
 pub fn is_self_hit(node: &RayNode, parent: &RayNode) -> bool {
     let Some(from) = &parent.hit else {
         return false;
@@ -142,7 +224,52 @@ pub fn is_self_hit(node: &RayNode, parent: &RayNode) -> bool {
         (None, Some(hit)) => Some((hit.object.handle, hit.t)),
         (None, None) => None,
     };
-    met.is_some_and(|(object, t)| object == from.object.handle && tiny(t, from))
+    met.is_some_and(|(object, t)| object == from.object.handle && near_by_error(t, from))
+}
+
+/// Whether a ray that left `from` and met `object` at distance `t` met the surface it left
+/// through rounding. It did when the object is the one it left and either the ray left a
+/// convex solid outwards (a shadow ray towards a light the surface faces, a reflection off
+/// its outside: no true path can meet it again, however far), or `t` is within
+/// [`ACNE_BOUNDS`] error bounds of the hit point, or a hair by the scene's own scale.
+pub fn is_acne(scene: &Scene, from: &HitInfo, object: u32, t: f32, outward: bool) -> bool {
+    if object != from.object.handle {
+        return false;
+    }
+    if outward && is_convex(scene, object) {
+        return true;
+    }
+    near_by_error(t, from)
+}
+
+/// Whether `t` is within rounding of the hit point `from`: [`ACNE_BOUNDS`] error bounds,
+/// or a hair by the scene's scale.
+fn near_by_error(t: f32, from: &HitInfo) -> bool {
+    t < ACNE_BOUNDS * from.error_bound || tiny(t, from)
+}
+
+/// Whether an object is a convex solid or a flat surface: no ray leaving its outside
+/// outwards can meet it again.
+fn is_convex(scene: &Scene, handle: u32) -> bool {
+    let Some(object) = scene
+        .objects
+        .get(Handle::<Object>::from_index(handle as usize))
+    else {
+        return false;
+    };
+    match &object.kind {
+        ObjectKind::Shape { shape } => match shape {
+            Shape::Sphere { .. }
+            | Shape::Box { .. }
+            | Shape::Plane { .. }
+            | Shape::Disk { .. }
+            | Shape::Triangle { .. } => true,
+            Shape::Cylinder { capped, .. } | Shape::Cone { capped, .. } => *capped,
+            Shape::Quadric { form, .. } => *form == QuadricForm::Ellipsoid,
+            _ => false,
+        },
+        ObjectKind::Csg { .. } | ObjectKind::Group { .. } => false,
+    }
 }
 
 fn tiny(t: f32, from: &HitInfo) -> bool {
@@ -161,14 +288,28 @@ fn report(
 ) {
     if object.handle == from.object.handle {
         let epsilon = setting_location(context.scene, "epsilon");
-        let fix = match &epsilon {
-            Some(at) => format!(
-                "the surface offset `epsilon` ({at}) is too small for this scene's size: \
-                 remove it (the tracer then offsets by each hit's error bound) or raise it"
+        let bound = from.error_bound;
+        let fix = match (&epsilon, context.scene.settings.epsilon) {
+            (Some(at), Some(value)) if (value as f32) < 2.0 * bound => format!(
+                "the surface offset `epsilon {}` ({at}) is smaller than this hit point's error \
+                 bound ({}): remove it, so that rays start off each hit by its own bound, or \
+                 raise it to at least {}",
+                shortest(value as f32),
+                shortest_up(bound),
+                shortest_up(4.0 * bound)
             ),
-            None => format!(
-                "scale the scene so that {} is nearer the origin, or set `epsilon` in settings \
-                 to an offset larger than {t:e}",
+            (Some(at), _) => format!(
+                "the surface offset `epsilon` ({at}) is too small for this scene's size: \
+                 remove it (the tracer then offsets by each hit's error bound) or raise it \
+                 above {}",
+                shortest_up(2.0 * t)
+            ),
+            (None, _) => format!(
+                "the automatic offset ({}) did not clear {}'s surface here: set `epsilon {}` \
+                 in the settings block, or make {} smaller or move it nearer the origin",
+                shortest_up(from.offset),
+                object.label,
+                shortest_up(2.0 * t),
                 object.label
             ),
         };
@@ -177,9 +318,13 @@ fn report(
             Finding {
                 kind: FindingKind::SelfHit,
                 message: format!(
-                    "a {ray} ray leaving {} hits {} again at t = {t:e}, where it started: \
-                     surface acne",
-                    from.object.label, object.label
+                    "a {ray} ray leaving {} meets {} again at t = {}, where it started: surface \
+                     acne (the hit point's error bound there is {}; rays start {} off the surface)",
+                    from.object.label,
+                    object.label,
+                    shortest(t),
+                    shortest_up(bound),
+                    shortest(from.offset)
                 ),
                 // The setting to change when the scene sets it; the object otherwise.
                 location: epsilon.unwrap_or_else(|| object.location.clone()),

@@ -180,6 +180,28 @@ pub struct HitInfo {
     /// Beer-Lambert transmittance over this ray's path inside an absorbing solid (1 in air);
     /// the returned colour includes it.
     pub absorption: [f32; 3],
+    /// How far `point` may be from the true surface along the normal: its floating-point
+    /// error bound, worked out for the shape that was hit.
+    pub error_bound: f32,
+    /// How far this hit's shadow, reflected and transmitted rays start off the surface:
+    /// the scene's `epsilon` when it sets one, else a margin over `error_bound`.
+    pub offset: f32,
+    /// Other surfaces the ray crosses within the hit's error bound: which of them it meets
+    /// is rounding (z-fighting). Empty almost always.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub coincident: Vec<CoincidentInfo>,
+}
+
+/// A surface in the same place as a hit, as far as f32 can tell.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CoincidentInfo {
+    /// Its distance along the ray.
+    pub t: f32,
+    /// The top-level object and the shape whose surface it is.
+    pub object: ObjectRef,
+    pub leaf: ObjectRef,
+    /// The material in effect there.
+    pub material: MaterialRef,
 }
 
 /// An IR object, named for people and located in the source.

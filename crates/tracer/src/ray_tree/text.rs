@@ -234,6 +234,16 @@ impl Printer {
         if hit.absorption != [1.0; 3] {
             lines.push(format!("absorption {}", self.color(hit.absorption)));
         }
+        for other in &hit.coincident {
+            lines.push(printable(&format!(
+                "coincident {} ({}, {}) at t {}: the same place, within the error bound {:.1e}",
+                other.object.label,
+                other.object.kind,
+                other.object.location,
+                num(other.t),
+                hit.error_bound
+            )));
+        }
         lines
     }
 

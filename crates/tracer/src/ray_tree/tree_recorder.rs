@@ -15,13 +15,13 @@ use glam::Vec3A;
 use whitted_ir::Scene;
 
 use super::model::{
-    Blocker, HitInfo, InterfaceInfo, LightContribution, LocalIllumination, RayNode, ShadowInfo,
-    ShadowOutcome, SkippedInfo, Visibility,
+    Blocker, CoincidentInfo, HitInfo, InterfaceInfo, LightContribution, LocalIllumination, RayNode,
+    ShadowInfo, ShadowOutcome, SkippedInfo, Visibility,
 };
 use super::scene_refs::{csg_path, light_ref, material_ref, object_ref};
 use crate::recorder::{
-    Interface, LightSample, RayKind, RayStart, Recorder, ShadowResult, SkippedRay, SurfaceHit,
-    Termination,
+    CoincidentSurface, Interface, LightSample, RayKind, RayStart, Recorder, ShadowResult,
+    SkippedRay, SurfaceHit, Termination,
 };
 
 /// Records every ray of one camera ray's tree. Names and source locations come from
@@ -149,6 +149,25 @@ impl Recorder for TreeRecorder<'_> {
             material: material_ref(scene, hit.material),
             resolved_material: material_ref(scene, hit.resolved_material),
             absorption: hit.absorption.to_array(),
+            error_bound: hit.error_bound,
+            offset: hit.offset,
+            coincident: Vec::new(),
+        });
+    }
+
+    fn coincident_surface(&mut self, other: &CoincidentSurface) {
+        if self.dropped_open > 0 {
+            return;
+        }
+        let scene = self.scene;
+        let Some(hit) = self.open.last_mut().and_then(|node| node.hit.as_mut()) else {
+            return;
+        };
+        hit.coincident.push(CoincidentInfo {
+            t: other.t,
+            object: object_ref(scene, other.object),
+            leaf: object_ref(scene, other.leaf),
+            material: material_ref(scene, other.material),
         });
     }
 

@@ -7,6 +7,7 @@ mod csg_oracle;
 mod csg_scenes;
 mod emission;
 mod energy;
+mod error_bounds;
 mod media_scenes;
 mod optics_scenes;
 mod shadow_rays;
