@@ -115,8 +115,13 @@ fn blocked(context: &Context<'_>, node: &RayNode, findings: &mut Vec<Finding>) {
         // place: `coincident_surfaces` says so.
         if let Some(from) = &node.hit {
             let scale = from.point.iter().fold(1.0f32, |m, c| m.max(c.abs()));
-            if super::surfaces::is_acne(scene, from, blocker.object.handle, blocker.t, true)
-                || blocker.t < super::surfaces::TINY * scale
+            if super::surfaces::is_acne(
+                scene,
+                from,
+                blocker.object.handle,
+                blocker.t,
+                from.front_face,
+            ) || blocker.t < super::surfaces::TINY * scale
             {
                 continue;
             }

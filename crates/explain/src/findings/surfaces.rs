@@ -99,7 +99,15 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
             else {
                 continue;
             };
-            if is_acne(context.scene, from, blocker.object.handle, blocker.t, true) {
+            // A shadow ray leaves outwards from a hit on the outside (it goes towards a
+            // light the surface faces); from the inside it may meet the far wall.
+            if is_acne(
+                context.scene,
+                from,
+                blocker.object.handle,
+                blocker.t,
+                from.front_face,
+            ) {
                 report(
                     context,
                     from,
@@ -324,7 +332,7 @@ fn report(
                     object.label,
                     shortest(t),
                     shortest_up(bound),
-                    shortest(from.offset)
+                    shortest_up(from.offset)
                 ),
                 // The setting to change when the scene sets it; the object otherwise.
                 location: epsilon.unwrap_or_else(|| object.location.clone()),

@@ -126,10 +126,19 @@ pub fn trace_tree(
     y: u32,
     with_offset: bool,
 ) -> Node {
-    let mut tracer = Tracer::new(scene, options.depth_limit(), options.min_weight);
-    if !with_offset {
-        tracer = tracer.without_surface_offset();
-    }
+    trace_tree_scaled(scene, options, x, y, if with_offset { 1.0 } else { 0.0 })
+}
+
+/// The recorded tree of one pixel (sample 0) with `scale` times the surface offset.
+pub fn trace_tree_scaled(
+    scene: &PreparedScene,
+    options: &RenderOptions,
+    x: u32,
+    y: u32,
+    offset_scale: f32,
+) -> Node {
+    let tracer = Tracer::new(scene, options.depth_limit(), options.min_weight);
+    let mut tracer = tracer.with_surface_offset_scale(offset_scale);
     let mut tape = Tape::default();
     trace_sample(&mut tracer, scene, options, x, y, 0, &mut tape);
     match tape.roots.pop() {
@@ -140,10 +149,19 @@ pub fn trace_tree(
 
 /// Every pixel's tree, row by row.
 pub fn trace_all(scene: &PreparedScene, options: &RenderOptions, with_offset: bool) -> Vec<Node> {
+    trace_all_scaled(scene, options, if with_offset { 1.0 } else { 0.0 })
+}
+
+/// Every pixel's tree, row by row, with `offset_scale` times the surface offset.
+pub fn trace_all_scaled(
+    scene: &PreparedScene,
+    options: &RenderOptions,
+    offset_scale: f32,
+) -> Vec<Node> {
     let mut trees = Vec::new();
     for y in 0..options.height {
         for x in 0..options.width {
-            trees.push(trace_tree(scene, options, x, y, with_offset));
+            trees.push(trace_tree_scaled(scene, options, x, y, offset_scale));
         }
     }
     trees
