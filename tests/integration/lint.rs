@@ -27,7 +27,14 @@ fn lints_of(path: &str) -> (Vec<Lint>, whitted_ir::ValidScene) {
 #[test]
 fn each_lint_fires_on_its_scene_with_its_location_and_fix() {
     // (scene, kind, where the warning points, words its fix must contain, how many)
-    let cases: [(&str, LintKind, &str, &str, usize); 7] = [
+    let cases: [(&str, LintKind, &str, &str, usize); 8] = [
+        (
+            "tests/lint/coincident-thin.scene",
+            LintKind::CoincidentSurfaces,
+            "tests/lint/coincident-thin.scene:9:1",
+            "move disk \"coaster\" off box \"table\" by more than a hair",
+            1,
+        ),
         (
             "tests/lint/light-inside-solid.scene",
             LintKind::LightInsideSolid,

@@ -7,7 +7,9 @@
 //! (c) a fully clear ior-1 solid (kt = 1, nothing else) renders as if absent, and a tinted
 //!     ior-1 box filters shadows as the same box built from twelve triangles does (each
 //!     surface a shadow ray crosses filters it, exactly as for camera rays);
-//! (d) raising max_depth changes only pixels whose ray tree was cut by max_depth.
+//! (d) raising max_depth changes only pixels whose ray tree was cut by max_depth;
+//! (e) moving the whole scene and camera far away changes no pixel beyond the error that
+//!     the move itself implies (f32 has fewer digits there): no acne, no holes.
 // A program, not a library: it prints its results and sets its exit status.
 #![allow(clippy::print_stdout, clippy::print_stderr, clippy::exit)]
 
@@ -60,6 +62,9 @@ struct Spec {
     objects: Vec<(Shape, usize)>,
     shadows: ShadowMode,
     max_depth: u32,
+    /// Every object is placed under this translation (camera and lights are moved by the
+    /// caller): the whole scene moved at once.
+    shift: DVec3,
 }
 
 impl Spec {
@@ -79,7 +84,11 @@ impl Spec {
             .map(|m| b.material(m.clone()))
             .collect();
         for (shape, material) in &self.objects {
-            b.add(shape.clone(), DMat4::IDENTITY, handles[*material]);
+            b.add(
+                shape.clone(),
+                DMat4::from_translation(self.shift),
+                handles[*material],
+            );
         }
         b.prepare()
             .unwrap_or_else(|message| panic!("invalid scene {message}: {self:?}"))
@@ -247,6 +256,7 @@ fn random_scene(seed: u64, objects: usize, reflective: bool, glass: bool) -> Spe
         objects: Vec::new(),
         shadows: ShadowMode::Opaque,
         max_depth: 6,
+        shift: DVec3::ZERO,
     };
     let floor_material = matte(0.8, 0.8, 0.7);
     let floor_material = spec.material(floor_material);
@@ -276,6 +286,7 @@ fn straight_down_light(others: usize, direction: DVec3) -> Spec {
         objects: Vec::new(),
         shadows: ShadowMode::Opaque,
         max_depth: 5,
+        shift: DVec3::ZERO,
     };
     let floor_material = spec.material(matte(0.8, 0.8, 0.8));
     let ball = spec.material(matte(0.8, 0.2, 0.2));
@@ -832,4 +843,103 @@ fn raising_max_depth_changes_only_pixels_cut_by_it() {
     );
     let (uncut_without_stats, _) = depth_changes(&random_scene(401, 5, true, true), 1, 3, false);
     assert!(!uncut_without_stats.is_empty());
+}
+
+// ---------------------------------------------------------------------------------------
+// (e) Moving the whole scene far away.
+
+fn moved_light(light: &Light, by: DVec3) -> Light {
+    let kind = match &light.kind {
+        LightKind::Point {
+            position,
+            attenuation,
+        } => LightKind::Point {
+            position: *position + by,
+            attenuation: *attenuation,
+        },
+        LightKind::Spot {
+            position,
+            direction,
+            inner_angle_degrees,
+            outer_angle_degrees,
+            attenuation,
+        } => LightKind::Spot {
+            position: *position + by,
+            direction: *direction,
+            inner_angle_degrees: *inner_angle_degrees,
+            outer_angle_degrees: *outer_angle_degrees,
+            attenuation: *attenuation,
+        },
+        directional => directional.clone(),
+    };
+    Light {
+        kind,
+        ..light.clone()
+    }
+}
+
+/// The scene, camera and lights moved by `by`.
+fn moved(spec: &Spec, by: DVec3) -> Spec {
+    Spec {
+        eye: spec.eye + by,
+        look_at: spec.look_at + by,
+        lights: spec.lights.iter().map(|l| moved_light(l, by)).collect(),
+        shift: spec.shift + by,
+        ..spec.clone()
+    }
+}
+
+/// How many pixels of the moved render may differ, in tenths of a percent per unit of
+/// the move's ulp: at a distance `d` every coordinate is known to about `d·2⁻²⁴`, so edges
+/// (silhouettes, shadow and checker borders, glass paths through them) move by that much
+/// and the pixels they cross change; acne or holes change whole surfaces.
+fn allowed_pixels(distance: f64) -> usize {
+    let ulp = distance * f64::from(f32::EPSILON);
+    let pixels = (WIDTH * HEIGHT) as f64;
+    // One pixel in 200 at a thousand, growing with the move's ulp; never under 4.
+    (pixels * (ulp / 1.2e-4 * 0.005))
+        .max(4.0)
+        .min(pixels * 0.05) as usize
+}
+
+fn check_moved(spec: &Spec, by: DVec3) -> Result<usize, String> {
+    let original = image(spec);
+    let far = image(&moved(spec, by));
+    let changed = differing(&original, &far, 0.02, |i| i);
+    let allowed = allowed_pixels(by.abs().max_element());
+    if changed.len() > allowed {
+        let i = changed[0];
+        let (x, y) = xy(i);
+        return Err(format!(
+            "{} pixels differ (at most {allowed} allowed), first ({x}, {y}): {:?} vs {:?}",
+            changed.len(),
+            original[i],
+            far[i]
+        ));
+    }
+    Ok(changed.len())
+}
+
+/// Issue 26: bounds that ignore where a shape is put acne on far scenes, and a gate that
+/// ignores how far a ray came opens holes; moving every random scene 1e3 and 3e4 away
+/// (along every axis, and along one) keeps its image.
+#[test]
+fn moving_the_whole_scene_far_away_keeps_its_image() {
+    let mut failures = Vec::new();
+    let mut changed = 0;
+    for seed in 200..215u64 {
+        let spec = random_scene(seed, 3 + (seed % 6) as usize, true, true);
+        for by in [
+            DVec3::new(1e3, -1e3, 1e3),
+            DVec3::new(3e4, 0.0, 0.0),
+            DVec3::new(-2e4, 2e4, -3e4),
+        ] {
+            match check_moved(&spec, by) {
+                Ok(n) => changed += n,
+                Err(e) => failures.push(format!("seed {seed}, moved by {by}: {e}")),
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    eprintln!("moved: {changed} edge pixels over 45 renders");
 }

@@ -1,16 +1,18 @@
 //! Lints found by tracing: a fixed grid of camera rays goes through the tracer's one code
 //! path (`trace_pixel_with`) with a recorder of this module's, which keeps the surfaces the
-//! rays hit, every object a ray met (hit or blocked a shadow ray) and the heaviest path
-//! through glass that the depth limit cut. From those: coincident surfaces (another
-//! object's surface passes through a hit point, tested with the IR's insideness) and
+//! rays hit, the surfaces the tracer found in the same place as a hit (within its error
+//! bound), every object a ray met (hit or blocked a shadow ray) and the heaviest path
+//! through glass that the depth limit cut. From those: coincident surfaces (the tracer's
+//! own report, which sees zero-thickness objects such as a disk on a table, and another
+//! object's surface passing through a hit point, tested with the IR's insideness) and
 //! `max_depth` too low (the depth that gets the light out is found by the explain probe).
 
 use glam::DVec3;
 use whitted_ir::{Diagnostic, Handle, Object, Scene};
 use whitted_tracer::optics::max_channel;
 use whitted_tracer::{
-    trace_pixel_with, LightSample, PreparedScene, RayKind, RayStart, Recorder, RenderOptions,
-    ShadowResult, SkippedRay, SurfaceHit, Termination,
+    trace_pixel_with, CoincidentSurface, LightSample, PreparedScene, RayKind, RayStart, Recorder,
+    RenderOptions, ShadowResult, SkippedRay, SurfaceHit, Termination,
 };
 
 use super::bounds::{world_bounds, Bounds};
@@ -63,9 +65,19 @@ pub struct DepthCut {
     pub object: Handle<Object>,
 }
 
+/// Two objects the tracer could not tell apart at a sampled hit: the one hit, the other,
+/// and the point.
+pub struct SamePlace {
+    pub hit: Handle<Object>,
+    pub other: Handle<Object>,
+    pub point: DVec3,
+}
+
 /// What the grid of camera rays found.
 pub struct Samples {
     pub hits: Vec<Hit>,
+    /// Coincident surfaces as the tracer reported them (significant rays only).
+    pub same_place: Vec<SamePlace>,
     /// Per object (by handle index): whether any sampled ray hit it or a shadow ray met it.
     pub met: Vec<bool>,
     pub depth_cut: Option<DepthCut>,
@@ -74,6 +86,8 @@ pub struct Samples {
 struct Frame {
     weight: f32,
     object: Option<Handle<Object>>,
+    /// Where this ray hit `object`.
+    point: DVec3,
     /// The transparent object this path last entered, if any.
     through: Option<Handle<Object>>,
 }
@@ -100,6 +114,7 @@ impl Recorder for GridRecorder<'_> {
         self.stack.push(Frame {
             weight: max_channel(ray.weight),
             object: None,
+            point: DVec3::ZERO,
             through,
         });
     }
@@ -110,6 +125,7 @@ impl Recorder for GridRecorder<'_> {
             return;
         };
         frame.object = Some(hit.object);
+        frame.point = hit.point.as_dvec3();
         if frame.weight < SIGNIFICANT {
             return;
         }
@@ -124,6 +140,22 @@ impl Recorder for GridRecorder<'_> {
             normal: hit.geometric_normal.as_dvec3(),
             priority,
         });
+    }
+
+    fn coincident_surface(&mut self, other: &CoincidentSurface) {
+        let Some(frame) = self.stack.last() else {
+            return;
+        };
+        let Some(hit) = frame.object.filter(|&hit| hit != other.object) else {
+            return;
+        };
+        if frame.weight >= SIGNIFICANT {
+            self.samples.same_place.push(SamePlace {
+                hit,
+                other: other.object,
+                point: frame.point,
+            });
+        }
     }
 
     fn light_sampled(&mut self, sample: &LightSample) {
@@ -206,6 +238,7 @@ pub fn sample(prepared: &PreparedScene, scene: &Scene) -> Samples {
         scene,
         samples: Samples {
             hits: Vec::new(),
+            same_place: Vec::new(),
             met: vec![false; scene.objects.len()],
             depth_cut: None,
         },
@@ -228,12 +261,27 @@ pub fn sample(prepared: &PreparedScene, scene: &Scene) -> Samples {
 /// surfaces of nested media (a material with a `priority`), which the tracer crosses
 /// together as one interface (ARCHITECTURE.md, "Coincident surfaces").
 pub(super) fn coincident_surfaces(scene: &Scene, samples: &Samples, lints: &mut Vec<Lint>) {
-    let objects = renderables(scene);
-    let bounds: Vec<Option<Bounds>> = objects.iter().map(|&o| world_bounds(scene, o)).collect();
-    let hits_to_test = (MAX_SURFACE_TESTS / objects.len().max(1)).min(samples.hits.len());
     // Pairs already found; a set, because thousands of spheres in one place make millions.
     let mut reported: std::collections::HashSet<(Handle<Object>, Handle<Object>)> =
         std::collections::HashSet::new();
+    let prioritised = |o: Handle<Object>| scene.materials[scene.objects[o].material].priority > 0;
+    // What the tracer itself saw: it finds zero-thickness surfaces (a disk on a table, a
+    // poster on a wall) that have no inside to test.
+    for same in &samples.same_place {
+        if !(prioritised(same.hit) && prioritised(same.other)) {
+            report_pair(
+                scene,
+                same.hit,
+                same.other,
+                same.point,
+                &mut reported,
+                lints,
+            );
+        }
+    }
+    let objects = renderables(scene);
+    let bounds: Vec<Option<Bounds>> = objects.iter().map(|&o| world_bounds(scene, o)).collect();
+    let hits_to_test = (MAX_SURFACE_TESTS / objects.len().max(1)).min(samples.hits.len());
     let mut shape_tests = 0usize;
     'hits: for hit in &samples.hits[..hits_to_test] {
         if hit.priority > 0 {
@@ -248,7 +296,7 @@ pub(super) fn coincident_surfaces(scene: &Scene, samples: &Samples, lints: &mut 
         for (&other, other_bounds) in objects.iter().zip(&bounds) {
             if other == hit.object
                 || other_bounds.is_some_and(|b| !b.contains(hit.point, step))
-                || scene.materials[scene.objects[other].material].priority > 0
+                || prioritised(other)
             {
                 continue;
             }
@@ -261,39 +309,9 @@ pub(super) fn coincident_surfaces(scene: &Scene, samples: &Samples, lints: &mut 
             else {
                 continue;
             };
-            if inside_below == inside_above {
-                continue;
+            if inside_below != inside_above {
+                report_pair(scene, hit.object, other, hit.point, &mut reported, lints);
             }
-            let pair = (hit.object.min(other), hit.object.max(other));
-            if !reported.insert(pair) || reported.len() > MAX_PER_KIND {
-                continue;
-            }
-            let (this_name, other_name) =
-                (object_name(scene, hit.object), object_name(scene, other));
-            let at = hit.point;
-            let diagnostic = Diagnostic::warning(
-                format!(
-                    "{other_name} and {this_name} share a surface at <{}, {}, {}>: which one a \
-                     ray sees there is decided by rounding, so it renders as speckles or stripes",
-                    short(at.x),
-                    short(at.y),
-                    short(at.z)
-                ),
-                scene.objects.span(other),
-            )
-            .with_label(format!(
-                "{other_name}'s surface passes through {this_name}'s"
-            ))
-            .with_secondary(
-                scene.objects.span(hit.object),
-                format!("{this_name} is here"),
-            )
-            .with_hint(format!(
-                "move {other_name} off {this_name} by more than a hair (for example 0.001), \
-                 so that no surface of one lies on the other; or, for water in glass, give \
-                 both materials a `priority`"
-            ));
-            lints.push(Lint::new(LintKind::CoincidentSurfaces, diagnostic));
         }
     }
     // Only the first pairs became warnings; the last one says how many more there were.
@@ -309,6 +327,43 @@ pub(super) fn coincident_surfaces(scene: &Scene, samples: &Samples, lints: &mut 
             ));
         }
     }
+}
+
+/// Warns, once per pair and up to [`MAX_PER_KIND`] pairs, that `other`'s surface lies on
+/// `hit`'s at `at`.
+fn report_pair(
+    scene: &Scene,
+    hit: Handle<Object>,
+    other: Handle<Object>,
+    at: DVec3,
+    reported: &mut std::collections::HashSet<(Handle<Object>, Handle<Object>)>,
+    lints: &mut Vec<Lint>,
+) {
+    let pair = (hit.min(other), hit.max(other));
+    if !reported.insert(pair) || reported.len() > MAX_PER_KIND {
+        return;
+    }
+    let (this_name, other_name) = (object_name(scene, hit), object_name(scene, other));
+    let diagnostic = Diagnostic::warning(
+        format!(
+            "{other_name} and {this_name} share a surface at <{}, {}, {}>: which one a ray \
+             sees there is decided by rounding, so it renders as speckles or stripes",
+            short(at.x),
+            short(at.y),
+            short(at.z)
+        ),
+        scene.objects.span(other),
+    )
+    .with_label(format!(
+        "{other_name}'s surface passes through {this_name}'s"
+    ))
+    .with_secondary(scene.objects.span(hit), format!("{this_name} is here"))
+    .with_hint(format!(
+        "move {other_name} off {this_name} by more than a hair (for example 0.001), so that \
+         no surface of one lies on the other; or, for water in glass, give both materials a \
+         `priority`"
+    ));
+    lints.push(Lint::new(LintKind::CoincidentSurfaces, diagnostic));
 }
 
 /// A sampled camera ray through glass is still carrying a significant weight when the
