@@ -1,6 +1,7 @@
 //! `mesh` objects: files read through the loader once however many objects name them, paths
-//! relative to the scene, `smooth`, and every mesh file error located at the `file` that
-//! named it, with the file's line where one line is at fault.
+//! relative to the scene, `smooth`, files as exporters write them, and every mesh file error,
+//! warning and note located in the file (with the `file` that named it), "not a solid" with
+//! its reason, edge and faces.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
