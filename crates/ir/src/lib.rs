@@ -19,7 +19,7 @@ mod validate;
 pub use arena::{Arena, Handle};
 pub use diagnostic::{Diagnostic, Label, Severity};
 pub use json::{document as json_document, to_json, ArgJson, IrDocument, StepJson};
-pub use mesh::Mesh;
+pub use mesh::{BadEdge, EdgeDefect, Mesh, NotSolid};
 pub use print::print;
 pub use provenance::{ArgValue, FrameId, Provenance, Site, SiteId, SiteKind, Step};
 pub use scene::{

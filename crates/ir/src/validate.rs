@@ -6,6 +6,7 @@ use glam::{DMat4, DVec3};
 use crate::arena::Handle;
 use crate::diagnostic::Diagnostic;
 use crate::limits::{MAX_MESH_TRIANGLES, MAX_SCENE_TRIANGLES};
+use crate::mesh::{BadEdge, NotSolid};
 use crate::scene::{
     Attenuation, Color, LightKind, Material, Object, ObjectKind, Projection, Scene, Shape,
 };
@@ -327,14 +328,42 @@ impl Checker {
                     }
                     if !is_solid(scene, child) {
                         let child_span = scene.objects.span(child);
-                        self.errors.push(
-                            Diagnostic::error(
-                                format!("a {} needs solid children, and this is not a solid", op.name()),
-                                child_span,
-                            )
-                            .with_secondary(span, "in this CSG operation")
-                            .with_hint("disks, triangles, open cylinders and cones, open meshes, and groups have no inside; use a capped shape, a closed mesh or a union"),
-                        );
+                        // A mesh says why it is not a solid, with an edge and its face.
+                        let why = match &scene.objects[child].kind {
+                            ObjectKind::Shape {
+                                shape: Shape::Mesh { mesh, .. },
+                            } => scene.meshes.get(*mesh).and_then(|m| m.not_solid.as_ref()),
+                            _ => None,
+                        };
+                        // `an intersection`, but `a union` (its first sound is a consonant).
+                        let article = if op.name().starts_with(['a', 'e', 'i', 'o']) {
+                            "an"
+                        } else {
+                            "a"
+                        };
+                        let message = match why {
+                            Some(why) => format!(
+                                "{article} {} needs solid children, and this mesh {}",
+                                op.name(),
+                                why.describe()
+                            ),
+                            None => format!(
+                                "{article} {} needs solid children, and this is not a solid",
+                                op.name()
+                            ),
+                        };
+                        let mut diagnostic = Diagnostic::error(message, child_span)
+                            .with_secondary(span, "in this CSG operation");
+                        if let Some(NotSolid::Edge(BadEdge {
+                            face, other_face, ..
+                        })) = why
+                        {
+                            for face in face.iter().chain(other_face) {
+                                diagnostic =
+                                    diagnostic.with_secondary(*face, "a face with that edge");
+                            }
+                        }
+                        self.errors.push(diagnostic.with_hint("disks, triangles, open cylinders and cones, open meshes, and groups have no inside; use a capped shape, a closed mesh or a union"));
                     }
                 }
             }

@@ -595,6 +595,8 @@ fn compile_root(
         return finish(sources, None, diagnostics, work);
     }
     crate::mesh::load_meshes(&mut scene, loader, limits, &mut diagnostics);
+    // The scene's map is `sources` and the mesh files its diagnostics point into.
+    let sources = scene.sources.clone();
     if has_error(&diagnostics) {
         return finish(sources, None, diagnostics, work);
     }

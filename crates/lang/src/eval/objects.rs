@@ -113,6 +113,7 @@ impl<'a> Evaluator<'a> {
             normals: Vec::new(),
             triangles: Vec::new(),
             solid: false,
+            not_solid: None,
         };
         let handle = self.scene.meshes.append(mesh, span);
         self.mesh_files.insert(target, handle);

@@ -7,7 +7,7 @@
 //! out on bad input, where this reader's every problem is an error naming the line (ASCII)
 //! or the byte (binary) at fault.
 
-use super::{MeshData, MeshError};
+use super::{MeshData, MeshError, VertexNumbers};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Format {
@@ -79,6 +79,7 @@ pub(super) fn parse(bytes: &[u8], budget: usize) -> Result<MeshData, MeshError> 
         Format::Ascii => Reader::Ascii {
             text: body,
             at: 0,
+            offset: bytes.len() - body.len(),
             line: header_lines,
             words_left: 0,
         },
@@ -89,7 +90,10 @@ pub(super) fn parse(bytes: &[u8], budget: usize) -> Result<MeshData, MeshError> 
             big_endian,
         },
     };
-    let mut data = MeshData::default();
+    let mut data = MeshData {
+        vertex_numbers: VertexNumbers::FromZero,
+        ..MeshData::default()
+    };
     let mut triangles = 0usize;
     for element in &elements {
         let is_vertex = element.name == "vertex";
@@ -111,6 +115,7 @@ pub(super) fn parse(bytes: &[u8], budget: usize) -> Result<MeshData, MeshError> 
         }
         for _ in 0..element.count {
             reader.start_record();
+            let record_start = reader.record_start();
             let mut values = [0.0f64; 6];
             for (index, property) in element.properties.iter().enumerate() {
                 match property.list {
@@ -140,7 +145,17 @@ pub(super) fn parse(bytes: &[u8], budget: usize) -> Result<MeshData, MeshError> 
                             }
                         }
                         if is_face && Some(index) == corners {
-                            triangles = triangles.saturating_add(count.saturating_sub(2));
+                            if count < 3 {
+                                return Err(reader.error(format!(
+                                    "a face needs three vertices or more, and this one has {}",
+                                    if count == 0 {
+                                        "none".to_string()
+                                    } else {
+                                        count.to_string()
+                                    }
+                                )));
+                            }
+                            triangles = triangles.saturating_add(count - 2);
                             if triangles > budget {
                                 return Err(MeshError::too_many(triangles));
                             }
@@ -160,6 +175,7 @@ pub(super) fn parse(bytes: &[u8], budget: usize) -> Result<MeshData, MeshError> 
                             // A fan, as for OBJ polygons.
                             for k in 1..ids.len().saturating_sub(1) {
                                 data.triangles.push([ids[0], ids[k], ids[k + 1]]);
+                                data.face_starts.extend(record_start);
                             }
                         }
                     }
@@ -288,6 +304,8 @@ enum Reader<'a> {
     Ascii {
         text: &'a [u8],
         at: usize,
+        /// Where the body starts in the file.
+        offset: usize,
         /// The line the last record started on (1-based, counting the header).
         line: usize,
         /// Words still to read on the current line (records are one per line).
@@ -310,6 +328,7 @@ impl Reader<'_> {
             at,
             line,
             words_left,
+            ..
         } = self
         {
             // The rest of the previous record's line, if it had more words than properties.
@@ -337,6 +356,15 @@ impl Reader<'_> {
                 *at = (end + 1).min(text.len());
             }
             *words_left = 0;
+        }
+    }
+
+    /// Where the current record starts in the file (ASCII files; a binary file has no
+    /// line to show).
+    fn record_start(&self) -> Option<usize> {
+        match self {
+            Reader::Ascii { at, offset, .. } => Some(offset + at),
+            Reader::Binary { .. } => None,
         }
     }
 
@@ -418,6 +446,7 @@ impl Reader<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::Place;
 
     const ASCII: &str = "ply\nformat ascii 1.0\ncomment a square\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
 
@@ -478,17 +507,30 @@ mod tests {
     fn errors_name_the_line_or_the_byte() {
         let bad_index = ASCII.replace("4 0 1 2 3", "4 0 1 2 9");
         let error = parse(bad_index.as_bytes(), 10).unwrap_err();
-        assert_eq!(error.line, Some(15), "{error:?}");
+        assert_eq!(error.place, Place::Line(15), "{error:?}");
         assert!(error.message.contains("vertex index 9"), "{error:?}");
         let short_vertex = ASCII.replace("1 1 0\n", "1 1\n");
         let error = parse(short_vertex.as_bytes(), 10).unwrap_err();
-        assert_eq!(error.line, Some(13), "{error:?}");
+        assert_eq!(error.place, Place::Line(13), "{error:?}");
         let bad_header = ASCII.replace("property float y", "property floaty y");
         let error = parse(bad_header.as_bytes(), 10).unwrap_err();
-        assert_eq!(error.line, Some(6), "{error:?}");
+        assert_eq!(error.place, Place::Line(6), "{error:?}");
         let truncated = "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n\0\0";
         let error = parse(truncated.as_bytes(), 10).unwrap_err();
         assert!(error.message.contains("at byte"), "{error:?}");
         assert!(parse(ASCII.as_bytes(), 1).unwrap_err().too_many.is_some());
+        let short_face = ASCII.replace("4 0 1 2 3", "2 0 1");
+        let error = parse(short_face.as_bytes(), 10).unwrap_err();
+        assert_eq!(error.place, Place::Line(15), "{error:?}");
+        assert!(error.message.contains("this one has 2"), "{error:?}");
+    }
+
+    /// Each triangle knows its face's line, for the messages of a mesh that is not a
+    /// solid; a binary file's triangles have none.
+    #[test]
+    fn ascii_triangles_know_where_their_face_is() {
+        let data = parse(ASCII.as_bytes(), 10).unwrap();
+        let start = ASCII.find("4 0 1 2 3").unwrap();
+        assert_eq!(data.face_starts, vec![start, start]);
     }
 }
