@@ -135,6 +135,13 @@ fn each_finding_kind_fires_on_its_scene_with_location_and_fix() {
             "the surface offset `epsilon 1e-9`",
         ),
         (
+            "light-inside-glass",
+            "20,25",
+            "light_inside_solid",
+            "light-inside-glass.scene:9:1",
+            "or set `shadows filtered` in settings",
+        ),
+        (
             "planet-acne",
             "20,22",
             "self_hit",

@@ -134,7 +134,22 @@ fn blocked(context: &Context<'_>, node: &RayNode, findings: &mut Vec<Finding>) {
                 p,
             ) == Some(true)
         });
+        let transparent = material_of(scene, blocker.leaf.handle)
+            .filter(|(m, _)| !m.transmissive.is_black())
+            .map(|(_, handle)| scene.material_label(handle));
+        let opaque_shadows = scene.settings.shadows == ShadowMode::Opaque;
         if inside {
+            // As `check` says for the same light: both fixes when the solid lets light
+            // through and only opaque shadows keep it in.
+            let through = match &transparent {
+                Some(material) if opaque_shadows => format!(
+                    ", or set `shadows filtered` in settings (or run with --set \
+                     shadows=filtered) so that its light shines out through {} (material \
+                     {material}), which is transparent",
+                    blocker.object.label
+                ),
+                _ => String::new(),
+            };
             push_unique(
                 findings,
                 Finding {
@@ -146,7 +161,7 @@ fn blocked(context: &Context<'_>, node: &RayNode, findings: &mut Vec<Finding>) {
                     ),
                     location: blocker.object.location.clone(),
                     fix: format!(
-                        "move {} out of {} (or make {} smaller)",
+                        "move {} out of {} (or make {} smaller){through}",
                         light.label, blocker.object.label, blocker.object.label
                     ),
                     weight,
@@ -155,15 +170,12 @@ fn blocked(context: &Context<'_>, node: &RayNode, findings: &mut Vec<Finding>) {
             );
             continue;
         }
-        let transparent = material_of(scene, blocker.leaf.handle)
-            .filter(|(m, _)| !m.transmissive.is_black())
-            .map(|(_, handle)| scene.material_label(handle));
         let surface = node
             .hit
             .as_ref()
             .map_or("the surface".to_string(), |h| h.object.label.clone());
         let (message, fix) = match transparent {
-            Some(material) if scene.settings.shadows == ShadowMode::Opaque => (
+            Some(material) if opaque_shadows => (
                 format!(
                     "the shadow ray from {surface} to {} is blocked by {} ({}), which is \
                      transparent (material {material}), but shadows are opaque",
