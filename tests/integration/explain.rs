@@ -248,6 +248,8 @@ fn a_rug_in_the_floor_is_coincident_with_it_for_the_camera_ray() {
         "floor (tests/explain/rug-on-floor.scene:7:1)",
         "rug (tests/explain/rug-on-floor.scene:8:1)",
         "camera ray",
+        "this ray shows wood (floor, rgb(0.",
+        "with rug in front it would show wool (rug, rgb(0.",
     ] {
         assert!(message.contains(part), "`{message}` lacks `{part}`");
     }

@@ -43,8 +43,9 @@ pub use recorder::{
     ShadowRay, ShadowResult, SkippedRay, SurfaceHit, Termination, TerminationSet,
 };
 pub use render::{
-    render, render_from, render_with_pixel_stats, trace_pixel_with, Image, NoObserver,
-    PixelAccumulator, RenderObserver, RenderOptions, RenderStats, TileResult, TILE_SIZE,
+    render, render_from, render_with_pixel_stats, trace_pixel_preferring, trace_pixel_with, Image,
+    NoObserver, PixelAccumulator, RenderObserver, RenderOptions, RenderStats, TileResult,
+    TILE_SIZE,
 };
 pub use scene::PreparedScene;
 

@@ -223,6 +223,24 @@ pub fn trace_pixel_with<R: Recorder>(
     trace_sample(&mut tracer, scene, options, x, y, sample, rec).to_array()
 }
 
+/// The colour of sample `sample` of pixel (x, y) had the camera ray met `object`'s surface
+/// where it meets another in the same place (z-fighting: what the pixel shows with the
+/// other surface in front), through the one code path. `None` when the camera ray has no
+/// such surface of `object` within its first hit's error bound.
+pub fn trace_pixel_preferring<R: Recorder>(
+    scene: &PreparedScene,
+    options: &RenderOptions,
+    (x, y, sample): (u32, u32, u32),
+    object: whitted_ir::Handle<whitted_ir::Object>,
+    rec: &mut R,
+) -> Option<[f32; 3]> {
+    let mut tracer = Tracer::new(scene, options.depth_limit(), options.min_weight);
+    let ray = camera_ray(&scene.camera, options, x, y, sample);
+    tracer
+        .trace_preferring(&ray, object, rec)
+        .map(|c| c.to_array())
+}
+
 #[inline]
 pub(crate) fn trace_sample<R: Recorder>(
     tracer: &mut Tracer<'_>,

@@ -13,7 +13,7 @@
 //! ray stays in its parent's media; Beer-Lambert absorption follows the current medium.
 
 use glam::Vec3A;
-use whitted_ir::{Fresnel, Handle, Highlight, Material, ShadowMode};
+use whitted_ir::{Fresnel, Handle, Highlight, Material, Object, ShadowMode};
 
 use crate::bvh::PACKET;
 use crate::material::PreparedMaterial;
@@ -200,6 +200,37 @@ impl<'a> Tracer<'a> {
     pub(crate) fn camera_hits(&mut self, rays: &[Ray], hits: &mut [Option<Hit>; PACKET]) -> bool {
         self.scene
             .intersect_packet(rays, 0.0, &mut self.scratch, hits)
+    }
+
+    /// [`Tracer::trace`] of a camera ray that meets `object`'s surface first where the
+    /// tracer cannot tell it from the surface it does meet first (z-fighting: the other
+    /// side of the fight). `None` when the ray misses, or no surface of `object` is within
+    /// the first hit's error bound along it.
+    pub(crate) fn trace_preferring<R: Recorder>(
+        &mut self,
+        ray: &Ray,
+        object: Handle<Object>,
+        rec: &mut R,
+    ) -> Option<Vec3A> {
+        let scene = self.scene;
+        let first = scene.intersect(ray, 0.0, f32::INFINITY, &mut self.scratch)?;
+        let surface = scene.surface(ray, &first);
+        let window = coincident_window(ray, first.t, &surface);
+        let mut preferred = None;
+        scene.surface_crossings_near(ray, 0.0, first.t, window, &mut self.scratch, |other| {
+            if scene.item(other.item).object() == object {
+                preferred = Some(other);
+                return false;
+            }
+            true
+        });
+        let preferred = preferred?;
+        Some(self.trace_first(
+            ray,
+            &PathState::camera(),
+            rec,
+            FirstHit::Known(Some(preferred)),
+        ))
     }
 
     /// [`Tracer::trace`] of a ray whose first hit is already known (from

@@ -5,12 +5,13 @@
 //! could not tell apart from the one it hit (z-fighting, seen by camera rays too).
 
 use whitted_tracer::ray_tree::{CoincidentInfo, HitInfo, ObjectRef, RayNode, ShadowOutcome};
+use whitted_tracer::{trace_pixel_preferring, NoRecord};
 
 use whitted_ir::{Handle, Material, Object, ObjectKind, QuadricForm, Scene, Shape};
 
 use crate::numbers::{shortest, shortest_up};
 
-use super::{material_of, push_unique, walk, weight_of, Context, SIGNIFICANT};
+use super::{material_of, push_unique, rgb, walk, weight_of, Context, SIGNIFICANT};
 use crate::locate::setting_location;
 use crate::model::{Finding, FindingKind};
 
@@ -57,7 +58,7 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
     });
     // Every ray, camera rays included: a surface the tracer could not tell apart from the
     // one hit (z-fighting).
-    walk(context.tree, &mut |node, _| {
+    walk(context.tree, &mut |node, above| {
         let Some(hit) = &node.hit else {
             return;
         };
@@ -77,7 +78,19 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
             if prioritised(hit.resolved_material.handle) && prioritised(other.material.handle) {
                 continue;
             }
-            z_fighting(hit, other, node.kind.name(), weight_of(node), findings);
+            // For a camera ray, the sample's colour either way, through the tracer.
+            let colours = above
+                .is_empty()
+                .then(|| either_colour(context, node, other))
+                .flatten();
+            z_fighting(
+                hit,
+                other,
+                node.kind.name(),
+                weight_of(node),
+                colours,
+                findings,
+            );
         }
     });
     // Shadow rays leave from their parent's hit.
@@ -122,6 +135,29 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
     });
 }
 
+/// The colour of the camera ray `root` as traced, and as traced had it met `other` first:
+/// the two sides of a z-fight, through the tracer's one code path.
+fn either_colour(
+    context: &Context<'_>,
+    root: &RayNode,
+    other: &CoincidentInfo,
+) -> Option<([f32; 3], [f32; 3])> {
+    let sample = context
+        .tree
+        .samples
+        .iter()
+        .find(|s| std::ptr::eq(&s.root, root))?;
+    let [x, y] = context.tree.pixel;
+    let with_other = trace_pixel_preferring(
+        context.prepared,
+        context.options,
+        (x, y, sample.index),
+        Handle::<Object>::from_index(other.object.handle as usize),
+        &mut NoRecord,
+    )?;
+    Some((root.color, with_other))
+}
+
 /// Two surfaces in one place along a ray: which one it meets is rounding, so neighbouring
 /// pixels alternate between them.
 fn z_fighting(
@@ -129,8 +165,13 @@ fn z_fighting(
     other: &CoincidentInfo,
     ray: &str,
     weight: f32,
+    colours: Option<([f32; 3], [f32; 3])>,
     findings: &mut Vec<Finding>,
 ) {
+    let (shown, would) = match colours {
+        Some((now, with_other)) => (format!(", {}", rgb(now)), format!(", {}", rgb(with_other))),
+        None => (String::new(), String::new()),
+    };
     push_unique(
         findings,
         Finding {
@@ -138,8 +179,8 @@ fn z_fighting(
             message: format!(
                 "{} ({}) and {} ({}) are in the same place here: the {ray} ray meets {} at \
                  t = {} and {} at t = {}, within rounding of each other, so which one it shows \
-                 is chance and neighbouring pixels alternate (z-fighting): this pixel shows {} \
-                 ({}); with {} it would show {} ({})",
+                 is chance and neighbouring pixels alternate (z-fighting): this ray shows {} \
+                 ({}{shown}); with {} in front it would show {} ({}{would})",
                 hit.object.label,
                 hit.object.location,
                 other.object.label,
