@@ -332,6 +332,20 @@ impl Lines {
         if hit.absorption != [1.0; 3] {
             self.color("absorption", hit.absorption, "Beer-Lambert on the way here");
         }
+        self.text(
+            "offset",
+            format!("{:.1e}  (error bound {:.1e})", hit.offset, hit.error_bound),
+        );
+        for other in &hit.coincident {
+            self.text(
+                "coincident",
+                format!(
+                    "{} ({}) in the same place: z-fighting",
+                    other.object.label, other.object.kind
+                ),
+            );
+            self.text("", format!("defined at {}", other.object.location));
+        }
     }
 
     fn local(&mut self, local: &LocalIllumination, highlight: whitted_ir::Highlight) {
