@@ -104,7 +104,7 @@ impl PreparedScene {
     pub(crate) fn offset_at(&self, surface: &Surface<'_>) -> f32 {
         match self.epsilon {
             Some(epsilon) => epsilon,
-            None => hit_error::spawn_offset(surface.geometric_normal, surface.error),
+            None => hit_error::spawn_offset(surface.geometric_normal, surface.error, surface.point),
         }
     }
 
