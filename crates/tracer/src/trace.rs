@@ -22,8 +22,8 @@ use crate::optics::{beer_lambert, fresnel_exact, max_channel, reflect, refract, 
 use crate::query::{Hit, Scratch, Shadow, Surface};
 use crate::ray::Ray;
 use crate::recorder::{
-    Interface, LightSample, RayKind, RayStart, Recorder, ShadowRay, ShadowResult, SkippedRay,
-    SurfaceHit, Termination,
+    Interface, LightSample, NoShadowRay, RayKind, RayStart, Recorder, ShadowRay, ShadowResult,
+    SkippedRay, SurfaceHit, Termination,
 };
 use crate::scene::PreparedScene;
 
@@ -687,28 +687,29 @@ impl<'a> Tracer<'a> {
                 n_dot_l,
                 attenuation: incidence.attenuation,
                 spot: incidence.spot,
+                cos_axis: incidence.cos_axis,
                 shadow_ray: None,
-                unshaded: false,
-                shadows_off: false,
-                back_face,
+                no_shadow_ray: None,
                 diffuse: Vec3A::ZERO,
                 specular: Vec3A::ZERO,
             };
             if back_face {
+                sample.no_shadow_ray = Some(NoShadowRay::BackFace);
                 rec.light_sampled(&sample);
                 continue;
             }
             if n_dot_l <= 0.0 || strength <= 0.0 || light.intensity == Vec3A::ZERO {
+                sample.no_shadow_ray = Some(unlit(n_dot_l, incidence.spot, light.intensity));
                 rec.light_sampled(&sample);
                 continue;
             }
             if unshaded && self.skip_unshaded_shadows {
-                sample.unshaded = true;
+                sample.no_shadow_ray = Some(NoShadowRay::Unshaded);
                 rec.light_sampled(&sample);
                 continue;
             }
             let (passed, shadow_ray) = if scene.shadows == ShadowMode::None {
-                sample.shadows_off = true;
+                sample.no_shadow_ray = Some(NoShadowRay::ShadowsOff);
                 (Vec3A::ONE, None)
             } else {
                 self.cast_shadow::<R>(outside, incidence.to_light, incidence.distance)
@@ -839,6 +840,21 @@ enum FirstHit {
 #[inline(always)]
 fn is_false_hit(solid: bool, outer: Option<Medium>, inner: Option<Medium>) -> bool {
     solid && same_medium(outer, inner)
+}
+
+/// Why a light facing the surface adds nothing (the `N·L`, cone and colour test of
+/// `local_illumination` failed), in the order of that test.
+#[cold]
+fn unlit(n_dot_l: f32, spot: f32, intensity: Vec3A) -> NoShadowRay {
+    if n_dot_l <= 0.0 {
+        NoShadowRay::FacingAway
+    } else if spot <= 0.0 {
+        NoShadowRay::OutsideCone
+    } else if intensity == Vec3A::ZERO {
+        NoShadowRay::BlackLight
+    } else {
+        NoShadowRay::TooFaint
+    }
 }
 
 /// A shadow query's outcome as the recorder reports it.

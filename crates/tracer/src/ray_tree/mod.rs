@@ -14,9 +14,9 @@ mod tests;
 
 pub use json::RayTreeDocument;
 pub use model::{
-    Blocker, HitInfo, InterfaceInfo, LightContribution, LightRef, LocalIllumination, MaterialRef,
-    ObjectRef, RayNode, RayTree, SampleChoice, SampleTree, ShadingModel, ShadowInfo, ShadowOutcome,
-    SkippedInfo, StackArg, StackStep, Visibility, RAY_TREE_JSON_VERSION,
+    Blocker, ConeInfo, HitInfo, InterfaceInfo, LightContribution, LightRef, LocalIllumination,
+    MaterialRef, ObjectRef, RayNode, RayTree, SampleChoice, SampleTree, ShadingModel, ShadowInfo,
+    ShadowOutcome, SkippedInfo, StackArg, StackStep, Visibility, RAY_TREE_JSON_VERSION,
 };
 pub use pixel::{check_request, trace_pixel, trace_pixel_request, TraceError, TraceRequest};
 pub use text::{format_text, TextOptions};
