@@ -48,9 +48,9 @@ fn trace_json(args: &[&str]) -> Value {
 #[test]
 fn json_matches_the_documented_schema_on_varied_scenes() {
     let schema = schema();
-    let cases: [&[&str]; 6] = [
+    let cases: [&[&str]; 7] = [
         &["scenes/whitted.scene", "--pixel", "400,270"],
-        // A spot cone that misses (`outside_cone` with its `cone`).
+        // A spot cone that misses (`outside_cone` with its `cone`), and the ray budget.
         &[
             "scenes/spotlight.scene",
             "--pixel",
@@ -59,6 +59,14 @@ fn json_matches_the_documented_schema_on_varied_scenes() {
             "64",
             "--height",
             "48",
+        ],
+        // (At depth 24: a tree 64 deep passes serde_json's nesting limit when read back.)
+        &[
+            "scenes/ray-explosion.scene",
+            "--pixel",
+            "32,24",
+            "--max-depth",
+            "24",
         ],
         &[
             "scenes/csg-difference.scene",
@@ -110,7 +118,12 @@ fn json_matches_the_documented_schema_on_varied_scenes() {
         assert_eq!(document["root"]["kind"], "camera");
     }
     // The new words were among what the schema checked.
-    for word in ["\"outside_cone\"", "\"facing_away\"", "\"cone\":{"] {
+    for word in [
+        "\"outside_cone\"",
+        "\"facing_away\"",
+        "\"ray_budget\"",
+        "\"cone\":{",
+    ] {
         assert!(words.contains(word), "no {word} in the documents checked");
     }
     // The antialiasing scene has 16 samples: all are recorded unless one is asked for.

@@ -119,6 +119,7 @@ pub struct Finding {
 pub enum FindingKind {
     MaxDepth,
     WeightCutoff,
+    RayBudget,
     LightBehind,
     OutsideSpotCone,
     ShadowBlocked,
@@ -135,6 +136,7 @@ impl FindingKind {
         match self {
             FindingKind::MaxDepth => "max_depth",
             FindingKind::WeightCutoff => "weight_cutoff",
+            FindingKind::RayBudget => "ray_budget",
             FindingKind::LightBehind => "light_behind",
             FindingKind::OutsideSpotCone => "outside_spot_cone",
             FindingKind::ShadowBlocked => "shadow_blocked",

@@ -72,16 +72,21 @@ pub enum Termination {
     TotalInternalReflection,
     /// The surface neither reflects nor transmits: only its local colour returns.
     Absorbed,
+    /// The sample had already cast its budget of rays
+    /// ([`whitted_ir::limits::MAX_RAYS_PER_SAMPLE`]): the secondary ray was not traced and
+    /// the colour gathered so far is kept.
+    RayBudget,
 }
 
 impl Termination {
-    pub const ALL: [Termination; 6] = [
+    pub const ALL: [Termination; 7] = [
         Termination::NotEnded,
         Termination::Miss,
         Termination::MaxDepth,
         Termination::WeightCutoff,
         Termination::TotalInternalReflection,
         Termination::Absorbed,
+        Termination::RayBudget,
     ];
 
     pub fn name(self) -> &'static str {
@@ -92,6 +97,7 @@ impl Termination {
             Termination::WeightCutoff => "weight_cutoff",
             Termination::TotalInternalReflection => "total_internal_reflection",
             Termination::Absorbed => "absorbed",
+            Termination::RayBudget => "ray_budget",
         }
     }
 

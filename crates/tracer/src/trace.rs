@@ -37,6 +37,12 @@ pub struct RayCounters {
     pub deepest: u32,
     /// Camera rays whose first hit was found in a packet.
     pub camera_in_packets: u64,
+    /// Samples that reached the ray budget ([`whitted_ir::limits::MAX_RAYS_PER_SAMPLE`]).
+    pub samples_cut: u64,
+    /// Pixels with at least one such sample (counted by the renderer, per pixel).
+    pub pixels_cut: u64,
+    /// The first such pixel in row-major order, `[x, y]`.
+    pub first_pixel_cut: Option<[u32; 2]>,
 }
 
 impl RayCounters {
@@ -47,6 +53,21 @@ impl RayCounters {
         self.transmitted += other.transmitted;
         self.deepest = self.deepest.max(other.deepest);
         self.camera_in_packets += other.camera_in_packets;
+        self.samples_cut += other.samples_cut;
+        self.pixels_cut += other.pixels_cut;
+        self.first_pixel_cut = match (self.first_pixel_cut, other.first_pixel_cut) {
+            (Some(a), Some(b)) => Some(if (a[1], a[0]) <= (b[1], b[0]) { a } else { b }),
+            (a, b) => a.or(b),
+        };
+    }
+
+    /// Records that pixel `(x, y)` had a sample cut at the ray budget.
+    pub fn pixel_cut(&mut self, x: u32, y: u32) {
+        self.add(&RayCounters {
+            pixels_cut: 1,
+            first_pixel_cut: Some([x, y]),
+            ..RayCounters::default()
+        });
     }
 }
 
@@ -147,6 +168,12 @@ pub struct Tracer<'a> {
     /// The media before and beyond the last coincident meeting (nested media only), read
     /// right after [`Tracer::meet`] returns.
     coincident: (MediumStack, MediumStack),
+    /// The most reflected, transmitted and shadow rays one sample may cast
+    /// ([`whitted_ir::limits::MAX_RAYS_PER_SAMPLE`]), the count cast so far in the current
+    /// sample, and whether it has reached the budget.
+    ray_budget: u32,
+    sample_rays: u32,
+    sample_cut: bool,
 }
 
 impl<'a> Tracer<'a> {
@@ -160,7 +187,17 @@ impl<'a> Tracer<'a> {
             offset_scale: 1.0,
             skip_unshaded_shadows: true,
             coincident: (MediumStack::EMPTY, MediumStack::EMPTY),
+            ray_budget: whitted_ir::limits::MAX_RAYS_PER_SAMPLE,
+            sample_rays: 0,
+            sample_cut: false,
         }
+    }
+
+    /// A smaller ray budget per sample than the limit: only for tests of the cut.
+    #[cfg(test)]
+    pub fn with_ray_budget(mut self, budget: u32) -> Self {
+        self.ray_budget = budget;
+        self
     }
 
     /// Casts shadow rays even where the material cannot use them: only for tests showing
@@ -229,6 +266,9 @@ impl<'a> Tracer<'a> {
             medium: path.medium,
             media: &path.media,
         };
+        // A new sample: its ray budget starts afresh.
+        self.sample_rays = 0;
+        self.sample_cut = false;
         self.count(&path);
         self.trace_started(ray, &path, rec, first)
     }
@@ -238,8 +278,14 @@ impl<'a> Tracer<'a> {
     fn count(&mut self, path: &Path<'_>) {
         match path.kind {
             RayKind::Camera => self.counters.camera += 1,
-            RayKind::Reflected => self.counters.reflected += 1,
-            RayKind::Transmitted => self.counters.transmitted += 1,
+            RayKind::Reflected => {
+                self.counters.reflected += 1;
+                self.sample_rays += 1;
+            }
+            RayKind::Transmitted => {
+                self.counters.transmitted += 1;
+                self.sample_rays += 1;
+            }
             // Shadow rays are queries, not traced paths; they are counted where they are cast.
             RayKind::Shadow => {}
         }
@@ -743,6 +789,7 @@ impl<'a> Tracer<'a> {
         let scene = self.scene;
         let ray = Ray::new(origin, to_light);
         self.counters.shadow += 1;
+        self.sample_rays += 1;
         let shadow = match scene.shadows {
             ShadowMode::Opaque => match scene.occluded(&ray, 0.0, distance, &mut self.scratch) {
                 Some(blocker) => Shadow::Blocked(blocker),
@@ -800,6 +847,10 @@ impl<'a> Tracer<'a> {
                 Some(self.trace_started(ray, child, rec, FirstHit::Find))
             }
             Some(reason) => {
+                if reason == Termination::RayBudget && !self.sample_cut {
+                    self.sample_cut = true;
+                    self.counters.samples_cut += 1;
+                }
                 rec.secondary_skipped(&SkippedRay {
                     kind: child.kind,
                     depth: child.depth,
@@ -820,6 +871,8 @@ impl<'a> Tracer<'a> {
             Some(Termination::MaxDepth)
         } else if max_channel(child.weight) < self.min_weight {
             Some(Termination::WeightCutoff)
+        } else if self.sample_rays >= self.ray_budget {
+            Some(Termination::RayBudget)
         } else {
             None
         }

@@ -469,6 +469,9 @@ fn reason(termination: Termination) -> &'static str {
         Termination::WeightCutoff => "weight cut-off: it would weigh less than min_weight",
         Termination::TotalInternalReflection => "total internal reflection",
         Termination::Absorbed => "absorbed: the surface neither reflects nor transmits",
+        Termination::RayBudget => {
+            "ray budget: the sample had cast its budget of rays (rays per sample, docs/language.md)"
+        }
     }
 }
 

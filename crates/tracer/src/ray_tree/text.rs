@@ -180,6 +180,11 @@ impl Printer {
                 Termination::TotalInternalReflection => {
                     format!(" (weight {} dropped)", self.color(skipped.weight))
                 }
+                Termination::RayBudget => format!(
+                    " (the sample had cast its {} rays; weight {})",
+                    whitted_ir::limits::MAX_RAYS_PER_SAMPLE,
+                    self.color(skipped.weight)
+                ),
                 _ => format!(" (weight {})", self.color(skipped.weight)),
             };
             lines.push(format!(
@@ -425,6 +430,7 @@ fn termination_text(termination: Termination) -> &'static str {
         Termination::WeightCutoff => "weight cut-off",
         Termination::TotalInternalReflection => "total internal reflection",
         Termination::Absorbed => "absorbed",
+        Termination::RayBudget => "ray budget",
     }
 }
 

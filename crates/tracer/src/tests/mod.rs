@@ -9,6 +9,7 @@ mod emission;
 mod energy;
 mod media_scenes;
 mod optics_scenes;
+mod ray_budget;
 mod shadow_rays;
 mod switches;
 
