@@ -53,7 +53,8 @@ fn ray_budget(context: &Context<'_>, findings: &mut Vec<Finding>) {
         largest(total) * 100.0,
         tree.min_weight,
         tree.max_depth,
-        tree.max_depth
+        // 2 + 4 + ... + 2^max_depth reflected and transmitted rays.
+        tree.max_depth + 1
     );
     let fix = format!(
         "raise min_weight so that weak paths end (0.001 is usual): {}; or lower max_depth",
