@@ -439,6 +439,26 @@ mod tests {
         assert_eq!(events(&view, 0), [RayEvent::MaxDepth]);
     }
 
+    /// A ray refused because its sample had cast its budget of rays is an event of its own,
+    /// named as the ray tree names it.
+    #[test]
+    fn the_ray_budget_is_an_event() {
+        let mut tree = glass_pixel_tree();
+        tree.samples[0]
+            .root
+            .skipped
+            .push(whitted_tracer::ray_tree::SkippedInfo {
+                kind: RayKind::Reflected,
+                depth: 1,
+                weight: [0.5; 3],
+                coefficient: [0.5; 3],
+                reason: Termination::RayBudget,
+            });
+        let view = TreeView::new(tree);
+        assert_eq!(events(&view, 0), [RayEvent::RayBudget]);
+        assert_eq!(RayEvent::RayBudget.name(), "ray budget");
+    }
+
     #[test]
     fn a_hit_on_the_surface_just_left_is_a_self_hit_event() {
         let mut tree = glass_pixel_tree();
