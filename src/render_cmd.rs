@@ -236,6 +236,13 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     };
     estimate.check()?;
     let objects = loaded.scene.objects.len();
+    // What would make samples reach the ray budget, said while the IR (and its sources) is
+    // at hand: the report after the render needs it only if pixels were cut.
+    let budget_cause = whitted_explain::lint::ray_budget_cause(
+        &loaded.scene,
+        loaded.scene.settings.min_weight,
+        options.max_depth,
+    );
     // A scene too big to lint by default is rendered without its lints (`check --lint`
     // has them): they would add about a second per million objects to the render.
     let lint =
@@ -325,6 +332,12 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         wall_seconds: started.elapsed().as_secs_f64(),
         peak_memory_kib: crate::cpu_time::peak_memory_kib(),
     };
+    if !args.quiet && stats.pixels_cut_at_ray_budget > 0 {
+        eprintln!(
+            "{}",
+            ray_budget_report(&stats, width, height, &budget_cause)
+        );
+    }
     match args.stats {
         Some(StatsFormat::Text) => write_stdout(&summary.text())?,
         Some(StatsFormat::Json) => write_stdout(&(summary.json().to_string() + "\n"))?,
@@ -340,6 +353,24 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         );
     }
     Ok(())
+}
+
+/// The warning after a render whose samples reached the ray budget: how many pixels, the
+/// first one, and the settings that made it happen.
+fn ray_budget_report(stats: &RenderStats, width: u32, height: u32, cause: &str) -> String {
+    let pixels = u64::from(width) * u64::from(height);
+    let first = match stats.first_pixel_cut_at_ray_budget {
+        Some([x, y]) => format!(", the first at ({x}, {y})"),
+        None => String::new(),
+    };
+    format!(
+        "warning: {} of {pixels} pixels were cut at the ray budget of {} rays per sample{first}: \
+         their recursion stopped there and they keep the colour gathered so far\n  = cause: \
+         {cause}\n  = help: raise min_weight (0.001 is usual) so that weak paths end, or lower \
+         max_depth; `whitted trace --pixel X,Y` shows where a pixel was cut",
+        stats.pixels_cut_at_ray_budget,
+        whitted_ir::limits::MAX_RAYS_PER_SAMPLE
+    )
 }
 
 /// Everything `--stats` reports about one render.
@@ -398,6 +429,17 @@ impl Summary<'_> {
             format!("reflected rays   {}", s.reflected_rays),
             format!("transmitted rays {}", s.transmitted_rays),
             format!("total rays       {}", s.total_rays()),
+            match s.first_pixel_cut_at_ray_budget {
+                Some([x, y]) => format!(
+                    "ray budget       {} pixels cut at {} rays per sample, the first at ({x}, {y})",
+                    s.pixels_cut_at_ray_budget,
+                    whitted_ir::limits::MAX_RAYS_PER_SAMPLE
+                ),
+                None => format!(
+                    "ray budget       no pixel cut ({} rays per sample)",
+                    whitted_ir::limits::MAX_RAYS_PER_SAMPLE
+                ),
+            },
             format!(
                 "speed            {mrays:.2} Mrays/s ({:.2} per thread)",
                 mrays / self.threads as f64
@@ -440,6 +482,9 @@ impl Summary<'_> {
             "reflected_rays": s.reflected_rays,
             "transmitted_rays": s.transmitted_rays,
             "total_rays": s.total_rays(),
+            "ray_budget_per_sample": whitted_ir::limits::MAX_RAYS_PER_SAMPLE,
+            "pixels_cut_at_ray_budget": s.pixels_cut_at_ray_budget,
+            "first_pixel_cut_at_ray_budget": s.first_pixel_cut_at_ray_budget,
             "rays_per_second": self.stats.rays_per_second(),
             "render_cpu_seconds": self.render_cpu_seconds,
             "rays_per_cpu_second": self.rays_per_cpu_second(),

@@ -107,6 +107,13 @@ fn each_finding_kind_fires_on_its_scene_with_location_and_fix() {
             "move under to the side of floor",
         ),
         (
+            "outside-spot-cone",
+            "20,15",
+            "outside_spot_cone",
+            "outside-spot-cone.scene:5:1",
+            "widen torch's cone (`outer` to more than 38°) or aim it",
+        ),
+        (
             "shadow-blocked-opaque",
             "20,15",
             "shadow_blocked",
@@ -444,5 +451,35 @@ fn a_course_scene_is_explained_too() {
     assert!(
         fix.starts_with("raise max_depth to 2: run with --set max_depth=2"),
         "{fix}"
+    );
+}
+
+/// A spot light whose cone misses the point is not "behind" it: explain says the point is
+/// outside the cone, with the angle from the axis and the cone's, and how to fix it.
+#[test]
+fn a_spot_cone_that_misses_is_outside_the_cone_not_behind() {
+    let json = explain_json("tests/explain/outside-spot-cone.scene", "20,15");
+    let findings = json["findings"].as_array().cloned().unwrap_or_default();
+    assert!(
+        findings.iter().all(|f| f["kind"] != "light_behind"),
+        "{findings:#?}"
+    );
+    let Some(finding) = findings.iter().find(|f| f["kind"] == "outside_spot_cone") else {
+        panic!("no outside_spot_cone finding: {findings:#?}");
+    };
+    let message = finding["message"].as_str().unwrap_or("");
+    assert!(
+        message.contains("is outside the cone of spot light torch")
+            && message.contains("37.3° from the spot's axis, beyond its cone of 15°")
+            && !message.contains("behind"),
+        "{message}"
+    );
+    // The light behind the floor is still behind it.
+    let json = explain_json("tests/explain/light-behind.scene", "20,15");
+    let findings = json["findings"].as_array().cloned().unwrap_or_default();
+    assert!(
+        findings.iter().any(|f| f["kind"] == "light_behind")
+            && findings.iter().all(|f| f["kind"] != "outside_spot_cone"),
+        "{findings:#?}"
     );
 }

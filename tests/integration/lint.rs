@@ -27,7 +27,7 @@ fn lints_of(path: &str) -> (Vec<Lint>, whitted_ir::ValidScene) {
 #[test]
 fn each_lint_fires_on_its_scene_with_its_location_and_fix() {
     // (scene, kind, where the warning points, words its fix must contain, how many)
-    let cases: [(&str, LintKind, &str, &str, usize); 8] = [
+    let cases: [(&str, LintKind, &str, &str, usize); 9] = [
         (
             "tests/lint/coincident-thin.scene",
             LintKind::CoincidentSurfaces,
@@ -83,6 +83,13 @@ fn each_lint_fires_on_its_scene_with_its_location_and_fix() {
             "tests/lint/facing-away.scene:7:1",
             "turn the triangle around (swap two of its corners), or set `shade_back on`",
             2,
+        ),
+        (
+            "tests/lint/ray-budget.scene",
+            LintKind::RayBudget,
+            "tests/lint/ray-budget.scene:3:44",
+            "raise min_weight (0.001 is usual) so that weak paths end, or lower max_depth to 12",
+            1,
         ),
     ];
     for (path, kind, location, fix, count) in cases {
@@ -156,6 +163,28 @@ fn shipped_scenes() -> Vec<PathBuf> {
     scenes
 }
 
+/// The ray budget's warning names the material and says how many rays a sample could
+/// take; a scene whose weights fall in time is quiet at any depth.
+#[test]
+fn the_ray_budget_warning_counts_the_rays_and_names_the_material() {
+    let (lints, _) = lints_of("tests/lint/ray-budget.scene");
+    assert_eq!(
+        lints[0].diagnostic.message,
+        "ray_budget: min_weight 0 with material `half_glass`, which reflects and transmits, \
+         at max_depth 40: a sample could take up to 2.2e12 rays, past the budget of 10000 \
+         rays per sample, so `render` stops each such sample's recursion there and keeps the \
+         colour so far"
+    );
+    // The same glass with the usual minimum weight: 2 + 4 + ... + 2^9 rays at most.
+    let output = check(&["tests/lint/ray-budget.scene", "--set", "min_weight=0.001"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(!stderr.contains("ray_budget"), "{stderr}");
+}
+
+/// The scene that shows the ray budget, and its one expected warning.
+const RAY_EXPLOSION: &str = "scenes/ray-explosion.scene";
+
 #[test]
 fn every_shipped_scene_is_quiet() {
     let scenes = shipped_scenes();
@@ -165,6 +194,10 @@ fn every_shipped_scene_is_quiet() {
         let output = check(&[&name]);
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(output.status.success(), "{name}: {stderr}");
+        if name == RAY_EXPLOSION {
+            assert!(stderr.contains("warning: ray_budget: "), "{stderr}");
+            continue;
+        }
         for kind in LintKind::ALL {
             assert!(
                 !stderr.contains(kind.name()),

@@ -17,6 +17,7 @@ mod lint;
 mod mit6837;
 mod provenance;
 mod query;
+mod ray_budget;
 mod ray_trees;
 mod reshade;
 mod tidy;

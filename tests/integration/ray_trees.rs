@@ -312,6 +312,58 @@ fn text_of_one_sample_of_many() {
     );
 }
 
+/// A spot light whose cone misses the point, and lights behind the surface, each say so in
+/// their own words (issue 26): a floor pixel outside the blue spot's cone (the others lit),
+/// and a pixel low on the ball that faces away from all three.
+#[test]
+fn text_of_a_spot_cone_that_misses_and_lights_that_face_away() {
+    snapshot(
+        "trace_spot_outside_cone",
+        text_of(
+            "scenes/spotlight.scene",
+            Some((64, 48)),
+            32,
+            30,
+            SampleChoice::All,
+        ),
+    );
+    snapshot(
+        "trace_spot_facing_away",
+        text_of(
+            "scenes/spotlight.scene",
+            Some((64, 48)),
+            32,
+            23,
+            SampleChoice::All,
+        ),
+    );
+}
+
+/// The same two pixels' light entries in the JSON form: the visibility words and the cone.
+#[test]
+fn json_of_a_spot_cone_that_misses_and_lights_that_face_away() {
+    let loaded = load("scenes/spotlight.scene");
+    let options = options_at(&loaded, 64, 48);
+    let mut lights = Vec::new();
+    for (x, y) in [(32, 30), (32, 23)] {
+        let tree = tree(&loaded, &options, x, y, SampleChoice::All);
+        let local = tree.samples[0].root.local.clone().expect("a hit");
+        for light in local.lights {
+            lights.push(serde_json::json!({
+                "pixel": [x, y],
+                "light": light.light.label,
+                "n_dot_l": light.n_dot_l,
+                "spot": light.spot,
+                "cone": light.cone,
+                "visibility": light.visibility,
+                "shadow_child": light.shadow_child,
+            }));
+        }
+    }
+    let text = serde_json::to_string_pretty(&lights).expect("JSON");
+    snapshot("trace_spot_lights_json", text);
+}
+
 /// The text between the first fence that starts with `opening` and the next fence.
 fn fenced_block<'a>(doc: &'a str, opening: &str, after: &str) -> &'a str {
     let from = doc.find(after).expect("the anchor text") + after.len();

@@ -48,8 +48,26 @@ fn trace_json(args: &[&str]) -> Value {
 #[test]
 fn json_matches_the_documented_schema_on_varied_scenes() {
     let schema = schema();
-    let cases: [&[&str]; 5] = [
+    let cases: [&[&str]; 7] = [
         &["scenes/whitted.scene", "--pixel", "400,270"],
+        // A spot cone that misses (`outside_cone` with its `cone`), and the ray budget.
+        &[
+            "scenes/spotlight.scene",
+            "--pixel",
+            "32,30",
+            "--width",
+            "64",
+            "--height",
+            "48",
+        ],
+        // (At depth 24: a tree 64 deep passes serde_json's nesting limit when read back.)
+        &[
+            "scenes/ray-explosion.scene",
+            "--pixel",
+            "32,24",
+            "--max-depth",
+            "24",
+        ],
         &[
             "scenes/csg-difference.scene",
             "--pixel",
@@ -89,13 +107,24 @@ fn json_matches_the_documented_schema_on_varied_scenes() {
             "1",
         ],
     ];
+    let mut words = String::new();
     for args in cases {
         let document = trace_json(args);
+        words.push_str(&document.to_string());
         let errors = validate(&schema, &document);
         assert!(errors.is_empty(), "{args:?}: {errors:#?}");
-        assert_eq!(document["version"], 1);
+        assert_eq!(document["version"], 2);
         assert_eq!(document["root"], document["samples"][0]["root"]);
         assert_eq!(document["root"]["kind"], "camera");
+    }
+    // The new words were among what the schema checked.
+    for word in [
+        "\"outside_cone\"",
+        "\"facing_away\"",
+        "\"ray_budget\"",
+        "\"cone\":{",
+    ] {
+        assert!(words.contains(word), "no {word} in the documents checked");
     }
     // The antialiasing scene has 16 samples: all are recorded unless one is asked for.
     let all = trace_json(&[

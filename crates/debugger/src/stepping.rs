@@ -98,6 +98,8 @@ pub enum RayEvent {
     MaxDepth,
     /// A secondary ray's path weight was under `min_weight`.
     WeightCutoff,
+    /// The sample had cast its budget of rays (`rays per sample`): recursion stopped.
+    RayBudget,
     /// A shadow ray found an opaque blocker.
     ShadowBlocked,
     /// The ray met the surface it left at once (surface acne), as the explain library
@@ -111,6 +113,7 @@ impl RayEvent {
             RayEvent::TotalInternalReflection => "total internal reflection",
             RayEvent::MaxDepth => "max depth",
             RayEvent::WeightCutoff => "weight cut-off",
+            RayEvent::RayBudget => "ray budget",
             RayEvent::ShadowBlocked => "blocked shadow ray",
             RayEvent::SelfHit => "self-hit",
         }
@@ -135,6 +138,9 @@ pub fn events(view: &TreeView, id: NodeId) -> Vec<RayEvent> {
     }
     if ended(Termination::WeightCutoff) {
         found.push(RayEvent::WeightCutoff);
+    }
+    if ended(Termination::RayBudget) {
+        found.push(RayEvent::RayBudget);
     }
     if node
         .shadow
@@ -431,6 +437,26 @@ mod tests {
         tree.samples[0].root.skipped.push(skipped);
         let view = TreeView::new(tree);
         assert_eq!(events(&view, 0), [RayEvent::MaxDepth]);
+    }
+
+    /// A ray refused because its sample had cast its budget of rays is an event of its own,
+    /// named as the ray tree names it.
+    #[test]
+    fn the_ray_budget_is_an_event() {
+        let mut tree = glass_pixel_tree();
+        tree.samples[0]
+            .root
+            .skipped
+            .push(whitted_tracer::ray_tree::SkippedInfo {
+                kind: RayKind::Reflected,
+                depth: 1,
+                weight: [0.5; 3],
+                coefficient: [0.5; 3],
+                reason: Termination::RayBudget,
+            });
+        let view = TreeView::new(tree);
+        assert_eq!(events(&view, 0), [RayEvent::RayBudget]);
+        assert_eq!(RayEvent::RayBudget.name(), "ray budget");
     }
 
     #[test]

@@ -119,7 +119,9 @@ pub struct Finding {
 pub enum FindingKind {
     MaxDepth,
     WeightCutoff,
+    RayBudget,
     LightBehind,
+    OutsideSpotCone,
     ShadowBlocked,
     LightInsideSolid,
     SelfHit,
@@ -134,7 +136,9 @@ impl FindingKind {
         match self {
             FindingKind::MaxDepth => "max_depth",
             FindingKind::WeightCutoff => "weight_cutoff",
+            FindingKind::RayBudget => "ray_budget",
             FindingKind::LightBehind => "light_behind",
+            FindingKind::OutsideSpotCone => "outside_spot_cone",
             FindingKind::ShadowBlocked => "shadow_blocked",
             FindingKind::LightInsideSolid => "light_inside_solid",
             FindingKind::SelfHit => "self_hit",

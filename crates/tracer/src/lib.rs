@@ -39,8 +39,9 @@ mod tests;
 
 pub use bvh::{force_traversal_path, PathUnavailable, TraversalPath};
 pub use recorder::{
-    CoincidentSurface, Interface, LightSample, NoRecord, PixelStats, RayKind, RayStart, Recorder,
-    ShadowRay, ShadowResult, SkippedRay, SurfaceHit, Termination, TerminationSet,
+    CoincidentSurface, Interface, LightSample, NoRecord, NoShadowRay, PixelStats, RayKind,
+    RayStart, Recorder, ShadowRay, ShadowResult, SkippedRay, SurfaceHit, Termination,
+    TerminationSet,
 };
 pub use render::{
     render, render_from, render_with_pixel_stats, trace_pixel_preferring, trace_pixel_with, Image,

@@ -47,6 +47,9 @@ pub struct Incidence {
     pub attenuation: f32,
     /// The spot cone's factor, 1 for other lights.
     pub spot: f32,
+    /// The cosine of the angle between a spot's axis and the direction from the light to
+    /// the point, 1 for other lights (the ray tree reports the angle when the cone misses).
+    pub cos_axis: f32,
 }
 
 fn terms(a: &Attenuation) -> [f32; 3] {
@@ -99,6 +102,7 @@ impl PreparedLight {
                 distance: f32::INFINITY,
                 attenuation: 1.0,
                 spot: 1.0,
+                cos_axis: 1.0,
             },
             PreparedLightKind::Point {
                 position,
@@ -111,6 +115,7 @@ impl PreparedLight {
                     distance,
                     attenuation: fatt(attenuation, distance, *clamp),
                     spot: 1.0,
+                    cos_axis: 1.0,
                 }
             }
             PreparedLightKind::Spot {
@@ -128,6 +133,7 @@ impl PreparedLight {
                     distance,
                     attenuation: fatt(attenuation, distance, *clamp),
                     spot: optics::spot_factor(cos_angle, *cos_inner, *cos_outer),
+                    cos_axis: cos_angle,
                 }
             }
         }

@@ -72,16 +72,21 @@ pub enum Termination {
     TotalInternalReflection,
     /// The surface neither reflects nor transmits: only its local colour returns.
     Absorbed,
+    /// The sample had already cast its budget of rays
+    /// ([`whitted_ir::limits::MAX_RAYS_PER_SAMPLE`]): the secondary ray was not traced and
+    /// the colour gathered so far is kept.
+    RayBudget,
 }
 
 impl Termination {
-    pub const ALL: [Termination; 6] = [
+    pub const ALL: [Termination; 7] = [
         Termination::NotEnded,
         Termination::Miss,
         Termination::MaxDepth,
         Termination::WeightCutoff,
         Termination::TotalInternalReflection,
         Termination::Absorbed,
+        Termination::RayBudget,
     ];
 
     pub fn name(self) -> &'static str {
@@ -92,6 +97,7 @@ impl Termination {
             Termination::WeightCutoff => "weight_cutoff",
             Termination::TotalInternalReflection => "total_internal_reflection",
             Termination::Absorbed => "absorbed",
+            Termination::RayBudget => "ray_budget",
         }
     }
 
@@ -253,22 +259,43 @@ pub struct LightSample {
     pub attenuation: f32,
     /// The spot cone factor (1 for other lights).
     pub spot: f32,
-    /// `None` when no shadow ray was needed: the light is behind the surface, outside its
-    /// cone, or too far to count, or the material is unshaded (see `unshaded`).
+    /// The cosine of the angle between a spot light's axis and the direction from the light
+    /// to the point (1 for other lights).
+    pub cos_axis: f32,
+    /// The shadow ray cast towards the light, if one was (see `no_shadow_ray` otherwise).
     pub shadow_ray: Option<ShadowRay>,
-    /// The light faces the surface, but no shadow ray was cast because the material has no
-    /// diffuse and no specular colour: the light could add nothing.
-    pub unshaded: bool,
-    /// The light faces the surface and no shadow ray was cast because the scene has
-    /// `shadows none`: the light counts as unblocked.
-    pub shadows_off: bool,
-    /// The surface is seen from its back and the scene has `shade_back off`: the light adds
-    /// nothing, and no shadow ray was cast.
-    pub back_face: bool,
+    /// Why no shadow ray was cast, when none was (`None` when `shadow_ray` is `Some`).
+    pub no_shadow_ray: Option<NoShadowRay>,
     /// `fatt·spot·Ii·shadow·kd·(N·L)`, as added to the colour.
     pub diffuse: Vec3A,
     /// `fatt·spot·Ii·shadow·ks·(R·V)^n`, as added to the colour.
     pub specular: Vec3A,
+}
+
+/// Why a light cast no shadow ray at a hit, in the order the tracer tests them: the first
+/// that applies is the one reported.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoShadowRay {
+    /// The surface is seen from its back and the scene has `shade_back off`: the light adds
+    /// nothing.
+    BackFace,
+    /// The light is behind the surface (`N·L <= 0`): it adds nothing.
+    FacingAway,
+    /// A spot light whose cone does not reach the point (its cone factor is 0): it adds
+    /// nothing.
+    OutsideCone,
+    /// The light's colour is black: it adds nothing.
+    BlackLight,
+    /// `fatt·spot` rounds to 0 in f32 though neither factor is 0 (only at the very edge of
+    /// a wide cone, far from the light; `fatt` itself is never 0 within the number limits):
+    /// the light adds nothing.
+    TooFaint,
+    /// The light reaches the point, but the material has no diffuse and no specular colour:
+    /// it could add nothing whatever a shadow ray found.
+    Unshaded,
+    /// The scene has `shadows none`: the light counts as unblocked.
+    ShadowsOff,
 }
 
 /// A reflected or transmitted ray the material asked for but that was not traced.

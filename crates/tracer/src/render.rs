@@ -98,6 +98,11 @@ pub struct RenderStats {
     pub deepest_ray: u32,
     /// The rayon threads the render ran on.
     pub threads: usize,
+    /// Pixels with a sample that reached the ray budget
+    /// ([`whitted_ir::limits::MAX_RAYS_PER_SAMPLE`]): their recursion was cut short.
+    pub pixels_cut_at_ray_budget: u64,
+    /// The first such pixel in row-major order, `[x, y]`.
+    pub first_pixel_cut_at_ray_budget: Option<[u32; 2]>,
 }
 
 impl RenderStats {
@@ -343,6 +348,8 @@ fn render_recorded<R: Recorder + Default + Send>(
         render_seconds: started.elapsed().as_secs_f64(),
         deepest_ray: counters.deepest,
         threads: rayon::current_num_threads(),
+        pixels_cut_at_ray_budget: counters.pixels_cut,
+        first_pixel_cut_at_ray_budget: counters.first_pixel_cut,
     };
     let image = Image {
         width,
@@ -396,8 +403,11 @@ fn render_tile<R: Recorder + Default>(
         // The rays in the order they were made: pixel by pixel, sample by sample, exactly
         // as `trace_sample` traces them one at a time.
         let samples = samples as usize;
-        for (pixel_rays, pixel_hits) in rays.chunks(samples).zip(first_hits.chunks(samples)) {
+        for (x, (pixel_rays, pixel_hits)) in
+            (x0..).zip(rays.chunks(samples).zip(first_hits.chunks(samples)))
+        {
             let mut rec = R::default();
+            let cut_before = tracer.counters.samples_cut;
             let mut accumulator = PixelAccumulator::new();
             for (ray, first_hit) in pixel_rays.iter().zip(pixel_hits) {
                 let color = match first_hit {
@@ -408,6 +418,9 @@ fn render_tile<R: Recorder + Default>(
             }
             pixels.push(accumulator.mean());
             worker.recorders.push(rec);
+            if tracer.counters.samples_cut != cut_before {
+                tracer.counters.pixel_cut(x, y);
+            }
         }
     }
     let tile = TileResult {

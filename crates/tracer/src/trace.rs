@@ -22,7 +22,7 @@ use crate::optics::{beer_lambert, fresnel_exact, max_channel, reflect, refract, 
 use crate::query::{Hit, Scratch, Shadow, Surface};
 use crate::ray::Ray;
 use crate::recorder::{
-    CoincidentSurface, Interface, LightSample, RayKind, RayStart, Recorder, ShadowRay,
+    CoincidentSurface, Interface, LightSample, NoShadowRay, RayKind, RayStart, Recorder, ShadowRay,
     ShadowResult, SkippedRay, SurfaceHit, Termination,
 };
 use crate::scene::PreparedScene;
@@ -46,6 +46,12 @@ pub struct RayCounters {
     pub deepest: u32,
     /// Camera rays whose first hit was found in a packet.
     pub camera_in_packets: u64,
+    /// Samples that reached the ray budget ([`whitted_ir::limits::MAX_RAYS_PER_SAMPLE`]).
+    pub samples_cut: u64,
+    /// Pixels with at least one such sample (counted by the renderer, per pixel).
+    pub pixels_cut: u64,
+    /// The first such pixel in row-major order, `[x, y]`.
+    pub first_pixel_cut: Option<[u32; 2]>,
 }
 
 impl RayCounters {
@@ -56,6 +62,21 @@ impl RayCounters {
         self.transmitted += other.transmitted;
         self.deepest = self.deepest.max(other.deepest);
         self.camera_in_packets += other.camera_in_packets;
+        self.samples_cut += other.samples_cut;
+        self.pixels_cut += other.pixels_cut;
+        self.first_pixel_cut = match (self.first_pixel_cut, other.first_pixel_cut) {
+            (Some(a), Some(b)) => Some(if (a[1], a[0]) <= (b[1], b[0]) { a } else { b }),
+            (a, b) => a.or(b),
+        };
+    }
+
+    /// Records that pixel `(x, y)` had a sample cut at the ray budget.
+    pub fn pixel_cut(&mut self, x: u32, y: u32) {
+        self.add(&RayCounters {
+            pixels_cut: 1,
+            first_pixel_cut: Some([x, y]),
+            ..RayCounters::default()
+        });
     }
 }
 
@@ -156,6 +177,12 @@ pub struct Tracer<'a> {
     /// The media before and beyond the last coincident meeting (nested media only), read
     /// right after [`Tracer::meet`] returns.
     coincident: (MediumStack, MediumStack),
+    /// The most reflected, transmitted and shadow rays one sample may cast
+    /// ([`whitted_ir::limits::MAX_RAYS_PER_SAMPLE`]), the count cast so far in the current
+    /// sample, and whether it has reached the budget.
+    ray_budget: u32,
+    sample_rays: u32,
+    sample_cut: bool,
 }
 
 impl<'a> Tracer<'a> {
@@ -169,7 +196,17 @@ impl<'a> Tracer<'a> {
             offset_scale: 1.0,
             skip_unshaded_shadows: true,
             coincident: (MediumStack::EMPTY, MediumStack::EMPTY),
+            ray_budget: whitted_ir::limits::MAX_RAYS_PER_SAMPLE,
+            sample_rays: 0,
+            sample_cut: false,
         }
+    }
+
+    /// A smaller ray budget per sample than the limit: only for tests of the cut.
+    #[cfg(test)]
+    pub fn with_ray_budget(mut self, budget: u32) -> Self {
+        self.ray_budget = budget;
+        self
     }
 
     /// Casts shadow rays even where the material cannot use them: only for tests showing
@@ -270,6 +307,9 @@ impl<'a> Tracer<'a> {
             medium: path.medium,
             media: &path.media,
         };
+        // A new sample: its ray budget starts afresh.
+        self.sample_rays = 0;
+        self.sample_cut = false;
         self.count(&path);
         self.trace_started(ray, &path, rec, first)
     }
@@ -279,8 +319,14 @@ impl<'a> Tracer<'a> {
     fn count(&mut self, path: &Path<'_>) {
         match path.kind {
             RayKind::Camera => self.counters.camera += 1,
-            RayKind::Reflected => self.counters.reflected += 1,
-            RayKind::Transmitted => self.counters.transmitted += 1,
+            RayKind::Reflected => {
+                self.counters.reflected += 1;
+                self.sample_rays += 1;
+            }
+            RayKind::Transmitted => {
+                self.counters.transmitted += 1;
+                self.sample_rays += 1;
+            }
             // Shadow rays are queries, not traced paths; they are counted where they are cast.
             RayKind::Shadow => {}
         }
@@ -734,28 +780,29 @@ impl<'a> Tracer<'a> {
                 n_dot_l,
                 attenuation: incidence.attenuation,
                 spot: incidence.spot,
+                cos_axis: incidence.cos_axis,
                 shadow_ray: None,
-                unshaded: false,
-                shadows_off: false,
-                back_face,
+                no_shadow_ray: None,
                 diffuse: Vec3A::ZERO,
                 specular: Vec3A::ZERO,
             };
             if back_face {
+                sample.no_shadow_ray = Some(NoShadowRay::BackFace);
                 rec.light_sampled(&sample);
                 continue;
             }
             if n_dot_l <= 0.0 || strength <= 0.0 || light.intensity == Vec3A::ZERO {
+                sample.no_shadow_ray = Some(unlit(n_dot_l, incidence.spot, light.intensity));
                 rec.light_sampled(&sample);
                 continue;
             }
             if unshaded && self.skip_unshaded_shadows {
-                sample.unshaded = true;
+                sample.no_shadow_ray = Some(NoShadowRay::Unshaded);
                 rec.light_sampled(&sample);
                 continue;
             }
             let (passed, shadow_ray) = if scene.shadows == ShadowMode::None {
-                sample.shadows_off = true;
+                sample.no_shadow_ray = Some(NoShadowRay::ShadowsOff);
                 (Vec3A::ONE, None)
             } else {
                 self.cast_shadow::<R>(outside, incidence.to_light, incidence.distance)
@@ -789,6 +836,7 @@ impl<'a> Tracer<'a> {
         let scene = self.scene;
         let ray = Ray::new(origin, to_light);
         self.counters.shadow += 1;
+        self.sample_rays += 1;
         let shadow = match scene.shadows {
             ShadowMode::Opaque => match scene.occluded(&ray, 0.0, distance, &mut self.scratch) {
                 Some(blocker) => Shadow::Blocked(blocker),
@@ -882,6 +930,10 @@ impl<'a> Tracer<'a> {
                 Some(self.trace_started(ray, child, rec, FirstHit::Find))
             }
             Some(reason) => {
+                if reason == Termination::RayBudget && !self.sample_cut {
+                    self.sample_cut = true;
+                    self.counters.samples_cut += 1;
+                }
                 rec.secondary_skipped(&SkippedRay {
                     kind: child.kind,
                     depth: child.depth,
@@ -902,6 +954,8 @@ impl<'a> Tracer<'a> {
             Some(Termination::MaxDepth)
         } else if max_channel(child.weight) < self.min_weight {
             Some(Termination::WeightCutoff)
+        } else if self.sample_rays >= self.ray_budget {
+            Some(Termination::RayBudget)
         } else {
             None
         }
@@ -934,6 +988,21 @@ enum FirstHit {
 #[inline(always)]
 fn is_false_hit(solid: bool, outer: Option<Medium>, inner: Option<Medium>) -> bool {
     solid && same_medium(outer, inner)
+}
+
+/// Why a light facing the surface adds nothing (the `N·L`, cone and colour test of
+/// `local_illumination` failed), in the order of that test.
+#[cold]
+fn unlit(n_dot_l: f32, spot: f32, intensity: Vec3A) -> NoShadowRay {
+    if n_dot_l <= 0.0 {
+        NoShadowRay::FacingAway
+    } else if spot <= 0.0 {
+        NoShadowRay::OutsideCone
+    } else if intensity == Vec3A::ZERO {
+        NoShadowRay::BlackLight
+    } else {
+        NoShadowRay::TooFaint
+    }
 }
 
 /// A shadow query's outcome as the recorder reports it.

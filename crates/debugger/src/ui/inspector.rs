@@ -361,7 +361,20 @@ impl Lines {
                     Visibility::Lit => "lit".to_string(),
                     Visibility::Filtered => "filtered".to_string(),
                     Visibility::Blocked => "in shadow".to_string(),
-                    Visibility::NotFacing => "faces away (no shadow ray)".to_string(),
+                    Visibility::FacingAway => "faces away: N·L <= 0 (no shadow ray)".to_string(),
+                    Visibility::OutsideCone => match &light.cone {
+                        Some(cone) => format!(
+                            "outside the spot cone: {:.1}° from its axis, cone {:.1}° (no shadow ray)",
+                            cone.angle_degrees, cone.outer_degrees
+                        ),
+                        None => "outside the spot cone (no shadow ray)".to_string(),
+                    },
+                    Visibility::BlackLight => {
+                        "black light: adds nothing (no shadow ray)".to_string()
+                    }
+                    Visibility::TooFaint => {
+                        "too faint: fatt·spot rounds to 0 (no shadow ray)".to_string()
+                    }
                     Visibility::Unshaded => "nothing to light (no shadow ray)".to_string(),
                     Visibility::NoShadows => "lit (shadows none: no shadow ray)".to_string(),
                     Visibility::BackFace => "unlit back face (shade_back off)".to_string(),
@@ -470,6 +483,9 @@ fn reason(termination: Termination) -> &'static str {
         Termination::WeightCutoff => "weight cut-off: it would weigh less than min_weight",
         Termination::TotalInternalReflection => "total internal reflection",
         Termination::Absorbed => "absorbed: the surface neither reflects nor transmits",
+        Termination::RayBudget => {
+            "ray budget: the sample had cast its budget of rays (rays per sample, docs/language.md)"
+        }
     }
 }
 
@@ -515,6 +531,57 @@ mod tests {
         assert!(plain.contains("ambient"), "{plain}");
     }
 
+    /// A light that adds nothing says why, in the tracer's words: a spot cone that misses
+    /// the point with its angles, a light behind the surface, a black light.
+    #[test]
+    fn a_light_that_adds_nothing_says_why() {
+        let light = |visibility, n_dot_l, cone| whitted_tracer::ray_tree::LightContribution {
+            light: whitted_tracer::ray_tree::LightRef {
+                handle: 0,
+                name: Some("torch".into()),
+                label: "torch".into(),
+                kind: "spot".into(),
+                location: "s.scene:3:1".into(),
+                span: whitted_ir::Span::detached(),
+            },
+            to_light: [0.0, 1.0, 0.0],
+            distance: Some(5.0),
+            n_dot_l,
+            attenuation: 1.0,
+            spot: 0.0,
+            cone,
+            diffuse: [0.0; 3],
+            specular: [0.0; 3],
+            visibility,
+            shadow_child: None,
+        };
+        let cone = whitted_tracer::ray_tree::ConeInfo {
+            angle_degrees: 52.3,
+            inner_degrees: 20.0,
+            outer_degrees: 30.0,
+        };
+        let local = LocalIllumination {
+            ambient: [0.0; 3],
+            emission: [0.0; 3],
+            lights: vec![
+                light(Visibility::OutsideCone, 0.607, Some(cone)),
+                light(Visibility::FacingAway, -0.25, Some(cone)),
+                light(Visibility::BlackLight, 0.5, None),
+            ],
+            total: [0.0; 3],
+        };
+        let text = text_of(&local, whitted_ir::Highlight::Phong);
+        let lines: Vec<&str> = text.lines().filter(|l| l.contains("torch")).collect();
+        assert_eq!(lines.len(), 3, "{text}");
+        assert!(
+            lines[0].contains("outside the spot cone: 52.3° from its axis, cone 30.0°")
+                && !lines[0].contains("faces away"),
+            "{text}"
+        );
+        assert!(lines[1].contains("faces away: N·L <= 0"), "{text}");
+        assert!(lines[2].contains("black light"), "{text}");
+    }
+
     #[test]
     fn the_specular_line_names_the_scene_s_highlight_model() {
         let light = whitted_tracer::ray_tree::LightContribution {
@@ -531,6 +598,7 @@ mod tests {
             n_dot_l: 1.0,
             attenuation: 1.0,
             spot: 1.0,
+            cone: None,
             diffuse: [0.5; 3],
             specular: [0.25; 3],
             visibility: Visibility::NoShadows,

@@ -186,6 +186,7 @@ fn describe(node: &RayNode) -> String {
         Termination::MaxDepth => Some("max depth"),
         Termination::WeightCutoff => Some("weight cut-off"),
         Termination::TotalInternalReflection => Some("total internal reflection"),
+        Termination::RayBudget => Some("ray budget"),
         Termination::Absorbed | Termination::NotEnded | Termination::Miss => None,
     };
     if let Some(ended) = ended {

@@ -1,7 +1,8 @@
 //! Findings about where recursion stopped: the depth limit or the weight cut-off dropped a
-//! path that matters (`max_depth`, `weight_cutoff`), and light trapped by total internal
-//! reflection (`tir_trapped`). The first two ask the tracer, through [`crate::probe`],
-//! which setting would bring the light back and what the pixel would then be.
+//! path that matters (`max_depth`, `weight_cutoff`), light was trapped by total internal
+//! reflection (`tir_trapped`), or the sample reached its ray budget (`ray_budget`). The
+//! first two ask the tracer, through [`crate::probe`], which setting would bring the light
+//! back and what the pixel would then be.
 
 use whitted_tracer::ray_tree::RayNode;
 use whitted_tracer::{RayKind, RenderOptions, Termination};
@@ -17,6 +18,59 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
     max_depth(context, findings);
     weight_cutoff(context, findings);
     tir_trapped(context, findings);
+    ray_budget(context, findings);
+}
+
+/// A sample that cast its whole budget of rays: recursion stopped wherever it was, however
+/// much the rays left out weighed, so this is reported whatever their weight.
+fn ray_budget(context: &Context<'_>, findings: &mut Vec<Finding>) {
+    let scale = 1.0 / context.tree.samples_per_pixel.max(1) as f32;
+    let mut total = [0.0f32; 3];
+    let mut count = 0u32;
+    walk(context.tree, &mut |node, _| {
+        for skipped in node
+            .skipped
+            .iter()
+            .filter(|s| s.reason == Termination::RayBudget)
+        {
+            count += 1;
+            for (t, w) in total.iter_mut().zip(skipped.weight) {
+                *t += w * scale;
+            }
+        }
+    });
+    if count == 0 {
+        return;
+    }
+    let tree = context.tree;
+    let (location, written) = setting_or_scene(context.scene, "min_weight");
+    let message = format!(
+        "the ray budget ({} reflected, transmitted and shadow rays per sample) stopped \
+         recursion: {count} ray{} not traced, carrying a path weight of {:.2}% of the pixel; \
+         with min_weight {} and max_depth {} a sample can take up to 2^{} rays",
+        whitted_ir::limits::MAX_RAYS_PER_SAMPLE,
+        if count == 1 { " was" } else { "s were" },
+        largest(total) * 100.0,
+        tree.min_weight,
+        tree.max_depth,
+        // 2 + 4 + ... + 2^max_depth reflected and transmitted rays.
+        tree.max_depth + 1
+    );
+    let fix = format!(
+        "raise min_weight so that weak paths end (0.001 is usual): {}; or lower max_depth",
+        how_to_set("min_weight", "0.001", &location, written)
+    );
+    push_unique(
+        findings,
+        Finding {
+            kind: FindingKind::RayBudget,
+            message,
+            location,
+            fix,
+            weight: largest(total),
+            source_line: None,
+        },
+    );
 }
 
 fn is_tir(node: &RayNode) -> bool {

@@ -1,5 +1,6 @@
 //! Findings about lights at the surfaces that matter: a light behind the surface
-//! (`light_behind`, N·L <= 0), a shadow ray stopped by an object (`shadow_blocked`, and
+//! (`light_behind`, N·L <= 0), a spot light whose cone does not reach the point
+//! (`outside_spot_cone`), a shadow ray stopped by an object (`shadow_blocked`, and
 //! whether that object is transparent while shadows are opaque), and a light inside a
 //! solid (`light_inside_solid`).
 
@@ -23,6 +24,7 @@ pub(super) fn find(context: &Context<'_>, findings: &mut Vec<Finding>) {
             return;
         }
         light_behind(node, findings);
+        outside_cone(node, findings);
         blocked(context, node, findings);
     });
 }
@@ -55,7 +57,7 @@ fn light_behind(node: &RayNode, findings: &mut Vec<Finding>) {
         "this path"
     };
     for light in &local.lights {
-        if light.visibility != Visibility::NotFacing || light.n_dot_l > 0.0 {
+        if light.visibility != Visibility::FacingAway {
             continue;
         }
         let what = match hit.object.kind.as_str() {
@@ -86,6 +88,66 @@ fn light_behind(node: &RayNode, findings: &mut Vec<Finding>) {
             },
         );
     }
+}
+
+/// A spot light whose cone does not reach the point: the tracer said so
+/// (`outside_cone`), whatever N·L is; the angles come from the tree.
+fn outside_cone(node: &RayNode, findings: &mut Vec<Finding>) {
+    let (Some(hit), Some(local)) = (&node.hit, &node.local) else {
+        return;
+    };
+    let seen_by = if node.kind == RayKind::Camera {
+        "the camera"
+    } else {
+        "this path"
+    };
+    for light in &local.lights {
+        if light.visibility != Visibility::OutsideCone {
+            continue;
+        }
+        let label = &light.light.label;
+        let (angles, widen) = match &light.cone {
+            Some(cone) => (
+                format!(
+                    "{} from the spot's axis, beyond its cone of {}",
+                    degrees(cone.angle_degrees),
+                    degrees(cone.outer_degrees)
+                ),
+                format!(
+                    "widen {label}'s cone (`outer` to more than {}) or aim it at the point",
+                    degrees(cone.angle_degrees.ceil())
+                ),
+            ),
+            None => (
+                "beyond the spot's cone".to_string(),
+                format!("widen {label}'s cone (`outer`) or aim it at the point"),
+            ),
+        };
+        push_unique(
+            findings,
+            Finding {
+                kind: FindingKind::OutsideSpotCone,
+                message: format!(
+                    "the point of {} ({}) {seen_by} sees is outside the cone of spot light \
+                     {label} ({}): {angles}, so it adds nothing there (N·L = {:.3})",
+                    hit.object.label, hit.object.location, light.light.location, light.n_dot_l
+                ),
+                location: light.light.location.clone(),
+                fix: format!(
+                    "{widen} (its `direction`) if it should light {}",
+                    hit.object.label
+                ),
+                weight: weight_of(node),
+                source_line: None,
+            },
+        );
+    }
+}
+
+/// An angle as people read it: `52.3°`.
+fn degrees(value: f32) -> String {
+    let text = format!("{value:.1}");
+    format!("{}°", text.strip_suffix(".0").unwrap_or(&text))
 }
 
 /// A point or spot light's position.

@@ -10,9 +10,12 @@
 //! which objects the camera cannot see. The rules are in docs/explain.md ("Lints").
 
 mod bounds;
+mod budget;
 mod geometry;
 mod sampled;
 mod view;
+
+pub use budget::{ray_budget_cause, worst_case, worst_case_at, WorstCase};
 
 use whitted_ir::{Diagnostic, Scene};
 use whitted_tracer::PreparedScene;
@@ -26,16 +29,18 @@ pub enum LintKind {
     MaterialGain,
     UnseenObject,
     FacingAwayFromLights,
+    RayBudget,
 }
 
 impl LintKind {
-    pub const ALL: [LintKind; 6] = [
+    pub const ALL: [LintKind; 7] = [
         LintKind::LightInsideSolid,
         LintKind::CoincidentSurfaces,
         LintKind::MaxDepthTooLow,
         LintKind::MaterialGain,
         LintKind::UnseenObject,
         LintKind::FacingAwayFromLights,
+        LintKind::RayBudget,
     ];
 
     pub fn name(self) -> &'static str {
@@ -46,6 +51,7 @@ impl LintKind {
             LintKind::MaterialGain => "material_gain",
             LintKind::UnseenObject => "unseen_object",
             LintKind::FacingAwayFromLights => "facing_away_from_lights",
+            LintKind::RayBudget => "ray_budget",
         }
     }
 }
@@ -97,6 +103,7 @@ pub fn lint(prepared: &PreparedScene, scene: &Scene) -> Vec<Lint> {
     geometry::material_gain(scene, &mut lints);
     view::unseen_objects(scene, &samples, &mut lints);
     geometry::facing_away_from_lights(scene, &mut lints);
+    budget::ray_budget(scene, &mut lints);
     cap_per_kind(&mut lints);
     lints
 }

@@ -14,7 +14,7 @@ mod tests;
 
 pub use json::RayTreeDocument;
 pub use model::{
-    Blocker, CoincidentInfo, HitInfo, InterfaceInfo, LightContribution, LightRef,
+    Blocker, CoincidentInfo, ConeInfo, HitInfo, InterfaceInfo, LightContribution, LightRef,
     LocalIllumination, MaterialRef, ObjectRef, RayNode, RayTree, SampleChoice, SampleTree,
     ShadingModel, ShadowInfo, ShadowOutcome, SkippedInfo, StackArg, StackStep, Visibility,
     RAY_TREE_JSON_VERSION,

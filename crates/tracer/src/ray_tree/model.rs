@@ -8,10 +8,10 @@
 use serde::Serialize;
 use whitted_ir::Span;
 
-use crate::recorder::{RayKind, Termination};
+use crate::recorder::{NoShadowRay, RayKind, Termination};
 
 /// The version of the JSON document (`docs/ray-tree.md`); bumped on any incompatible change.
-pub const RAY_TREE_JSON_VERSION: u32 = 1;
+pub const RAY_TREE_JSON_VERSION: u32 = 2;
 
 /// Every recorded ray of one pixel.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -304,6 +304,8 @@ pub struct LightContribution {
     pub attenuation: f32,
     /// The spot cone factor (1 for other lights).
     pub spot: f32,
+    /// For spot lights, where the point lies in the cone (`None` for other lights).
+    pub cone: Option<ConeInfo>,
     /// `fatt·spot·Ii·shadow·kd·(N·L)`.
     pub diffuse: [f32; 3],
     /// `fatt·spot·Ii·shadow·ks·(R·V)^n`.
@@ -315,7 +317,19 @@ pub struct LightContribution {
     pub shadow_child: Option<usize>,
 }
 
-/// Whether a light reaches a hit point.
+/// Where a point lies in a spot light's cone.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ConeInfo {
+    /// The angle between the spot's axis and the direction from the light to the point.
+    pub angle_degrees: f32,
+    /// The spot's inner angle (full strength within it) and outer angle (nothing beyond it),
+    /// from the axis, as the scene gives them.
+    pub inner_degrees: f32,
+    pub outer_degrees: f32,
+}
+
+/// Whether a light reaches a hit point, and when no shadow ray was cast, why not (the
+/// tracer's own reason, `NoShadowRay`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Visibility {
@@ -325,9 +339,16 @@ pub enum Visibility {
     Filtered,
     /// The shadow ray was stopped by an opaque object.
     Blocked,
-    /// No shadow ray was cast: the light is behind the surface (`N·L <= 0`), outside its
-    /// cone, too far to count, or black.
-    NotFacing,
+    /// No shadow ray was cast: the light is behind the surface (`N·L <= 0`).
+    FacingAway,
+    /// No shadow ray was cast: a spot light whose cone does not reach the point (`cone`
+    /// says by how much).
+    OutsideCone,
+    /// No shadow ray was cast: the light's colour is black.
+    BlackLight,
+    /// No shadow ray was cast: `fatt·spot` rounds to 0 in f32 though neither is 0 (only at
+    /// the very edge of a wide cone, far from the light).
+    TooFaint,
     /// No shadow ray was cast: the light faces the surface, but the material has no diffuse
     /// and no specular colour, so it could add nothing.
     Unshaded,
@@ -337,6 +358,51 @@ pub enum Visibility {
     /// The light adds nothing and no shadow ray was cast: the surface is seen from its back
     /// and the scene has `shade_back off`.
     BackFace,
+}
+
+impl Visibility {
+    /// Every visibility, in declaration order.
+    pub const ALL: [Visibility; 10] = [
+        Visibility::Lit,
+        Visibility::Filtered,
+        Visibility::Blocked,
+        Visibility::FacingAway,
+        Visibility::OutsideCone,
+        Visibility::BlackLight,
+        Visibility::TooFaint,
+        Visibility::Unshaded,
+        Visibility::NoShadows,
+        Visibility::BackFace,
+    ];
+
+    /// The word the JSON form uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            Visibility::Lit => "lit",
+            Visibility::Filtered => "filtered",
+            Visibility::Blocked => "blocked",
+            Visibility::FacingAway => "facing_away",
+            Visibility::OutsideCone => "outside_cone",
+            Visibility::BlackLight => "black_light",
+            Visibility::TooFaint => "too_faint",
+            Visibility::Unshaded => "unshaded",
+            Visibility::NoShadows => "no_shadows",
+            Visibility::BackFace => "back_face",
+        }
+    }
+
+    /// The visibility of a light that cast no shadow ray, for the tracer's reason.
+    pub fn without_shadow_ray(reason: NoShadowRay) -> Visibility {
+        match reason {
+            NoShadowRay::BackFace => Visibility::BackFace,
+            NoShadowRay::FacingAway => Visibility::FacingAway,
+            NoShadowRay::OutsideCone => Visibility::OutsideCone,
+            NoShadowRay::BlackLight => Visibility::BlackLight,
+            NoShadowRay::TooFaint => Visibility::TooFaint,
+            NoShadowRay::Unshaded => Visibility::Unshaded,
+            NoShadowRay::ShadowsOff => Visibility::NoShadows,
+        }
+    }
 }
 
 /// What a shadow ray was cast for and what it found.

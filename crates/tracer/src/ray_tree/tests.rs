@@ -52,7 +52,12 @@ fn check_node(node: &RayNode) {
         for light in &local.lights {
             match light.shadow_child {
                 Some(i) => assert_eq!(node.children[i].kind, RayKind::Shadow),
-                None => assert!(cut || light.visibility == Visibility::NotFacing),
+                None => assert!(
+                    cut || !matches!(
+                        light.visibility,
+                        Visibility::Lit | Visibility::Blocked | Visibility::Filtered
+                    )
+                ),
             }
         }
     }

@@ -180,6 +180,11 @@ impl Printer {
                 Termination::TotalInternalReflection => {
                     format!(" (weight {} dropped)", self.color(skipped.weight))
                 }
+                Termination::RayBudget => format!(
+                    " (the sample had cast its {} rays; weight {})",
+                    whitted_ir::limits::MAX_RAYS_PER_SAMPLE,
+                    self.color(skipped.weight)
+                ),
                 _ => format!(" (weight {})", self.color(skipped.weight)),
             };
             lines.push(format!(
@@ -249,7 +254,21 @@ impl Printer {
 
     fn light_line(&self, light: &LightContribution) -> String {
         let shadow = match (light.visibility, light.shadow_child) {
-            (Visibility::NotFacing, _) => "no shadow ray".to_string(),
+            (Visibility::FacingAway, _) => {
+                "no shadow ray (faces away: N.L <= 0): unlit".to_string()
+            }
+            (Visibility::OutsideCone, _) => match &light.cone {
+                Some(cone) => format!(
+                    "no shadow ray (outside the spot cone: {}° from its axis, cone {}°): unlit",
+                    num(cone.angle_degrees),
+                    num(cone.outer_degrees)
+                ),
+                None => "no shadow ray (outside the spot cone): unlit".to_string(),
+            },
+            (Visibility::BlackLight, _) => "no shadow ray (the light is black): unlit".to_string(),
+            (Visibility::TooFaint, _) => {
+                "no shadow ray (fatt times spot rounds to 0): unlit".to_string()
+            }
             (Visibility::Unshaded, _) => {
                 "no shadow ray (no diffuse or specular colour to light)".to_string()
             }
@@ -403,7 +422,10 @@ fn visibility_text(visibility: Visibility) -> &'static str {
         Visibility::Lit => "lit",
         Visibility::Filtered => "filtered",
         Visibility::Blocked => "blocked",
-        Visibility::NotFacing => "not facing",
+        Visibility::FacingAway => "faces away",
+        Visibility::OutsideCone => "outside the spot cone",
+        Visibility::BlackLight => "black light",
+        Visibility::TooFaint => "too faint",
         Visibility::Unshaded => "unshaded",
         Visibility::NoShadows => "no shadows",
         Visibility::BackFace => "back face",
@@ -418,6 +440,7 @@ fn termination_text(termination: Termination) -> &'static str {
         Termination::WeightCutoff => "weight cut-off",
         Termination::TotalInternalReflection => "total internal reflection",
         Termination::Absorbed => "absorbed",
+        Termination::RayBudget => "ray budget",
     }
 }
 

@@ -12,16 +12,16 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::Vec3A;
-use whitted_ir::Scene;
+use whitted_ir::{LightKind, Scene};
 
 use super::model::{
-    Blocker, CoincidentInfo, HitInfo, InterfaceInfo, LightContribution, LocalIllumination, RayNode,
-    ShadowInfo, ShadowOutcome, SkippedInfo, Visibility,
+    Blocker, CoincidentInfo, ConeInfo, HitInfo, InterfaceInfo, LightContribution,
+    LocalIllumination, RayNode, ShadowInfo, ShadowOutcome, SkippedInfo, Visibility,
 };
 use super::scene_refs::{csg_path, light_ref, material_ref, object_ref};
 use crate::recorder::{
-    CoincidentSurface, Interface, LightSample, RayKind, RayStart, Recorder, ShadowResult,
-    SkippedRay, SurfaceHit, Termination,
+    CoincidentSurface, Interface, LightSample, NoShadowRay, RayKind, RayStart, Recorder,
+    ShadowResult, SkippedRay, SurfaceHit, Termination,
 };
 
 /// Records every ray of one camera ray's tree. Names and source locations come from
@@ -216,10 +216,10 @@ impl Recorder for TreeRecorder<'_> {
         let light = light_ref(scene, sample.light);
         let mut shadow_child = None;
         let visibility = match &sample.shadow_ray {
-            None if sample.back_face => Visibility::BackFace,
-            None if sample.shadows_off => Visibility::NoShadows,
-            None if sample.unshaded => Visibility::Unshaded,
-            None => Visibility::NotFacing,
+            // The tracer always gives a reason when it casts no shadow ray.
+            None => Visibility::without_shadow_ray(
+                sample.no_shadow_ray.unwrap_or(NoShadowRay::FacingAway),
+            ),
             Some(shadow_ray) => {
                 let (result, blocker, transmittance, filters, passed, termination) =
                     match shadow_ray.result {
@@ -308,6 +308,7 @@ impl Recorder for TreeRecorder<'_> {
             n_dot_l: sample.n_dot_l,
             attenuation: sample.attenuation,
             spot: sample.spot,
+            cone: cone_info(scene, sample),
             diffuse: sample.diffuse.to_array(),
             specular: sample.specular.to_array(),
             visibility,
@@ -358,6 +359,23 @@ fn interface_info(interface: &Interface) -> InterfaceInfo {
         fresnel_reflectance: interface.fresnel_reflectance,
         fresnel_transmittance: interface.fresnel_reflectance.map(|r| 1.0 - r),
         total_internal_reflection: interface.total_internal_reflection,
+    }
+}
+
+/// Where the point lies in a spot light's cone: the angle from the tracer's own cosine, the
+/// cone's angles from the scene.
+fn cone_info(scene: &Scene, sample: &LightSample) -> Option<ConeInfo> {
+    match &scene.lights.get(sample.light)?.kind {
+        LightKind::Spot {
+            inner_angle_degrees,
+            outer_angle_degrees,
+            ..
+        } => Some(ConeInfo {
+            angle_degrees: sample.cos_axis.clamp(-1.0, 1.0).acos().to_degrees(),
+            inner_degrees: *inner_angle_degrees as f32,
+            outer_degrees: *outer_angle_degrees as f32,
+        }),
+        _ => None,
     }
 }
 

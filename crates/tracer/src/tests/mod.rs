@@ -10,6 +10,7 @@ mod energy;
 mod error_bounds;
 mod media_scenes;
 mod optics_scenes;
+mod ray_budget;
 mod shadow_rays;
 mod switches;
 

@@ -93,7 +93,11 @@ fn the_tree_says_why_an_unshaded_surface_has_no_shadow_ray() {
     assert!(!node.lights.is_empty());
     for light in &node.lights {
         if light.n_dot_l > 0.0 {
-            assert!(light.unshaded && light.shadow_ray.is_none(), "{light:?}");
+            assert!(
+                light.no_shadow_ray == Some(crate::NoShadowRay::Unshaded)
+                    && light.shadow_ray.is_none(),
+                "{light:?}"
+            );
         }
         assert_eq!(light.diffuse + light.specular, Vec3A::ZERO);
     }

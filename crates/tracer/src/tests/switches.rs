@@ -62,7 +62,11 @@ fn shadows_none_casts_no_shadow_rays_and_renders_as_if_nothing_blocked_the_light
                     assert!(light.shadow_ray.is_none(), "a shadow ray at ({x}, {y})");
                     // Every light that faces the surface is marked as counted unblocked.
                     if light.n_dot_l > 0.0 {
-                        assert!(light.shadows_off, "({x}, {y}): {light:?}");
+                        assert_eq!(
+                            light.no_shadow_ray,
+                            Some(crate::NoShadowRay::ShadowsOff),
+                            "({x}, {y}): {light:?}"
+                        );
                     }
                 }
             }
@@ -135,7 +139,10 @@ fn shade_back_lights_a_back_face_with_the_turned_normal_or_not_at_all() {
     let unlit = floor_from_below(false);
     assert!(unlit.color.abs_diff_eq(ambient, 1e-7), "{}", unlit.color);
     let light = unlit.lights[0];
-    assert!(light.back_face && light.shadow_ray.is_none(), "{light:?}");
+    assert!(
+        light.no_shadow_ray == Some(crate::NoShadowRay::BackFace) && light.shadow_ray.is_none(),
+        "{light:?}"
+    );
     assert_eq!(light.diffuse, Vec3A::ZERO);
 }
 
