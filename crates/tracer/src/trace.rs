@@ -568,8 +568,19 @@ impl<'a> Tracer<'a> {
     ) -> Meeting<'a> {
         const MOST: usize = MediumStack::CAPACITY;
         let scene = self.scene;
-        // Surfaces closer together than the hit point's error bound cannot be told apart.
-        let window = scene.offset_at(&first.surface);
+        // Surfaces closer together than the surface offset (along the normal) are crossed
+        // together. Along the ray that is the offset over the cosine, and never less than
+        // the rounding of `t` itself: two shapes in the same plane (water touching glass)
+        // get distances that far apart from their own tests, more than one hit's offset.
+        let cos = first
+            .surface
+            .geometric_normal
+            .dot(ray.direction)
+            .abs()
+            .max(0.01);
+        let rounding_of_t =
+            (first.hit.t + ray.origin.abs().max_element()) * f32::EPSILON * COINCIDENT_T_ULPS;
+        let window = (scene.offset_at(&first.surface) / cos).max(rounding_of_t);
         let resume = first.hit.t + window;
         let empty = NearCrossing {
             hit: first.hit,
