@@ -14,6 +14,14 @@
 //! are made again here. Where a decision sits on a knife edge (f32 and f64 may honestly
 //! disagree), the re-shader follows the recording; everywhere else a different decision is a
 //! failure. The child colours are the re-shader's own, bottom-up: no recorded colour is used.
+//!
+//! The medium each ray travels in, and so the ior pair and the absorption, is the
+//! re-shader's own too (see [`Media`]): a nested stack in scenes without priorities, and in
+//! scenes with `priority` the solids that hold a point beside each surface, found from the
+//! IR's shapes, so that water touching glass is one interface. What it still takes from the
+//! recording is a filtered shadow ray's transmittance. Where it simplifies: a solid the
+//! ray is inside has the material of its IR node (a CSG's), unless the hit at hand is on
+//! it (then the material recorded there, patterns resolved).
 
 use whitted_ir::{
     CsgOp, DMat4, DVec3, Fresnel, Handle, Highlight, LightKind, Material, Object, ObjectKind,
@@ -1005,9 +1013,11 @@ fn every_scene_re_shaded_in_f64_from_its_ray_trees_matches_the_render() {
         // Every scene is re-shaded: those with priorities through the geometric media model
         // (`Media`), the others through the nested stack.
         with_priorities += usize::from(uses_priorities(&load(&name).scene));
-        let (mut found, largest, failing) = check_scene(&name, 40, 30);
+        let (width, height) = (40, 30);
+        let (mut found, largest, failing) = check_scene(&name, width, height);
         report.push(format!(
-            "{name}: largest error {largest:.2e}, {failing} of 1200 pixels fail"
+            "{name}: largest error {largest:.2e}, {failing} of {} pixels fail",
+            width * height
         ));
         failures.append(&mut found);
     }
