@@ -72,6 +72,8 @@ pub struct Passed {
     pub meshes: usize,
     /// Lints `whitted check` would print.
     pub lints: usize,
+    /// Findings `whitted explain` gave for the traced pixel.
+    pub findings: usize,
     /// Why it stopped before the tracer: its first error, numbers and names blanked.
     pub stopped_by: Option<String>,
 }
@@ -218,27 +220,28 @@ pub fn run(case: &Case, cancel: &Cancel<'_>) -> Result<Passed, Failure> {
     if let Err(e) = serde_json::to_string(&tree.document()) {
         return Err(Failure::new("ray tree JSON", e.to_string()));
     }
-    explain_pixel(&prepared, &scene, &render_options, (x, y), rendered)?;
+    let findings = explain_pixel(&prepared, &scene, &render_options, (x, y), rendered)?;
     Ok(Passed {
         compiled: true,
         rendered: true,
         objects: prepared.object_count(),
         meshes: scene.meshes.len(),
         lints: lints.len(),
+        findings,
         stopped_by: None,
     })
 }
 
 /// `whitted explain` of the traced pixel: its colour is the rendered pixel, its paths sum
 /// to it (as `tests/integration/explain.rs` asserts on every shipped scene), and its text
-/// and JSON can be written.
+/// and JSON can be written. Returns how many findings it has.
 fn explain_pixel(
     prepared: &PreparedScene,
     scene: &whitted_ir::Scene,
     options: &RenderOptions,
     (x, y): (u32, u32),
     rendered: [f32; 3],
-) -> Result<(), Failure> {
+) -> Result<usize, Failure> {
     let explanation = whitted_explain::explain(prepared, scene, options, x, y)
         .map_err(|e| Failure::new("explain refused a pixel in range", e.to_string()))?;
     if explanation.color.map(f32::to_bits) != rendered.map(f32::to_bits) {
@@ -267,7 +270,7 @@ fn explain_pixel(
     if let Err(e) = serde_json::to_string(&explanation.document()) {
         return Err(Failure::new("explain JSON", e.to_string()));
     }
-    Ok(())
+    Ok(explanation.findings.len())
 }
 
 /// A diagnostic's message as a class of reasons: numbers and quoted names blanked.

@@ -610,6 +610,36 @@ impl Generator<'_> {
         format!("{op} {{ {} {extras} }}", parts.join(" "))
     }
 
+    /// Two surfaces in one place at the origin, where the camera looks (the pixel that is
+    /// explained): a rug on a floor, a poster on a wall, boxes sharing a face, a ball twice,
+    /// a flat mesh on a plane. Inputs for the coincident-surface lint and explain's
+    /// z-fighting finding.
+    fn coincident_pair(&mut self) -> String {
+        let material = if self.rng.chance(0.5) {
+            format!(" material {{ {} }}", self.material_body())
+        } else {
+            String::new()
+        };
+        match self.rng.below(5) {
+            0 => format!(
+                "plane {{ normal <0, 1, 0> offset 0 }} disk \"rug\" {{ center <0, 0, 0> normal <0, 1, 0> radius 1{material} }}"
+            ),
+            1 => format!(
+                "box {{ min <-1, -1, -1> max <1, 1, 0> }} triangle \"poster\" {{ vertices <-0.5, -0.5, 0>, <0.5, -0.5, 0>, <0, 0.5, 0>{material} }}"
+            ),
+            2 => format!(
+                "box {{ min <-1, -1, -1> max <0, 1, 1> }} box {{ min <0, -1, -1> max <1, 1, 1>{material} }}"
+            ),
+            3 => format!("sphere {{ radius 1 }} sphere {{ radius 1{material} }}"),
+            _ => {
+                let name = self.write_mesh(&MeshData::open_square(), DVec3::ZERO);
+                format!(
+                    "plane {{ normal <0, 1, 0> offset 0 }} mesh {{ file \"{name}\"{material} }}"
+                )
+            }
+        }
+    }
+
     /// A `mesh` statement and the file it reads: a closed solid (box, tetrahedron,
     /// octahedron, sphere) or open triangles (a flat square, a soup), as `.obj` or `.ply`
     /// (ASCII or binary); in wild scenes sometimes a broken or missing file.
@@ -754,6 +784,11 @@ impl Generator<'_> {
     fn statement(&mut self) {
         if self.rng.chance(if self.valid { 0.3 } else { 0.05 }) {
             let text = self.mesh();
+            self.line(&text);
+            return;
+        }
+        if self.valid && self.rng.chance(0.08) {
+            let text = self.coincident_pair();
             self.line(&text);
             return;
         }
@@ -1115,6 +1150,7 @@ mod tests {
             "mesh { file \"m0.obj\"",
             "mesh { file \"m0.ply\"",
             "mesh \"slab\"",
+            "disk \"rug\"",
             "priority",
             "fresnel exact",
             "highlight blinn",

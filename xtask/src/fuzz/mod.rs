@@ -236,6 +236,8 @@ pub struct Summary {
     pub with_meshes: u64,
     /// Lints found over the rendered cases.
     pub lints: u64,
+    /// Findings of explain over the rendered cases.
+    pub findings: u64,
     /// Cases and cases that reached the tracer, by how they were made.
     pub by_origin: BTreeMap<&'static str, (u64, u64)>,
     /// Why cases stopped at compilation: their first error's class and how many.
@@ -261,7 +263,7 @@ impl Summary {
         let share = |n: u64| 100.0 * n as f64 / self.cases.max(1) as f64;
         let mut out = format!(
             "fuzz: seed {seed}, {} cases in {:.1} s: {} compiled ({:.0}%), {} reached the \
-             tracer ({:.0}%; {} with meshes, {} lints), {} failed\n",
+             tracer ({:.0}%; {} with meshes, {} lints, {} explain findings), {} failed\n",
             self.cases,
             self.seconds,
             self.compiled,
@@ -270,6 +272,7 @@ impl Summary {
             share(self.rendered),
             self.with_meshes,
             self.lints,
+            self.findings,
             self.failed()
         );
         let origins: Vec<String> = self
@@ -336,6 +339,7 @@ pub fn run_cases(
                 summary.rendered += u64::from(passed.rendered);
                 summary.with_meshes += u64::from(passed.rendered && passed.meshes > 0);
                 summary.lints += passed.lints as u64;
+                summary.findings += passed.findings as u64;
                 if let Some(reason) = passed.stopped_by {
                     let reason = format!("({}) {reason}", case.origin);
                     *summary.stopped_by.entry(reason).or_default() += 1;
