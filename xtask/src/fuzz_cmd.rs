@@ -53,20 +53,20 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     let corpus = fuzz::corpus(&root);
     let step = (cases / 20).max(1);
     if let Some(index) = only_case {
-        let text = fuzz::case_text(seed, index, &corpus);
+        let case = fuzz::make_case(seed, index, &corpus);
         let mut summary = fuzz::Summary {
             cases: 1,
             ..fuzz::Summary::default()
         };
-        match fuzz::run_case(&text) {
+        match fuzz::run_case(&case) {
             fuzz::Verdict::Passed(_) => eprintln!("case {index} of seed {seed} passes"),
             fuzz::Verdict::Failed(f) => {
                 eprintln!("case {index} of seed {seed}: {}: {}", f.class, f.detail);
-                summary.failures.insert(f.class, (1, index, f.detail, text));
+                summary.failures.insert(f.class, (1, index, f.detail, case));
             }
             fuzz::Verdict::Hung => {
                 eprintln!("case {index} of seed {seed} hangs");
-                summary.hung.push((index, text));
+                summary.hung.push((index, case));
             }
         }
         if save {
@@ -81,14 +81,14 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     });
     eprintln!();
     eprint!("{}", summary.report(seed));
-    for (class, (_, index, detail, text)) in &summary.failures {
+    for (class, (_, index, detail, case)) in &summary.failures {
         eprintln!(
             "\n--- first case of `{class}` (case {index}: {detail}):\n{}",
-            excerpt(text)
+            excerpt(case)
         );
     }
-    for (index, text) in &summary.hung {
-        eprintln!("\n--- case {index} hung:\n{}", excerpt(text));
+    for (index, case) in &summary.hung {
+        eprintln!("\n--- case {index} hung:\n{}", excerpt(case));
     }
     if save {
         save_new(&root, seed, &summary)?;
@@ -99,17 +99,23 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The first 40 lines of a case (mutations can repeat a line a thousand times).
-fn excerpt(text: &str) -> String {
-    let lines: Vec<&str> = text.lines().collect();
-    if lines.len() <= 40 {
-        return text.to_string();
+/// The first 40 lines of a case's scene (mutations can repeat a line a thousand times),
+/// and the names of its files.
+fn excerpt(case: &fuzz::Case) -> String {
+    let lines: Vec<&str> = case.text.lines().collect();
+    let mut out = if lines.len() <= 40 {
+        case.text.clone()
+    } else {
+        format!(
+            "{}\n... ({} more lines)",
+            lines[..40].join("\n"),
+            lines.len() - 40
+        )
+    };
+    for (name, bytes) in &case.files {
+        out.push_str(&format!("\n(with {name}, {} bytes)", bytes.len()));
     }
-    format!(
-        "{}\n... ({} more lines)",
-        lines[..40].join("\n"),
-        lines.len() - 40
-    )
+    out
 }
 
 fn number(value: Option<&String>, flag: &str) -> anyhow::Result<u64> {
@@ -123,29 +129,29 @@ fn number(value: Option<&String>, flag: &str) -> anyhow::Result<u64> {
 fn save_new(root: &std::path::Path, seed: u64, summary: &fuzz::Summary) -> anyhow::Result<()> {
     let known: BTreeSet<String> = fuzz::regressions(root)
         .iter()
-        .filter_map(|(_, text)| match fuzz::run_case(text) {
+        .filter_map(|(_, case)| match fuzz::run_case(case) {
             fuzz::Verdict::Failed(f) => Some(f.class),
             fuzz::Verdict::Hung => Some("hang".into()),
             fuzz::Verdict::Passed(_) => None,
         })
         .collect();
     let mut new = Vec::new();
-    for (class, (_, index, _, text)) in &summary.failures {
+    for (class, (_, index, _, case)) in &summary.failures {
         if !known.contains(class) {
-            new.push((class.clone(), *index, text.clone()));
+            new.push((class.clone(), *index, case.clone()));
         }
     }
-    if let Some((index, text)) = summary.hung.first() {
+    if let Some((index, case)) = summary.hung.first() {
         if !known.contains("hang") {
-            new.push(("hang".to_string(), *index, text.clone()));
+            new.push(("hang".to_string(), *index, case.clone()));
         }
     }
-    for (class, index, text) in new {
+    for (class, index, case) in new {
         // A hang is not shrunk: every try would cost the whole timeout.
         let small = if class == "hang" {
-            text
+            case
         } else {
-            fuzz::shrink(&text, &class)
+            fuzz::shrink(&case, &class)
         };
         let path =
             fuzz::save_regression(root, &small, &class, &format!("seed {seed}, case {index}"))?;

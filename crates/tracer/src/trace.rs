@@ -646,7 +646,9 @@ impl<'a> Tracer<'a> {
     ) -> Meeting<'a> {
         const MOST: usize = MediumStack::CAPACITY;
         let scene = self.scene;
-        // Surfaces closer together than the hit point's error bound cannot be told apart.
+        // Surfaces closer together than the hit point's error bound cannot be told apart: two
+        // shapes in one plane (water touching glass) get distances that far apart from their
+        // own tests, along the ray the bound over the cosine or the rounding of `t` itself.
         let window = coincident_window(ray, first.hit.t, &first.surface)
             .max(scene.offset_at(&first.surface));
         let resume = first.hit.t + window;

@@ -1,7 +1,9 @@
 //! One fuzz case through the whole pipeline, in-process: compile (whitted-lang, with small
-//! limits), validate, prepare, render at 8x6 and trace one pixel, checking what must hold
-//! for any input: diagnostics are located, a scene exists exactly when there is no error, no
-//! pixel or tree colour is NaN or infinite, and the traced tree is the rendered pixel.
+//! limits, its mesh files served from the case), validate, prepare, lint (`whitted check`),
+//! render at 8x6, trace one pixel and explain it, checking what must hold for any input:
+//! diagnostics and lints are located, a scene exists exactly when there is no error, no
+//! pixel or tree colour is NaN or infinite, the traced tree and the explanation are the
+//! rendered pixel, and the explanation's paths sum to it.
 
 use std::path::Path;
 
@@ -9,6 +11,8 @@ use whitted_ir::Severity;
 use whitted_lang::{compile_source, CompileOptions, Limits, SourceLoader};
 use whitted_tracer::ray_tree::{format_text, trace_pixel, RayNode, SampleChoice, TextOptions};
 use whitted_tracer::{render, PreparedScene, RenderObserver, RenderOptions, TileResult};
+
+use super::Case;
 
 /// The image every case renders: tiny, so that a case costs the scene, not the pixels.
 pub const WIDTH: u32 = 8;
@@ -37,12 +41,16 @@ pub fn limits() -> Limits {
     }
 }
 
-/// Imports resolve to a few fixed files (one of them imports itself).
-struct Files;
+/// Imports resolve to the case's own files (its meshes) and a few fixed files (one of them
+/// imports itself).
+struct Files<'a>(&'a [(String, Vec<u8>)]);
 
-impl SourceLoader for Files {
+impl SourceLoader for Files<'_> {
     fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
         let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if let Some((_, bytes)) = self.0.iter().find(|(file, _)| file == name) {
+            return Ok(bytes.clone());
+        }
         match name {
             "materials.scene" => Ok(b"material chrome { reflective 0.8 specular 1 }\n".to_vec()),
             "loop.scene" => Ok(b"import \"loop.scene\"\nsphere { }\n".to_vec()),
@@ -55,11 +63,19 @@ impl SourceLoader for Files {
 }
 
 /// What a passing case did, for the summary.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct Passed {
     pub compiled: bool,
     pub rendered: bool,
     pub objects: usize,
+    /// Meshes the scene holds (read from the case's `.obj` and `.ply` files).
+    pub meshes: usize,
+    /// Lints `whitted check` would print.
+    pub lints: usize,
+    /// Findings `whitted explain` gave for the traced pixel.
+    pub findings: usize,
+    /// Why it stopped before the tracer: its first error, numbers and names blanked.
+    pub stopped_by: Option<String>,
 }
 
 /// A failed check, with what to show.
@@ -90,12 +106,12 @@ impl RenderObserver for Cancel<'_> {
 }
 
 /// Runs one case. Panics are not caught here: the runner catches them.
-pub fn run(text: &str, cancel: &Cancel<'_>) -> Result<Passed, Failure> {
+pub fn run(case: &Case, cancel: &Cancel<'_>) -> Result<Passed, Failure> {
     let options = CompileOptions {
         limits: limits(),
         ..CompileOptions::default()
     };
-    let compilation = compile_source("fuzz.scene", text, &mut Files, &options);
+    let compilation = compile_source("fuzz.scene", &case.text, &mut Files(&case.files), &options);
     let errors = compilation
         .diagnostics
         .iter()
@@ -128,10 +144,37 @@ pub fn run(text: &str, cancel: &Cancel<'_>) -> Result<Passed, Failure> {
     }
     let _ = whitted_lang::render_diagnostics(&compilation.sources, &compilation.diagnostics, false);
     let Some(scene) = compilation.scene else {
-        return Ok(Passed::default());
+        let first = compilation.diagnostics.iter().find(|d| d.is_error());
+        return Ok(Passed {
+            stopped_by: first.map(|d| reason(&d.message)),
+            ..Passed::default()
+        });
     };
 
     let prepared = PreparedScene::new(&scene);
+    // `whitted check`: every lint located inside the source.
+    let lints = if whitted_explain::lint::lints_by_default(&scene) {
+        whitted_explain::lint::lint(&prepared, &scene)
+    } else {
+        Vec::new()
+    };
+    for lint in &lints {
+        let Some(span) = lint.diagnostic.span else {
+            continue;
+        };
+        let len = compilation.sources.get(span.file).map(|f| f.text.len());
+        if len.is_none_or(|len| span.start > span.end || span.end as usize > len) {
+            return Err(Failure::new(
+                "a lint outside its file",
+                format!(
+                    "{span:?} in a file of {len:?} bytes: {}",
+                    lint.diagnostic.message
+                ),
+            ));
+        }
+    }
+    let lint_diagnostics: Vec<_> = lints.iter().map(|l| l.diagnostic.clone()).collect();
+    let _ = whitted_lang::render_diagnostics(&compilation.sources, &lint_diagnostics, false);
     let settings = &scene.settings;
     let render_options = RenderOptions {
         width: WIDTH,
@@ -177,11 +220,81 @@ pub fn run(text: &str, cancel: &Cancel<'_>) -> Result<Passed, Failure> {
     if let Err(e) = serde_json::to_string(&tree.document()) {
         return Err(Failure::new("ray tree JSON", e.to_string()));
     }
+    let findings = explain_pixel(&prepared, &scene, &render_options, (x, y), rendered)?;
     Ok(Passed {
         compiled: true,
         rendered: true,
         objects: prepared.object_count(),
+        meshes: scene.meshes.len(),
+        lints: lints.len(),
+        findings,
+        stopped_by: None,
     })
+}
+
+/// `whitted explain` of the traced pixel: its colour is the rendered pixel, its paths sum
+/// to it (as `tests/integration/explain.rs` asserts on every shipped scene), and its text
+/// and JSON can be written. Returns how many findings it has.
+fn explain_pixel(
+    prepared: &PreparedScene,
+    scene: &whitted_ir::Scene,
+    options: &RenderOptions,
+    (x, y): (u32, u32),
+    rendered: [f32; 3],
+) -> Result<usize, Failure> {
+    let explanation = whitted_explain::explain(prepared, scene, options, x, y)
+        .map_err(|e| Failure::new("explain refused a pixel in range", e.to_string()))?;
+    if explanation.color.map(f32::to_bits) != rendered.map(f32::to_bits) {
+        return Err(Failure::new(
+            "explained colour is not the rendered pixel",
+            format!("explain {:?}, pixel {rendered:?}", explanation.color),
+        ));
+    }
+    for (channel, &pixel) in rendered.iter().enumerate() {
+        let parts = explanation
+            .contributions
+            .iter()
+            .map(|c| f64::from(c.color[channel]));
+        let sum: f64 = parts.clone().sum();
+        let size: f64 = parts.map(f64::abs).sum::<f64>().max(1.0);
+        let pixel = f64::from(pixel);
+        let close = (sum - pixel).abs() <= 1e-4 * size;
+        if !close {
+            return Err(Failure::new(
+                "explained paths do not sum to the pixel",
+                format!("channel {channel}: paths sum to {sum}, pixel {pixel}"),
+            ));
+        }
+    }
+    let _ = whitted_explain::format_text(&explanation);
+    if let Err(e) = serde_json::to_string(&explanation.document()) {
+        return Err(Failure::new("explain JSON", e.to_string()));
+    }
+    Ok(explanation.findings.len())
+}
+
+/// A diagnostic's message as a class of reasons: numbers and quoted names blanked.
+fn reason(message: &str) -> String {
+    let mut out = String::new();
+    let mut quoted = false;
+    for ch in message.chars() {
+        match ch {
+            '`' => {
+                quoted = !quoted;
+                if quoted {
+                    out.push_str("`_`");
+                }
+            }
+            _ if quoted => {}
+            '0'..='9' => {
+                if !out.ends_with('#') {
+                    out.push('#');
+                }
+            }
+            _ => out.push(ch),
+        }
+    }
+    out.chars().take(90).collect()
 }
 
 fn first_non_finite(node: &RayNode) -> Option<String> {

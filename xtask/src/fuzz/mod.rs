@@ -1,9 +1,11 @@
-//! The whole-pipeline fuzzer (issue 10, deliver 5): generated and mutated scenes run
-//! in-process through compile, validate, prepare, render and trace (`case.rs`), each on a
-//! worker thread under a time, step and memory budget. Any panic, hang, memory blow-up, NaN
-//! pixel or unlocated error fails and prints the case. `cargo xtask fuzz --cases N [--seed S]
-//! [--save]`; `--save` shrinks each new kind of failure and keeps it in
-//! `tests/fuzz-regressions/`, which `xtask/tests/fuzz.rs` replays.
+//! The whole-pipeline fuzzer (issue 10, deliver 5; issue 26, deliver 6): generated and
+//! mutated scenes, with the mesh files they read, run in-process through compile, validate,
+//! prepare, lint, render, trace and explain (`case.rs`), each on a worker thread under a
+//! time, step and memory budget. Any panic, hang, memory blow-up, NaN pixel or unlocated
+//! error fails and prints the case. `cargo xtask fuzz --cases N [--seed S] [--save]`;
+//! `--save` shrinks each new kind of failure and keeps it in `tests/fuzz-regressions/`
+//! (`NNN.scene`, or `NNN/case.scene` with its mesh files beside it), which
+//! `xtask/tests/fuzz.rs` replays.
 
 pub mod case;
 pub mod generate;
@@ -64,10 +66,42 @@ fn short_path(file: &str) -> &str {
     }
 }
 
-/// Where the case being run is written first, so that a case that aborts the process (a
-/// stack overflow, the allocator's hard cap) can be found afterwards.
+/// One fuzz input: a scene and the files it reads (meshes), by file name.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Case {
+    pub text: String,
+    pub files: Vec<(String, Vec<u8>)>,
+    /// How it was made: `valid`, `wild`, `mutated` or `regression`.
+    pub origin: &'static str,
+}
+
+impl Case {
+    /// A scene that reads no files of its own.
+    pub fn scene(text: impl Into<String>, origin: &'static str) -> Case {
+        Case {
+            text: text.into(),
+            files: Vec::new(),
+            origin,
+        }
+    }
+
+    /// Writes the case as files: the scene as `scene`, its files beside it.
+    pub fn write(&self, scene: &Path) -> std::io::Result<()> {
+        let dir = scene.parent().unwrap_or(Path::new("."));
+        std::fs::create_dir_all(dir)?;
+        std::fs::write(scene, &self.text)?;
+        for (name, bytes) in &self.files {
+            std::fs::write(dir.join(name), bytes)?;
+        }
+        Ok(())
+    }
+}
+
+/// Where the case being run is written first (its mesh files beside it), so that a case
+/// that aborts the process (a stack overflow, the allocator's hard cap) can be found, and
+/// run with `whitted`, afterwards.
 pub fn current_case_file() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fuzz-current.scene")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/fuzz-current/case.scene")
 }
 
 /// What a case came to.
@@ -84,7 +118,7 @@ pub enum Verdict {
 static ONE_CASE_AT_A_TIME: Mutex<()> = Mutex::new(());
 
 /// Runs one case on a worker thread with the time and memory budgets.
-pub fn run_case(text: &str) -> Verdict {
+pub fn run_case(case: &Case) -> Verdict {
     install_panic_hook();
     // A case that panicked while holding the lock poisons nothing we rely on.
     let _turn = ONE_CASE_AT_A_TIME
@@ -93,10 +127,10 @@ pub fn run_case(text: &str) -> Verdict {
     let (send, receive) = mpsc::channel();
     let cancel = Arc::new(AtomicBool::new(false));
     let worker_cancel = Arc::clone(&cancel);
-    let owned = text.to_string();
+    let owned = case.clone();
     let before = memory::reset_peak();
     // A stack overflow aborts the process: leave the case where it can be found.
-    let _ = std::fs::write(current_case_file(), text);
+    let _ = case.write(&current_case_file());
     let spawned = std::thread::Builder::new()
         .name("fuzz case".into())
         // The stack of a main thread (8 MiB on Linux), where the CLI runs the same code.
@@ -179,13 +213,15 @@ pub fn corpus(root: &Path) -> Vec<String> {
 }
 
 /// Case `index` of the run with `seed`: generated or mutated, a pure function of both.
-pub fn case_text(seed: u64, index: u64, corpus: &[String]) -> String {
+/// Most generated scenes are valid (they reach the tracer, lints and explain); a minority
+/// are written wild, with numbers at the edges and constructs that end in errors.
+pub fn make_case(seed: u64, index: u64, corpus: &[String]) -> Case {
     let mut rng = Rng::new(seed ^ index.wrapping_mul(0x2545_f491_4f6c_dd1d));
-    if corpus.is_empty() || rng.chance(0.5) {
-        generate::scene(&mut rng)
+    if corpus.is_empty() || rng.chance(0.8) {
+        generate::case(&mut rng)
     } else {
         let base = rng.pick(corpus).clone();
-        mutate::mutate(&mut rng, &base)
+        Case::scene(mutate::mutate(&mut rng, &base), "mutated")
     }
 }
 
@@ -194,11 +230,22 @@ pub fn case_text(seed: u64, index: u64, corpus: &[String]) -> String {
 pub struct Summary {
     pub cases: u64,
     pub compiled: u64,
+    /// Cases that reached the tracer (and lint, trace and explain).
     pub rendered: u64,
-    /// Failures by class: how many, and the first case's index and text.
-    pub failures: BTreeMap<String, (u64, u64, String, String)>,
+    /// Rendered cases with meshes read from their `.obj` and `.ply` files.
+    pub with_meshes: u64,
+    /// Lints found over the rendered cases.
+    pub lints: u64,
+    /// Findings of explain over the rendered cases.
+    pub findings: u64,
+    /// Cases and cases that reached the tracer, by how they were made.
+    pub by_origin: BTreeMap<&'static str, (u64, u64)>,
+    /// Why cases stopped at compilation: their first error's class and how many.
+    pub stopped_by: BTreeMap<String, u64>,
+    /// Failures by class: how many, and the first case's index and input.
+    pub failures: BTreeMap<String, (u64, u64, String, Case)>,
     /// Cases that did not finish in time (the run stops after [`MAX_HANGS`]).
-    pub hung: Vec<(u64, String)>,
+    pub hung: Vec<(u64, Case)>,
     pub seconds: f64,
     /// The slowest cases: seconds and index.
     pub slowest: Vec<(f64, u64)>,
@@ -213,14 +260,32 @@ impl Summary {
     }
 
     pub fn report(&self, seed: u64) -> String {
+        let share = |n: u64| 100.0 * n as f64 / self.cases.max(1) as f64;
         let mut out = format!(
-            "fuzz: seed {seed}, {} cases in {:.1} s: {} compiled, {} rendered, {} failed\n",
+            "fuzz: seed {seed}, {} cases in {:.1} s: {} compiled ({:.0}%), {} reached the \
+             tracer ({:.0}%; {} with meshes, {} lints, {} explain findings), {} failed\n",
             self.cases,
             self.seconds,
             self.compiled,
+            share(self.compiled),
             self.rendered,
+            share(self.rendered),
+            self.with_meshes,
+            self.lints,
+            self.findings,
             self.failed()
         );
+        let origins: Vec<String> = self
+            .by_origin
+            .iter()
+            .map(|(origin, (cases, rendered))| format!("{origin} {rendered} of {cases}"))
+            .collect();
+        out.push_str(&format!("  reached the tracer: {}\n", origins.join(", ")));
+        let mut stopped: Vec<(&String, &u64)> = self.stopped_by.iter().collect();
+        stopped.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
+        for (reason, count) in stopped.iter().take(6) {
+            out.push_str(&format!("  stopped at compilation {count} x: {reason}\n"));
+        }
         for (class, (count, index, detail, _)) in &self.failures {
             out.push_str(&format!(
                 "  {count} x {class} (first: case {index}: {detail})\n"
@@ -256,10 +321,13 @@ pub fn run_cases(
     let started = Instant::now();
     let mut summary = Summary::default();
     for index in 0..cases {
-        let text = case_text(seed, index, corpus);
+        let case = make_case(seed, index, corpus);
         summary.cases += 1;
         let case_started = Instant::now();
-        let verdict = run_case(&text);
+        let verdict = run_case(&case);
+        let origin = summary.by_origin.entry(case.origin).or_default();
+        origin.0 += 1;
+        origin.1 += u64::from(matches!(&verdict, Verdict::Passed(p) if p.rendered));
         summary
             .slowest
             .push((case_started.elapsed().as_secs_f64(), index));
@@ -269,18 +337,25 @@ pub fn run_cases(
             Verdict::Passed(passed) => {
                 summary.compiled += u64::from(passed.compiled);
                 summary.rendered += u64::from(passed.rendered);
+                summary.with_meshes += u64::from(passed.rendered && passed.meshes > 0);
+                summary.lints += passed.lints as u64;
+                summary.findings += passed.findings as u64;
+                if let Some(reason) = passed.stopped_by {
+                    let reason = format!("({}) {reason}", case.origin);
+                    *summary.stopped_by.entry(reason).or_default() += 1;
+                }
             }
             Verdict::Failed(failure) => {
                 let entry = summary.failures.entry(failure.class).or_insert((
                     0,
                     index,
                     failure.detail,
-                    text,
+                    case,
                 ));
                 entry.0 += 1;
             }
             Verdict::Hung => {
-                summary.hung.push((index, text));
+                summary.hung.push((index, case));
                 if summary.hung.len() >= MAX_HANGS {
                     break;
                 }
@@ -292,25 +367,30 @@ pub fn run_cases(
     summary
 }
 
-/// The class a text fails with, for shrinking (`None` when it passes).
-fn failure_class(text: &str) -> Option<String> {
-    match run_case(text) {
+/// The class a case fails with, for shrinking (`None` when it passes).
+fn failure_class(case: &Case) -> Option<String> {
+    match run_case(case) {
         Verdict::Passed(_) => None,
         Verdict::Failed(f) => Some(f.class),
         Verdict::Hung => Some("hang".into()),
     }
 }
 
-/// Shrinks `text` while it still fails with `class`: drops whole lines while that keeps
-/// the failure, then ever smaller chunks of characters (a bounded number of tries).
-pub fn shrink(text: &str, class: &str) -> String {
+/// Shrinks a case's scene text while it still fails with `class` (its files are kept):
+/// drops whole lines while that keeps the failure, then ever smaller chunks of characters
+/// (a bounded number of tries).
+pub fn shrink(case: &Case, class: &str) -> Case {
     const TRIES: u32 = 1500;
     let tries = std::cell::Cell::new(0u32);
     let still_fails = |candidate: &str| {
         tries.set(tries.get() + 1);
-        !candidate.trim().is_empty() && failure_class(candidate).as_deref() == Some(class)
+        let candidate = Case {
+            text: candidate.to_string(),
+            ..case.clone()
+        };
+        !candidate.text.trim().is_empty() && failure_class(&candidate).as_deref() == Some(class)
     };
-    let mut best = text.to_string();
+    let mut best = case.text.clone();
     // Lines, last first (later statements depend on earlier ones, not the other way).
     loop {
         let lines: Vec<&str> = best.lines().collect();
@@ -350,23 +430,50 @@ pub fn shrink(text: &str, class: &str) -> String {
         }
         chunk /= 2;
     }
-    best
+    Case {
+        text: best,
+        ..case.clone()
+    }
 }
 
-/// The regression inputs, sorted by name.
-pub fn regressions(root: &Path) -> Vec<(PathBuf, String)> {
+/// The regression inputs, sorted by name: every `NNN.scene`, and every `NNN/case.scene`
+/// with the other files of its directory (its meshes).
+pub fn regressions(root: &Path) -> Vec<(PathBuf, Case)> {
     let mut found = Vec::new();
     if let Ok(entries) = std::fs::read_dir(root.join(REGRESSIONS)) {
         for entry in entries.flatten() {
             let path = entry.path();
             if path.extension().is_some_and(|e| e == "scene") {
                 if let Ok(text) = std::fs::read_to_string(&path) {
-                    found.push((path, text));
+                    found.push((path, Case::scene(text, "regression")));
                 }
+            } else if path.is_dir() {
+                let scene = path.join("case.scene");
+                let Ok(text) = std::fs::read_to_string(&scene) else {
+                    continue;
+                };
+                let mut files = Vec::new();
+                for file in std::fs::read_dir(&path).into_iter().flatten().flatten() {
+                    let name = file.file_name().to_string_lossy().into_owned();
+                    if name != "case.scene" {
+                        if let Ok(bytes) = std::fs::read(file.path()) {
+                            files.push((name, bytes));
+                        }
+                    }
+                }
+                files.sort();
+                found.push((
+                    scene,
+                    Case {
+                        text,
+                        files,
+                        origin: "regression",
+                    },
+                ));
             }
         }
     }
-    found.sort();
+    found.sort_by(|a, b| a.0.cmp(&b.0));
     found
 }
 
@@ -374,9 +481,9 @@ pub fn regressions(root: &Path) -> Vec<(PathBuf, String)> {
 pub fn replay(root: &Path) -> Vec<String> {
     regressions(root)
         .into_iter()
-        .filter_map(|(path, text)| {
+        .filter_map(|(path, case)| {
             let name = path.display();
-            match run_case(&text) {
+            match run_case(&case) {
                 Verdict::Passed(_) => None,
                 Verdict::Failed(f) => Some(format!("{name}: {}: {}", f.class, f.detail)),
                 Verdict::Hung => Some(format!("{name}: hang")),
@@ -385,11 +492,11 @@ pub fn replay(root: &Path) -> Vec<String> {
         .collect()
 }
 
-/// Writes `text` as the next `NNN.scene` of the regression directory, with a header saying
-/// what it failed with when found.
+/// Writes `case` as the next regression input, with a header saying what it failed with
+/// when found: `NNN.scene`, or `NNN/case.scene` with its files beside it.
 pub fn save_regression(
     root: &Path,
-    text: &str,
+    case: &Case,
     class: &str,
     origin: &str,
 ) -> std::io::Result<PathBuf> {
@@ -398,17 +505,29 @@ pub fn save_regression(
     let next = regressions(root)
         .iter()
         .filter_map(|(p, _)| {
-            let stem = p.file_stem()?.to_str()?;
+            let stem = if p.file_name().is_some_and(|n| n == "case.scene") {
+                p.parent()?.file_name()?.to_str()?
+            } else {
+                p.file_stem()?.to_str()?
+            };
             let digits: String = stem.chars().take_while(char::is_ascii_digit).collect();
             digits.parse::<u32>().ok()
         })
         .max()
         .map_or(1, |n| n + 1);
-    let path = dir.join(format!("{next:03}.scene"));
     let header: String = format!("// Found by `cargo xtask fuzz` ({origin}): {class}")
         .chars()
         .map(|c| if c.is_control() { ' ' } else { c })
         .collect();
-    std::fs::write(&path, format!("{header}\n{text}"))?;
+    let saved = Case {
+        text: format!("{header}\n{}", case.text),
+        ..case.clone()
+    };
+    let path = if case.files.is_empty() {
+        dir.join(format!("{next:03}.scene"))
+    } else {
+        dir.join(format!("{next:03}")).join("case.scene")
+    };
+    saved.write(&path)?;
     Ok(path)
 }
