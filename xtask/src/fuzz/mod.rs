@@ -4,7 +4,7 @@
 //! time, step and memory budget. Any panic, hang, memory blow-up, NaN pixel or unlocated
 //! error fails and prints the case. `cargo xtask fuzz --cases N [--seed S] [--save]`;
 //! `--save` shrinks each new kind of failure and keeps it in `tests/fuzz-regressions/`
-//! (`NNN.scene`, or `NNN/case.scene` with its mesh files beside it), which
+//! (`NNN.scene`, or a folder NNN holding case.scene with its mesh files beside it), which
 //! `xtask/tests/fuzz.rs` replays.
 
 pub mod case;
@@ -436,7 +436,7 @@ pub fn shrink(case: &Case, class: &str) -> Case {
     }
 }
 
-/// The regression inputs, sorted by name: every `NNN.scene`, and every `NNN/case.scene`
+/// The regression inputs, sorted by name: every `NNN.scene`, and every a folder NNN holding case.scene
 /// with the other files of its directory (its meshes).
 pub fn regressions(root: &Path) -> Vec<(PathBuf, Case)> {
     let mut found = Vec::new();
@@ -493,7 +493,7 @@ pub fn replay(root: &Path) -> Vec<String> {
 }
 
 /// Writes `case` as the next regression input, with a header saying what it failed with
-/// when found: `NNN.scene`, or `NNN/case.scene` with its files beside it.
+/// when found: `NNN.scene`, or a folder NNN holding case.scene with its files beside it.
 pub fn save_regression(
     root: &Path,
     case: &Case,
