@@ -436,7 +436,7 @@ pub fn shrink(case: &Case, class: &str) -> Case {
     }
 }
 
-/// The regression inputs, sorted by name: every `NNN.scene`, and every a folder NNN holding case.scene
+/// The regression inputs, sorted by name: every `NNN.scene`, and every folder NNN holding case.scene
 /// with the other files of its directory (its meshes).
 pub fn regressions(root: &Path) -> Vec<(PathBuf, Case)> {
     let mut found = Vec::new();
