@@ -33,17 +33,43 @@ impl RenderObserver for ProgressObserver {
 /// `render` and `trace`, so that a trace at a given size follows the render at that size.
 pub fn render_options(settings: &Settings, overrides: &RenderOverrides) -> RenderOptions {
     let mut options = RenderOptions::from_settings(settings);
-    options.width = overrides.width.unwrap_or(options.width);
-    options.height = overrides.height.unwrap_or(options.height);
+    (options.width, options.height) = image_size(
+        (settings.width, settings.height),
+        overrides.width,
+        overrides.height,
+    );
     options.samples_per_pixel = overrides.spp.unwrap_or(options.samples_per_pixel);
     options.max_depth = overrides.max_depth.unwrap_or(options.max_depth);
     options
+}
+
+/// The size of the image to make: both flags give exactly that size; one alone keeps the
+/// scene's aspect ratio, as every image tool does (`--width 320` of a 640x480 scene is
+/// 320x240, not a 320x480 crop), the other side rounded and at least 1.
+fn image_size(scene: (u32, u32), width: Option<u32>, height: Option<u32>) -> (u32, u32) {
+    let (scene_width, scene_height) = (f64::from(scene.0.max(1)), f64::from(scene.1.max(1)));
+    let side = |value: f64| value.round().clamp(1.0, f64::from(u32::MAX)) as u32;
+    match (width, height) {
+        (Some(w), Some(h)) => (w, h),
+        (Some(w), None) => (w, side(f64::from(w) * scene_height / scene_width)),
+        (None, Some(h)) => (side(f64::from(h) * scene_width / scene_height), h),
+        (None, None) => scene,
+    }
 }
 
 /// Refuses image sizes that cannot be held in memory, before any work starts: at most
 /// [`limits::MAX_PIXELS`] (about 11,585 x 11,585, 1.5 GiB of linear RGB). Larger sizes are
 /// almost always a typo (`--width 30000 --height 30000`) and would exhaust memory.
 pub fn check_image_size(width: u32, height: u32) -> Result<(), Failure> {
+    // A side worked out from the other one (`--height` alone of a very wide scene) may
+    // pass the side limit that the flags check.
+    if width.max(height) > limits::MAX_IMAGE_SIDE {
+        return Err(Failure::Message(format!(
+            "a {width}x{height} image has a side over the image side limit ({}): give both \
+             --width and --height",
+            limits::MAX_IMAGE_SIDE
+        )));
+    }
     let pixels = u64::from(width) * u64::from(height);
     if pixels > limits::MAX_PIXELS {
         return Err(Failure::Message(format!(
@@ -252,7 +278,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     let pool = thread_pool(args.threads)?;
     let prepared = if lint {
         let prepared = pool.install(|| PreparedScene::new(&loaded.scene));
-        crate::scene_input::print_lints(&loaded, &prepared);
+        crate::scene_input::print_lints(&loaded, &prepared, &options);
         prepared
     } else {
         // Nothing below needs the IR (names, spans, provenance): it is freed while the
@@ -508,6 +534,17 @@ mod tests {
     use super::*;
 
     const MAX: u64 = whitted_ir::limits::MAX_PIXELS;
+
+    #[test]
+    fn one_side_keeps_the_aspect_ratio_and_both_give_the_size() {
+        assert_eq!(image_size((640, 480), Some(320), None), (320, 240));
+        assert_eq!(image_size((640, 480), None, Some(60)), (80, 60));
+        assert_eq!(image_size((640, 480), Some(100), Some(100)), (100, 100));
+        assert_eq!(image_size((640, 480), None, None), (640, 480));
+        // Rounded, never 0.
+        assert_eq!(image_size((1000, 1), Some(10), None), (10, 1));
+        assert_eq!(image_size((160, 75), Some(33), None), (33, 15));
+    }
 
     fn estimate(pixels: u64, output: ImageFormat, stats: Option<ImageFormat>) -> u64 {
         MemoryEstimate {

@@ -172,16 +172,19 @@ pub fn check(check_args: &CheckArgs) -> Result<(), Failure> {
         );
     } else if !check_args.no_lint {
         let prepared = whitted_tracer::PreparedScene::new(&loaded.scene);
-        loaded.warnings += print_lints(&loaded, &prepared);
+        let options = whitted_tracer::RenderOptions::from_settings(&loaded.scene.settings);
+        loaded.warnings += print_lints(&loaded, &prepared, &options);
     }
     let scene = &loaded.scene;
     let summary = format!(
-        "{}: ok ({} objects, {} light{}, {} materials{})\n",
+        "{}: ok ({} object{}, {} light{}, {} material{}{})\n",
         args.scene.display(),
         scene.objects.len(),
+        if scene.objects.len() == 1 { "" } else { "s" },
         scene.lights.len(),
         if scene.lights.len() == 1 { "" } else { "s" },
         scene.materials.len(),
+        if scene.materials.len() == 1 { "" } else { "s" },
         match loaded.warnings {
             0 => String::new(),
             1 => ", 1 warning".to_string(),
@@ -194,9 +197,13 @@ pub fn check(check_args: &CheckArgs) -> Result<(), Failure> {
 /// Lints a compiled scene (docs/explain.md, "Lints"), prints its warnings like the
 /// compiler's and returns how many there were. A lint at a place the compiler already
 /// warned about is left out. `prepared` must be made from `loaded.scene`.
-pub fn print_lints(loaded: &Loaded, prepared: &whitted_tracer::PreparedScene) -> usize {
+pub fn print_lints(
+    loaded: &Loaded,
+    prepared: &whitted_tracer::PreparedScene,
+    options: &whitted_tracer::RenderOptions,
+) -> usize {
     let scene = &loaded.scene;
-    let lints = whitted_explain::lint::lint(prepared, scene);
+    let lints = whitted_explain::lint::lint_at(prepared, scene, options);
     let diagnostics: Vec<_> = lints
         .into_iter()
         .map(|l| l.diagnostic)

@@ -144,6 +144,36 @@ fn render_writes_the_requested_size_and_format() {
     }
 }
 
+/// Issue 27: `--width` alone rendered a 320x480 crop of a 640x480 scene; one side alone
+/// keeps the scene's aspect ratio, as every image tool does.
+#[test]
+fn one_side_alone_keeps_the_scenes_aspect_ratio() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("one-side.png");
+    for (flag, value, expected) in [
+        ("--width", "320", (320, 240)),
+        ("--height", "60", (80, 60)),
+        ("--width", "33", (33, 25)),
+    ] {
+        let output = run(&[
+            "render",
+            "scenes/whitted.scene",
+            flag,
+            value,
+            "--quiet",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(output.status.success(), "{}", stderr(&output));
+        let image = image::open(&out).unwrap();
+        assert_eq!(
+            (image.width(), image.height()),
+            expected,
+            "{flag} {value} of a 640x480 scene"
+        );
+    }
+}
+
 #[test]
 fn a_failed_render_leaves_the_old_image_alone() {
     let dir = tempfile::tempdir().unwrap();
@@ -249,11 +279,11 @@ fn set_replaces_a_setting_for_every_command_and_reports_mistakes_in_its_text() {
     assert!(output.status.success(), "{}", stderr(&output));
     let text = stdout(&output);
     assert!(
-        text.contains("highlight Blinn") && text.contains("max depth 9"),
+        text.contains("highlight blinn") && text.contains("max depth 9"),
         "{text}"
     );
     assert!(
-        text.contains("shadows None, highlight Blinn, back faces unlit, attenuation unclamped"),
+        text.contains("shadows none, highlight blinn, back faces unlit, attenuation unclamped"),
         "{text}"
     );
 

@@ -24,6 +24,65 @@ fn lints_of(path: &str) -> (Vec<Lint>, whitted_ir::ValidScene) {
     (lint(&loaded.prepared, &loaded.scene), loaded.scene)
 }
 
+/// Issue 27: after `--width 10 --height 8` a lint named a pixel of the scene's own 40x30,
+/// which `trace` at that size then refused. The pixel is in the image being made, and
+/// tracing it at that size shows the cut the warning is about.
+#[test]
+fn lint_pixels_are_pixels_of_the_image_being_rendered() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("small.png");
+    let render = Command::new(env!("CARGO_BIN_EXE_whitted"))
+        .current_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")))
+        .env("NO_COLOR", "1")
+        .args([
+            "render",
+            "tests/lint/max-depth.scene",
+            "--width",
+            "10",
+            "--height",
+            "8",
+        ])
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .expect("the whitted binary runs");
+    let stderr = String::from_utf8_lossy(&render.stderr);
+    let at = stderr
+        .split("at pixel (")
+        .nth(1)
+        .unwrap_or_else(|| panic!("{stderr}"));
+    let (x, rest) = at.split_once(", ").expect("x, y");
+    let y = rest.split(')').next().expect("y)");
+    let (x, y): (u32, u32) = (x.parse().expect("x"), y.parse().expect("y"));
+    assert!(
+        x < 10 && y < 8,
+        "pixel ({x}, {y}) is outside the 10x8 image"
+    );
+    let trace = Command::new(env!("CARGO_BIN_EXE_whitted"))
+        .current_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")))
+        .args([
+            "trace",
+            "tests/lint/max-depth.scene",
+            "--width",
+            "10",
+            "--height",
+            "8",
+        ])
+        .arg("--pixel")
+        .arg(format!("{x},{y}"))
+        .output()
+        .expect("the whitted binary runs");
+    assert!(
+        trace.status.success(),
+        "{}",
+        String::from_utf8_lossy(&trace.stderr)
+    );
+    assert!(
+        String::from_utf8_lossy(&trace.stdout).contains("(max depth)"),
+        "the traced pixel shows no depth cut"
+    );
+}
+
 #[test]
 fn each_lint_fires_on_its_scene_with_its_location_and_fix() {
     // (scene, kind, where the warning points, words its fix must contain, how many)
@@ -222,13 +281,13 @@ fn check_prints_the_lints_and_no_lint_silences_them() {
         stderr.contains("Help: move it (or the camera's eye, look_at or fov)"),
         "{stderr}"
     );
-    assert!(stdout.ends_with("materials, 2 warnings)\n"), "{stdout}");
+    assert!(stdout.ends_with("material, 2 warnings)\n"), "{stdout}");
 
     let output = check(&["tests/lint/unseen.scene", "--no-lint"]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(!stderr.contains("unseen_object"), "{stderr}");
-    assert!(stdout.ends_with("1 materials)\n"), "{stdout}");
+    assert!(stdout.ends_with("1 material)\n"), "{stdout}");
 }
 
 #[test]

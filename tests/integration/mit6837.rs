@@ -126,7 +126,7 @@ fn other_commands_read_a_course_scene_by_its_content_and_point_at_its_lines() {
     let output = whitted(&["ir", SPHERES, "--set", "shadows=opaque"]);
     let text = stdout(&output);
     assert!(
-        text.contains("shadows Opaque, highlight Blinn, back faces unlit, attenuation unclamped"),
+        text.contains("shadows opaque, highlight blinn, back faces unlit, attenuation unclamped"),
         "{text}"
     );
     assert!(text.contains("sphere center <-1.2, -0.6, 0> radius 1 material #0  @ scenes/mit6837/spheres-orthographic.txt:31:5"), "{text}");

@@ -21,15 +21,15 @@ pub fn print(scene: &Scene) -> String {
     );
     let _ = writeln!(
         out,
-        "  background {}, ambient {}, epsilon {}, shadows {:?}{}{}{}",
+        "  background {}, ambient {}, epsilon {}, shadows {}{}{}{}",
         color(&s.background),
         color(&s.ambient),
         s.epsilon.map_or("auto".to_string(), |e| e.to_string()),
-        s.shadows,
+        word(&s.shadows),
         // Shown when it is not the classic Phong, so that older dumps read the same.
         match s.highlight {
             crate::scene::Highlight::Phong => "",
-            crate::scene::Highlight::Blinn => ", highlight Blinn",
+            crate::scene::Highlight::Blinn => ", highlight blinn",
         },
         // Likewise shown only when they leave the default.
         if s.shade_back {
@@ -113,8 +113,8 @@ pub fn print(scene: &Scene) -> String {
         if let Some(p) = &material.pattern {
             let _ = writeln!(
                 out,
-                "  pattern {:?} of {} and {} scale {}{}",
-                p.kind,
+                "  pattern {} of {} and {} scale {}{}",
+                word(&p.kind),
                 p.a,
                 p.b,
                 p.scale,
@@ -154,9 +154,9 @@ fn material_name(m: &Material) -> String {
 
 fn material_fields(m: &Material) -> String {
     let mut fields = format!(
-        "ambient {} diffuse {} specular {} shininess {} reflective {} transmissive {} ior {} fresnel {:?} absorption {}",
+        "ambient {} diffuse {} specular {} shininess {} reflective {} transmissive {} ior {} fresnel {} absorption {}",
         color(&m.ambient), color(&m.diffuse), color(&m.specular), m.shininess, color(&m.reflective),
-        color(&m.transmissive), m.ior, m.fresnel, color(&m.absorption)
+        color(&m.transmissive), m.ior, m.fresnel.name(), color(&m.absorption)
     );
     // Only nested media use a priority: plain materials print as they always did.
     if m.priority != 0 {
@@ -182,7 +182,7 @@ fn print_object(scene: &Scene, handle: Handle<Object>, depth: usize, out: &mut S
         .map(|n| format!(" {n:?}"))
         .unwrap_or_default();
     let what = match &object.kind {
-        ObjectKind::Shape { shape } => shape_text(shape),
+        ObjectKind::Shape { shape } => shape_text(scene, shape),
         ObjectKind::Csg { op, .. } => op.name().to_string(),
         ObjectKind::Group { .. } => "group".to_string(),
     };
@@ -207,7 +207,16 @@ fn print_object(scene: &Scene, handle: Handle<Object>, depth: usize, out: &mut S
     }
 }
 
-fn shape_text(shape: &Shape) -> String {
+/// The word the scene language uses for a setting's value (`opaque`, `checker`): its
+/// serde name, which is that word.
+fn word<T: serde::Serialize>(value: &T) -> String {
+    serde_json::to_value(value)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default()
+}
+
+fn shape_text(scene: &Scene, shape: &Shape) -> String {
     match shape {
         Shape::Sphere { center, radius } => format!("sphere center {} radius {radius}", v(*center)),
         Shape::Plane { normal, offset } => format!("plane normal {} offset {offset}", v(*normal)),
@@ -249,7 +258,18 @@ fn shape_text(shape: &Shape) -> String {
         Shape::Triangle { a, b, c } => format!("triangle {} {} {}", v(*a), v(*b), v(*c)),
         Shape::Torus { major, minor } => format!("torus major {major} minor {minor}"),
         Shape::Mesh { mesh, smooth } => {
-            format!("mesh {mesh}{}", if *smooth { " smooth" } else { "" })
+            // Smooth shading interpolates the file's vertex normals, or normals worked out
+            // from the faces when the file has none: say which.
+            let computed = scene
+                .meshes
+                .get(*mesh)
+                .is_some_and(|m| m.normals.is_empty());
+            let shading = match (smooth, computed) {
+                (true, false) => " smooth",
+                (true, true) => " smooth (normals computed from the faces)",
+                (false, _) => "",
+            };
+            format!("mesh {mesh}{shading}")
         }
         Shape::Quadric { quadric, .. } => {
             let c = quadric.coefficients();

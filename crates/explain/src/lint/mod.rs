@@ -18,7 +18,7 @@ mod view;
 pub use budget::{ray_budget_cause, worst_case, worst_case_at, WorstCase};
 
 use whitted_ir::{Diagnostic, Scene};
-use whitted_tracer::PreparedScene;
+use whitted_tracer::{PreparedScene, RenderOptions};
 
 /// What a lint warns about; its name starts the warning's message.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -92,14 +92,26 @@ pub fn lints_by_default(scene: &Scene) -> bool {
     scene.objects.len() <= MAX_OBJECTS
 }
 
-/// Every lint of `scene`, in a fixed order (kind, then scene order). `prepared` must be
-/// made from `scene`.
+/// Every lint of `scene`, in a fixed order (kind, then scene order), at the scene's own
+/// image size and depth. `prepared` must be made from `scene`.
 pub fn lint(prepared: &PreparedScene, scene: &Scene) -> Vec<Lint> {
+    lint_at(
+        prepared,
+        scene,
+        &RenderOptions::from_settings(&scene.settings),
+    )
+}
+
+/// [`lint`] for the image being made with `options` (the command line's `--width`,
+/// `--height` and `--max-depth` applied): the pixels the warnings name are pixels of that
+/// image, and the depth they judge is the depth it is traced with.
+pub fn lint_at(prepared: &PreparedScene, scene: &Scene, options: &RenderOptions) -> Vec<Lint> {
     let mut lints = Vec::new();
     geometry::lights_inside_solids(scene, &mut lints);
-    let samples = sampled::sample(prepared, scene);
+    let options = sampled::grid_options(options);
+    let samples = sampled::sample(prepared, scene, &options);
     sampled::coincident_surfaces(scene, &samples, &mut lints);
-    sampled::max_depth_too_low(prepared, scene, &samples, &mut lints);
+    sampled::max_depth_too_low(prepared, scene, &samples, &options, &mut lints);
     geometry::material_gain(scene, &mut lints);
     view::unseen_objects(scene, &samples, &mut lints);
     geometry::facing_away_from_lights(scene, &mut lints);

@@ -208,11 +208,11 @@ impl GridRecorder<'_> {
     }
 }
 
-/// The image options the grid is traced with: the scene's own, one sample per pixel.
-pub fn grid_options(scene: &Scene) -> RenderOptions {
+/// The image options the grid is traced with: the image's, one sample per pixel.
+pub fn grid_options(image: &RenderOptions) -> RenderOptions {
     RenderOptions {
         samples_per_pixel: 1,
-        ..RenderOptions::from_settings(&scene.settings)
+        ..image.clone()
     }
 }
 
@@ -231,9 +231,8 @@ fn grid(options: &RenderOptions) -> impl Iterator<Item = (u32, u32)> {
     })
 }
 
-/// Traces the grid.
-pub fn sample(prepared: &PreparedScene, scene: &Scene) -> Samples {
-    let options = grid_options(scene);
+/// Traces the grid, over the image of `options`.
+pub fn sample(prepared: &PreparedScene, scene: &Scene, options: &RenderOptions) -> Samples {
     let mut recorder = GridRecorder {
         scene,
         samples: Samples {
@@ -246,11 +245,11 @@ pub fn sample(prepared: &PreparedScene, scene: &Scene) -> Samples {
         pixel: (0, 0),
         rays: 0,
     };
-    for (x, y) in grid(&options) {
+    for (x, y) in grid(options) {
         recorder.pixel = (x, y);
         recorder.rays = 0;
         recorder.stack.clear();
-        trace_pixel_with(prepared, &options, x, y, 0, &mut recorder);
+        trace_pixel_with(prepared, options, x, y, 0, &mut recorder);
     }
     recorder.samples
 }
@@ -373,12 +372,12 @@ pub(super) fn max_depth_too_low(
     prepared: &PreparedScene,
     scene: &Scene,
     samples: &Samples,
+    options: &RenderOptions,
     lints: &mut Vec<Lint>,
 ) {
     let Some(cut) = &samples.depth_cut else {
         return;
     };
-    let options = grid_options(scene);
     // `max_depth 0` asks for no reflected or transmitted rays at all: local shading only,
     // on purpose (the MIT 6.837 course's default without `-bounces`).
     if options.max_depth == 0 {
@@ -387,7 +386,7 @@ pub(super) fn max_depth_too_low(
     let (x, y) = cut.pixel;
     let name = object_name(scene, cut.object);
     let current = options.max_depth;
-    let needed = match depth_needed(prepared, &options, x, y, SIGNIFICANT) {
+    let needed = match depth_needed(prepared, options, x, y, SIGNIFICANT) {
         DepthSearch::Found { max_depth, .. } => format!(
             "raise max_depth to {max_depth} (`max_depth {max_depth}` in the settings, or \
              --set max_depth={max_depth}): the light then gets out of {name}"
