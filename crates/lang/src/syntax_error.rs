@@ -275,6 +275,9 @@ pub fn translate(
         .map(|p| p.name())
         .find(|name| *name == previous);
     let (found, found_len) = found_token(text, pos);
+    if let Some(diagnostic) = common_mistake(text, pos, found_len, file) {
+        return diagnostic;
+    }
     let words = expected.words();
     let message = format!("expected {}, found {found}", join_or(&words));
     let span = Span::new(file, pos, pos + found_len);
@@ -308,6 +311,129 @@ pub fn translate(
         diagnostic = diagnostic.with_hint(hint);
     }
     diagnostic
+}
+
+/// The first word of the line that opens the innermost block around `pos` (`sphere`,
+/// `for`, `fn`), or "" at the top level.
+fn enclosing_block_word(text: &str, pos: usize) -> &str {
+    let mut depth = 0usize;
+    for (i, c) in text.get(..pos).unwrap_or("").char_indices().rev() {
+        match c {
+            '}' => depth += 1,
+            '{' if depth > 0 => depth -= 1,
+            '{' => {
+                let line_start = text[..i].rfind(['\n', ';', '}', '{']).map_or(0, |j| j + 1);
+                return text[line_start..i]
+                    .split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                    .find(|w| !w.is_empty())
+                    .unwrap_or("");
+            }
+            _ => {}
+        }
+    }
+    ""
+}
+
+/// Whether `word` names a property of some block.
+fn is_property(word: &str) -> bool {
+    crate::schema::Prop::ALL.iter().any(|p| p.name() == word)
+}
+
+/// The statement around `pos` so far: from the last `{`, `}`, `;` or new line before it.
+fn statement_start(text: &str, pos: usize) -> usize {
+    text.get(..pos)
+        .unwrap_or("")
+        .rfind(['{', '}', ';', '\n'])
+        .map_or(0, |i| i + 1)
+}
+
+/// The syntax errors people make most, each said for what it is, at the place it is, with
+/// the fix: `=` after a property's name (`radius = 1`), `;` after a property
+/// (`radius 1;`), and a unit after a number (`640px`, `45deg`). `None` for anything else,
+/// which the general message describes.
+fn common_mistake(text: &str, pos: usize, found_len: usize, file: FileId) -> Option<Diagnostic> {
+    let bytes = text.as_bytes();
+    let found = text.get(pos..pos + found_len).unwrap_or("");
+    // A unit glued to a number: letters right after a digit.
+    if found.starts_with(|c: char| c.is_ascii_alphabetic())
+        && pos > 0
+        && bytes.get(pos - 1).is_some_and(u8::is_ascii_digit)
+    {
+        let number_start = text[..pos]
+            .rfind(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .map_or(0, |i| i + 1);
+        let number = &text[number_start..pos];
+        let advice = match found {
+            "px" | "pixels" => format!("sizes are in pixels already: write `{number}`"),
+            "deg" | "degrees" | "d" => format!("angles are in degrees already: write `{number}`"),
+            "rad" | "radians" => {
+                "angles are in degrees: write the angle in degrees (45, not 0.785)".to_string()
+            }
+            _ => format!("write the number alone: `{number}`"),
+        };
+        return Some(
+            Diagnostic::error(
+                format!("`{found}` after the number `{number}`: numbers have no units"),
+                Span::new(file, pos, pos + found_len),
+            )
+            .with_label("remove this")
+            .with_hint(advice),
+        );
+    }
+    // The statement before the error, which may have ended on an earlier line (pest
+    // notices a missing `;` only at the next word).
+    let end = text.get(..pos).unwrap_or("").trim_end().len();
+    let start = statement_start(text, end);
+    let statement = text.get(start..end).unwrap_or("");
+    let first_word = statement
+        .trim_start()
+        .split(|c: char| !(c.is_alphanumeric() || c == '_'))
+        .next()
+        .unwrap_or("");
+    if !is_property(first_word) {
+        return None;
+    }
+    let word_at = start + statement.find(first_word).unwrap_or(0);
+    // `radius = 1`: pest read an assignment and wanted its `;`. Only in a block that
+    // takes properties: in a loop's or a function's body it is an assignment.
+    let after_word = &text[word_at + first_word.len()..end];
+    let in_code_block = matches!(
+        enclosing_block_word(text, word_at),
+        "for" | "if" | "else" | "while" | "fn"
+    );
+    if let Some(equals) = after_word
+        .trim_start()
+        .strip_prefix('=')
+        .filter(|_| !in_code_block)
+    {
+        if !equals.starts_with('=') {
+            let at = word_at + first_word.len() + after_word.find('=').unwrap_or(0);
+            let value = equals.trim();
+            return Some(
+                Diagnostic::error(
+                    format!("`=` after the property `{first_word}`: a property takes its value without `=`"),
+                    Span::new(file, at, at + 1),
+                )
+                .with_label("remove this")
+                .with_hint(format!("write `{first_word} {value}`")),
+            );
+        }
+    }
+    // `radius 1;`: a property is not a statement that ends with `;`.
+    if found == ";" {
+        return Some(
+            Diagnostic::error(
+                format!("`;` after the property `{first_word}`: properties do not end with `;`"),
+                Span::new(file, pos, pos + 1),
+            )
+            .with_label("remove this")
+            .with_hint(
+                "properties are separated by spaces or new lines; only `let`, `const` and \
+                 `return` end with `;`",
+            ),
+        );
+    }
+    None
 }
 
 /// Advice for the mistakes people make most.

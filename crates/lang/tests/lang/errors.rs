@@ -43,6 +43,37 @@ fn syntax_errors() {
     );
 }
 
+/// Issue 27: the mistakes people bring from other languages, each said for what it is at
+/// the place it is, with the fix (before: "expected `;`, found `}`" with a help about
+/// `let`; "separate values with commas"; "expected something else, found `px`").
+#[test]
+fn common_mistakes() {
+    check_errors(
+        "common_mistakes",
+        &[
+            ("`=` after a property", "sphere { radius = 1 }\n"),
+            (
+                "`=` after a property on its own line",
+                "material glass {\n    ior = 1.5\n    transmissive 0.9\n}\n",
+            ),
+            ("`;` after a property", "sphere { radius 1; }\n"),
+            ("pixels after a number", "settings { width 640px }\n"),
+            (
+                "degrees after a number",
+                "camera perspective { fov 45deg }\n",
+            ),
+            (
+                "radians after a number",
+                "camera perspective { fov 0.8rad }\n",
+            ),
+            (
+                "an assignment in a loop is not a property",
+                "let radius = 1;\nfor i in 0..2 {\n    radius = radius + 1\n}\n",
+            ),
+        ],
+    );
+}
+
 #[test]
 fn name_errors() {
     check_errors(
