@@ -86,7 +86,14 @@ fn lint_pixels_are_pixels_of_the_image_being_rendered() {
 #[test]
 fn each_lint_fires_on_its_scene_with_its_location_and_fix() {
     // (scene, kind, where the warning points, words its fix must contain, how many)
-    let cases: [(&str, LintKind, &str, &str, usize); 9] = [
+    let cases: [(&str, LintKind, &str, &str, usize); 10] = [
+        (
+            "tests/lint/nothing-to-see.scene",
+            LintKind::NothingToSee,
+            "tests/lint/nothing-to-see.scene:5:1",
+            "add a light",
+            1,
+        ),
         (
             "tests/lint/coincident-thin.scene",
             LintKind::CoincidentSurfaces,
@@ -239,6 +246,40 @@ fn the_ray_budget_warning_counts_the_rays_and_names_the_material() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(output.status.success(), "{stderr}");
     assert!(!stderr.contains("ray_budget"), "{stderr}");
+}
+
+/// Issue 27: an empty scene, or one whose objects are all behind the camera, rendered a
+/// background image with "ok" and no word; it still renders, with a warning that says why.
+#[test]
+fn a_scene_with_nothing_to_see_warns_and_still_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    for (text, words) in [
+        (
+            "settings { width 8 height 6 }\ncamera perspective { eye <0, 0, -5> look_at <0, 0, 0> }\n",
+            "the scene has no objects",
+        ),
+        (
+            "settings { width 8 height 6 }\ncamera perspective { eye <0, 0, -5> look_at <0, 0, -10> }\nlight point { position <0, 5, 0> }\nsphere { center <0, 0, 10> }\n",
+            "no camera ray meets an object",
+        ),
+    ] {
+        let scene = dir.path().join("nothing.scene");
+        std::fs::write(&scene, text).unwrap();
+        let out = dir.path().join("nothing.png");
+        let render = Command::new(env!("CARGO_BIN_EXE_whitted"))
+            .env("NO_COLOR", "1")
+            .arg("render")
+            .arg(&scene)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .expect("the whitted binary runs");
+        let stderr = String::from_utf8_lossy(&render.stderr);
+        assert!(render.status.success(), "{stderr}");
+        assert!(out.exists(), "the image is still written");
+        assert!(stderr.contains("warning: nothing_to_see: "), "{stderr}");
+        assert!(stderr.contains(words), "{stderr}");
+    }
 }
 
 /// The scene that shows the ray budget, and its one expected warning.

@@ -147,9 +147,22 @@ impl Checker {
                 span,
             );
         } else if view.normalize().cross(camera.up).length() < 1e-9 {
-            self.error(
-                "the camera's `up` is parallel to its view direction".into(),
-                span,
+            // The world axis most across the view is an `up` that works.
+            let d = view.normalize().abs();
+            let across = if d.y <= d.x && d.y <= d.z {
+                "<0, 1, 0>"
+            } else if d.z <= d.x {
+                "<0, 0, 1>"
+            } else {
+                "<1, 0, 0>"
+            };
+            self.errors.push(
+                Diagnostic::error("the camera's `up` is parallel to its view direction", span)
+                    .with_label("looks straight along `up`")
+                    .with_hint(format!(
+                        "the image's vertical is undefined when the camera looks along `up`: \
+                         give the camera `up {across}`, or move `eye` off the line to `look_at`"
+                    )),
             );
         }
         match camera.projection {

@@ -11,6 +11,7 @@
 
 mod bounds;
 mod budget;
+mod empty;
 mod geometry;
 mod sampled;
 mod view;
@@ -30,10 +31,11 @@ pub enum LintKind {
     UnseenObject,
     FacingAwayFromLights,
     RayBudget,
+    NothingToSee,
 }
 
 impl LintKind {
-    pub const ALL: [LintKind; 7] = [
+    pub const ALL: [LintKind; 8] = [
         LintKind::LightInsideSolid,
         LintKind::CoincidentSurfaces,
         LintKind::MaxDepthTooLow,
@@ -41,6 +43,7 @@ impl LintKind {
         LintKind::UnseenObject,
         LintKind::FacingAwayFromLights,
         LintKind::RayBudget,
+        LintKind::NothingToSee,
     ];
 
     pub fn name(self) -> &'static str {
@@ -52,6 +55,7 @@ impl LintKind {
             LintKind::UnseenObject => "unseen_object",
             LintKind::FacingAwayFromLights => "facing_away_from_lights",
             LintKind::RayBudget => "ray_budget",
+            LintKind::NothingToSee => "nothing_to_see",
         }
     }
 }
@@ -114,6 +118,7 @@ pub fn lint_at(prepared: &PreparedScene, scene: &Scene, options: &RenderOptions)
     sampled::max_depth_too_low(prepared, scene, &samples, &options, &mut lints);
     geometry::material_gain(scene, &mut lints);
     view::unseen_objects(scene, &samples, &mut lints);
+    empty::nothing_to_see(scene, &samples, &mut lints);
     geometry::facing_away_from_lights(scene, &mut lints);
     budget::ray_budget(scene, &mut lints);
     cap_per_kind(&mut lints);

@@ -43,6 +43,10 @@ impl Converted {
     }
 }
 
+/// A `fov` under this many degrees is probably radians: the narrowest lenses people use
+/// on purpose are a few degrees wide, and 3.14 radians is 180°.
+const FOV_LOOKS_LIKE_RADIANS: f64 = 3.2;
+
 impl Evaluator<'_> {
     /// Converts `value` as `row` says: its kind and its range.
     pub(super) fn convert(&mut self, row: &Row, value: Value, span: Span) -> Eval<Converted> {
@@ -74,6 +78,9 @@ impl Evaluator<'_> {
         let x = self.as_number(value, span, prop)?;
         let ok = if low_open { x > low } else { x >= low } && x <= high;
         if ok {
+            if prop.name() == "fov" && x < FOV_LOOKS_LIKE_RADIANS {
+                self.warn_fov_in_radians(x, span);
+            }
             return Ok(x);
         }
         let wanted = match (low_open, high.is_finite()) {
@@ -182,7 +189,55 @@ impl Evaluator<'_> {
                     .with_label(format!("this is <{}, {}, {}>", v.x, v.y, v.z)),
             );
         }
+        if matches!(prop.name(), "diffuse" | "specular") && v.max_element() > 1.0 {
+            self.warn_color_out_of_255(prop, v, span);
+        }
         Ok(Color::new(v.x, v.y, v.z))
+    }
+
+    /// A surface colour over 1 is almost always written 0-255 (`rgb(255, 128, 0)`): it
+    /// reflects 255 times the light that arrives. Said with the colour to write instead.
+    fn warn_color_out_of_255(&mut self, prop: Prop, v: DVec3, span: Span) {
+        let scaled = |x: f64| {
+            let text = format!("{:.3}", x / 255.0);
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        };
+        self.diagnostics.push(
+            Diagnostic::warning(
+                format!(
+                    "`{}` is over 1 ({}, {}, {}): a surface colour goes from 0 to 1, so this \
+                     reflects more light than arrives",
+                    prop.name(),
+                    v.x,
+                    v.y,
+                    v.z
+                ),
+                span,
+            )
+            .with_label("written 0-255?")
+            .with_hint(format!(
+                "if it was written from 0 to 255, divide by 255: `rgb({}, {}, {})`",
+                scaled(v.x),
+                scaled(v.y),
+                scaled(v.z)
+            )),
+        );
+    }
+
+    /// A field of view under a few degrees is almost always radians (`0.785` for 45°).
+    fn warn_fov_in_radians(&mut self, fov: f64, span: Span) {
+        self.diagnostics.push(
+            Diagnostic::warning(
+                format!("a field of view of {fov} degrees is a very narrow telephoto"),
+                span,
+            )
+            .with_label("radians?")
+            .with_hint(format!(
+                "`fov` is in degrees: {fov} radians is {}°, so write `fov {}`",
+                (fov.to_degrees() * 10.0).round() / 10.0,
+                fov.to_degrees().round()
+            )),
+        );
     }
 
     /// A colour of light (background, ambient): at most the largest intensity limit.

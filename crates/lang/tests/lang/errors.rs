@@ -74,6 +74,30 @@ fn common_mistakes() {
     );
 }
 
+/// Issue 27: values that are valid but almost certainly meant otherwise, warned at the
+/// value with what to write (before: no word), and a camera looking along `up` gets the
+/// `up` to use.
+#[test]
+fn mistaken_values() {
+    check_errors(
+        "mistaken_values",
+        &[
+            (
+                "a colour written 0-255",
+                "material m { diffuse rgb(255, 128, 0) specular 0.5 }\nsphere { material m }\n",
+            ),
+            (
+                "a field of view in radians",
+                "camera perspective { eye <0, 0, -5> look_at <0, 0, 0> fov 0.785 }\nsphere { }\n",
+            ),
+            (
+                "a camera looking along `up`",
+                "camera perspective { eye <0, 5, 0> look_at <0, 0, 0> }\nsphere { }\n",
+            ),
+        ],
+    );
+}
+
 #[test]
 fn name_errors() {
     check_errors(
