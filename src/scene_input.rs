@@ -147,6 +147,31 @@ pub fn load_scene_with(
                 .iter()
                 .filter(|d| d.is_error())
                 .count();
+            // Errors only in what the command line said (`--set foo=1`, `-D N=oops`): the
+            // usage is wrong, not the scene (exit 2, the flag quoted).
+            let flag_of = |d: &whitted_ir::Diagnostic| {
+                let file = d.span.filter(|s| !s.is_detached())?.file;
+                let path = &compilation.sources.get(file)?.path;
+                path.strip_prefix('<')
+                    .and_then(|p| p.strip_suffix('>'))
+                    .filter(|p| p.starts_with("--set ") || p.starts_with("-D "))
+                    .map(str::to_string)
+            };
+            let flags: Option<Vec<String>> = compilation
+                .diagnostics
+                .iter()
+                .filter(|d| d.is_error())
+                .map(flag_of)
+                .collect();
+            if let Some(mut flags) = flags.filter(|f| !f.is_empty()) {
+                flags.dedup();
+                let quoted: Vec<String> = flags.iter().map(|f| format!("`{f}`")).collect();
+                return Err(Failure::Usage(format!(
+                    "the command line has {errors} error{} (in {}); the scene has no errors of its own",
+                    if errors == 1 { "" } else { "s" },
+                    quoted.join(", ")
+                )));
+            }
             let _ = writeln!(
                 std::io::stderr(),
                 "error: {} has {errors} error{}",

@@ -236,9 +236,16 @@ fn defines_override_constants_and_unknown_ones_are_errors() {
     let objects_4 = stdout(&output);
     assert_ne!(objects_3, objects_4, "-D N changes the scene");
 
+    // A mistake in the command line is bad usage (exit 2, the flag quoted), not an error of
+    // the scene (issue 27: it exited 1 and said "grid.scene has 1 error").
     let output = run(&["check", "scenes/bench/grid.scene", "-D", "NOPE=3"]);
-    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(output.status.code(), Some(2));
     assert!(stderr(&output).contains("NOPE"), "{}", stderr(&output));
+    assert!(
+        stderr(&output).contains("the command line has 1 error (in `-D NOPE`)"),
+        "{}",
+        stderr(&output)
+    );
 }
 
 #[test]
@@ -288,7 +295,7 @@ fn set_replaces_a_setting_for_every_command_and_reports_mistakes_in_its_text() {
     );
 
     let output = run(&["check", "scenes/whitted.scene", "--set", "max_dept=9"]);
-    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(output.status.code(), Some(2), "a wrong --set is bad usage");
     let message = stderr(&output);
     assert!(
         message.contains("there is no setting `max_dept`")
