@@ -360,8 +360,10 @@ fn common_mistake(text: &str, pos: usize, found_len: usize, file: FileId) -> Opt
         && bytes.get(pos - 1).is_some_and(u8::is_ascii_digit)
     {
         let number_start = text[..pos]
-            .rfind(|c: char| !(c.is_ascii_digit() || c == '.'))
-            .map_or(0, |i| i + 1);
+            .char_indices()
+            .rev()
+            .find(|&(_, c)| !(c.is_ascii_digit() || c == '.'))
+            .map_or(0, |(i, c)| i + c.len_utf8());
         let number = &text[number_start..pos];
         let advice = match found {
             "px" | "pixels" => format!("sizes are in pixels already: write `{number}`"),

@@ -58,6 +58,12 @@ fn common_mistakes() {
             ),
             ("`;` after a property", "sphere { radius 1; }\n"),
             ("pixels after a number", "settings { width 640px }\n"),
+            // A wide character just before the number (a byte-order mark the grammar
+            // takes for white space) once made the number's start a byte inside it.
+            (
+                "a unit after a number after a wide character",
+                "settings { width\u{feff}640px }\n",
+            ),
             (
                 "degrees after a number",
                 "camera perspective { fov 45deg }\n",
