@@ -139,16 +139,21 @@ pub fn on_quadric(matrix: &DMat4, p: Vec3A) -> BoundedPoint {
     }
 }
 
+/// The whole-ray bound, in ulps of the magnitudes a point `origin + t·d` came from: the
+/// rounding of that sum and of `t` itself (every intersection routine solves relative to
+/// the ray origin or a shape's centre), with a margin for a change of space.
+const ALONG_RAY_ULPS: f32 = 32.0;
+
 /// A point that no shape-specific rule places (a torus's quartic root): `origin + t·d`,
-/// bounded by a margin of ulps over the magnitudes it was computed from (the whole-ray
-/// bound whitted used for every shape before).
+/// bounded by [`ALONG_RAY_ULPS`] over the magnitudes it was computed from (the bound
+/// whitted used for every shape before).
 #[inline]
 pub fn along_ray(origin: Vec3A, direction: Vec3A, t: f32) -> BoundedPoint {
     let point = origin + t * direction;
     let magnitude = origin.abs().max_element() + t.abs() + point.abs().max_element();
     BoundedPoint {
         point,
-        error: Vec3A::splat(magnitude * f32::EPSILON * 32.0),
+        error: Vec3A::splat(magnitude * f32::EPSILON * ALONG_RAY_ULPS),
     }
 }
 
@@ -263,6 +268,21 @@ mod tests {
                 out.error
             );
         }
+    }
+
+    #[test]
+    fn the_whole_ray_bound_grows_with_the_magnitudes() {
+        // Close to the origin and to the eye: a few millionths.
+        let near = along_ray(Vec3A::new(0.0, 1.0, 0.0), Vec3A::new(0.0, -1.0, 0.0), 1.0);
+        assert!(near.error.x < 1e-5 && near.error.x > 0.0, "{}", near.error);
+        // Far away it moves the point by several ulps.
+        let far = along_ray(Vec3A::splat(1.0e5), Vec3A::new(0.0, 0.0, 1.0), 10.0);
+        let p = far.point.z;
+        assert!(
+            p + far.error.z > p + 4.0 * (p * f32::EPSILON),
+            "{}",
+            far.error
+        );
     }
 
     #[test]

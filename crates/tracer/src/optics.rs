@@ -1,5 +1,6 @@
 //! The optics of Whitted's model as small pure functions: reflection, Snell refraction,
-//! Schlick's and the exact Fresnel terms, light attenuation and the spot-light cone, and the surface offset.
+//! Schlick's and the exact Fresnel terms, light attenuation, the spot-light cone and Beer-Lambert absorption (the surface offset is
+//! `hit_error.rs`).
 //!
 //! They are kept free of scene types so that unit tests can check each formula numerically.
 
@@ -102,28 +103,6 @@ pub fn spot_factor(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
         let x = (cos_angle - cos_outer) / (cos_inner - cos_outer);
         x * x * (3.0 - 2.0 * x)
     }
-}
-
-/// The error bound of a computed hit point, in units of f32's epsilon times the magnitudes
-/// it was computed from. The point `p = o + t·d` carries the rounding of that sum (a few
-/// ulps of `|o|`, `t` and `|p|`) and the error of `t` itself: every intersection routine
-/// solves in coordinates relative to the ray origin or a shape's centre, so `t` is known to
-/// a few ulps of `|o| + t + |p|` (pbrt-v4 and Ray Tracing Gems ch. 6 bound it the same way,
-/// shape by shape; one bound for all shapes is looser but simple). Transformed shapes lose
-/// a few more ulps in their change of space: hence a margin over the handful of roundings.
-const HIT_ERROR_ULPS: f32 = 32.0;
-
-/// How far a secondary ray starts off the surface: the floating-point error bound of the
-/// hit point `point = origin + t·direction` (see [`HIT_ERROR_ULPS`]), so that the new ray
-/// cannot meet the surface it leaves, and no farther, so that thin features next to the
-/// point still block it. Near the origin and close to the eye this is a few millionths
-/// where a fixed offset of 1e-4 let grazing shadow rays pass over thin rims. A scene's
-/// explicit `epsilon` replaces it (see `Tracer`).
-#[inline]
-pub fn surface_offset(origin: Vec3A, t: f32, point: Vec3A) -> f32 {
-    let magnitude = origin.abs().max_element() + t.abs() + point.abs().max_element();
-    // Never zero (a hit at the origin from the origin): the smallest normal f32 at least.
-    (magnitude * f32::EPSILON * HIT_ERROR_ULPS).max(f32::MIN_POSITIVE)
 }
 
 /// The largest of the three channels: the path-weight test looks at the strongest one.
@@ -328,20 +307,5 @@ mod tests {
         assert!(close(t.z, (-1.0f32).exp(), 1e-7));
         let infinite = beer_lambert(Vec3A::new(0.0, 1.0, 0.0), f32::INFINITY);
         assert_eq!(infinite, Vec3A::new(1.0, 0.0, 1.0));
-    }
-
-    #[test]
-    fn offset_follows_the_error_bound() {
-        // Close to the origin and to the eye: a few millionths, far below the old 1e-4.
-        let near = surface_offset(Vec3A::new(0.0, 1.0, 0.0), 1.0, Vec3A::ZERO);
-        assert!(near < 1e-5 && near > 0.0, "{near}");
-        // It grows with the magnitudes the point was computed from.
-        let far = surface_offset(Vec3A::splat(1.0e5), 10.0, Vec3A::splat(1.0e5));
-        assert!(far > 1.0e5 * f32::EPSILON * 16.0, "{far}");
-        // Far enough to move the point by several ulps.
-        let p = 1.0e5f32;
-        assert!(p + far > p + 4.0 * (p * f32::EPSILON));
-        // Never zero.
-        assert!(surface_offset(Vec3A::ZERO, 0.0, Vec3A::ZERO) > 0.0);
     }
 }

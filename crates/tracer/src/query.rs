@@ -82,6 +82,15 @@ pub struct Surface<'a> {
     pub leaf: &'a Leaf,
 }
 
+/// Which surfaces [`PreparedScene::crossings_between`] reports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Crossed {
+    /// Only the surfaces of solids (nested media).
+    Solids,
+    /// Every surface.
+    Any,
+}
+
 /// Per-thread buffers that queries reuse from ray to ray.
 #[derive(Clone, Debug, Default)]
 pub struct Scratch {
@@ -448,52 +457,23 @@ impl PreparedScene {
         }
     }
 
-    /// Every crossing of a solid's surface strictly inside `(t − window, t + window)` (and
-    /// beyond `tmin`), for nested media: surfaces that close together are crossed as one.
-    /// `found` gets each crossing and returns whether to go on.
-    pub(crate) fn solid_crossings_near(
+    /// Every crossing of a surface (of a solid's only, with [`Crossed::Solids`]) strictly
+    /// inside `(low, high)`: the surfaces in the same place as a hit, crossed as one by
+    /// nested media, or told apart by nothing but rounding (z-fighting). `found` gets each
+    /// crossing and returns whether to go on.
+    pub(crate) fn crossings_between(
         &self,
         ray: &Ray,
-        tmin: f32,
-        t: f32,
-        window: f32,
-        scratch: &mut Scratch,
-        found: impl FnMut(Hit) -> bool,
-    ) {
-        self.crossings_near(ray, tmin, t, window, true, scratch, found);
-    }
-
-    /// Every crossing of any surface strictly inside `(t − window, t + window)` (and beyond
-    /// `tmin`): the surfaces a recorded hit cannot be told apart from (z-fighting).
-    pub(crate) fn surface_crossings_near(
-        &self,
-        ray: &Ray,
-        tmin: f32,
-        t: f32,
-        window: f32,
-        scratch: &mut Scratch,
-        found: impl FnMut(Hit) -> bool,
-    ) {
-        self.crossings_near(ray, tmin, t, window, false, scratch, found);
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn crossings_near(
-        &self,
-        ray: &Ray,
-        tmin: f32,
-        t: f32,
-        window: f32,
-        solids_only: bool,
+        (low, high): (f32, f32),
+        crossed: Crossed,
         scratch: &mut Scratch,
         mut found: impl FnMut(Hit) -> bool,
     ) {
         let Scratch { csg, bvh_stack, .. } = scratch;
-        let (low, high) = ((t - window).max(tmin), t + window);
         self.visit(ray, low, high, bvh_stack, |item_ref, item, _| {
             let mut from = low;
             while let Some((t, leaf, part, flip)) = item_hit(item, ray, from, high, csg) {
-                if !solids_only || item.leaf(leaf).geometry.is_solid() {
+                if crossed == Crossed::Any || item.leaf(leaf).geometry.is_solid() {
                     let hit = Hit {
                         t,
                         item: item_ref,

@@ -19,7 +19,7 @@ use crate::bvh::PACKET;
 use crate::material::PreparedMaterial;
 use crate::media::{same_medium, Medium, MediumStack};
 use crate::optics::{beer_lambert, fresnel_exact, max_channel, reflect, refract, schlick};
-use crate::query::{Hit, Scratch, Shadow, Surface};
+use crate::query::{Crossed, Hit, Scratch, Shadow, Surface};
 use crate::ray::Ray;
 use crate::recorder::{
     CoincidentSurface, Interface, LightSample, NoShadowRay, RayKind, RayStart, Recorder, ShadowRay,
@@ -254,7 +254,8 @@ impl<'a> Tracer<'a> {
         let surface = scene.surface(ray, &first);
         let window = coincident_window(ray, first.t, &surface);
         let mut preferred = None;
-        scene.surface_crossings_near(ray, 0.0, first.t, window, &mut self.scratch, |other| {
+        let range = ((first.t - window).max(0.0), first.t + window);
+        scene.crossings_between(ray, range, Crossed::Any, &mut self.scratch, |other| {
             if scene.item(other.item).object() == object {
                 preferred = Some(other);
                 return false;
@@ -676,7 +677,8 @@ impl<'a> Tracer<'a> {
                 },
             }
         };
-        scene.solid_crossings_near(ray, tmin, first.hit.t, window, &mut self.scratch, |hit| {
+        let range = ((first.hit.t - window).max(tmin), first.hit.t + window);
+        scene.crossings_between(ray, range, Crossed::Solids, &mut self.scratch, |hit| {
             near[count] = crossing(hit);
             count += 1;
             count < MOST
@@ -879,7 +881,8 @@ impl<'a> Tracer<'a> {
         let window = coincident_window(ray, hit.t, surface);
         let mut near = [None; 4];
         let mut count = 0;
-        scene.surface_crossings_near(ray, 0.0, hit.t, window, &mut self.scratch, |other| {
+        let range = ((hit.t - window).max(0.0), hit.t + window);
+        scene.crossings_between(ray, range, Crossed::Any, &mut self.scratch, |other| {
             if other.item == hit.item && other.leaf == hit.leaf {
                 return true;
             }

@@ -508,27 +508,32 @@ fn mirror_shape(shape: &Shape) -> Shape {
     }
 }
 
-fn mirror_light(light: &Light) -> Light {
+/// `light` with its position mapped by `position` and its direction by `direction`.
+fn map_light(
+    light: &Light,
+    position: impl Fn(DVec3) -> DVec3,
+    direction: impl Fn(DVec3) -> DVec3,
+) -> Light {
     let kind = match &light.kind {
         LightKind::Point {
-            position,
+            position: p,
             attenuation,
         } => LightKind::Point {
-            position: mirror(*position),
+            position: position(*p),
             attenuation: *attenuation,
         },
-        LightKind::Directional { direction } => LightKind::Directional {
-            direction: mirror(*direction),
+        LightKind::Directional { direction: d } => LightKind::Directional {
+            direction: direction(*d),
         },
         LightKind::Spot {
-            position,
-            direction,
+            position: p,
+            direction: d,
             inner_angle_degrees,
             outer_angle_degrees,
             attenuation,
         } => LightKind::Spot {
-            position: mirror(*position),
-            direction: mirror(*direction),
+            position: position(*p),
+            direction: direction(*d),
             inner_angle_degrees: *inner_angle_degrees,
             outer_angle_degrees: *outer_angle_degrees,
             attenuation: *attenuation,
@@ -538,6 +543,10 @@ fn mirror_light(light: &Light) -> Light {
         kind,
         ..light.clone()
     }
+}
+
+fn mirror_light(light: &Light) -> Light {
+    map_light(light, mirror, mirror)
 }
 
 /// x -> -x on every object, light and the camera. The camera's basis is derived from eye,
@@ -849,33 +858,7 @@ fn raising_max_depth_changes_only_pixels_cut_by_it() {
 // (e) Moving the whole scene far away.
 
 fn moved_light(light: &Light, by: DVec3) -> Light {
-    let kind = match &light.kind {
-        LightKind::Point {
-            position,
-            attenuation,
-        } => LightKind::Point {
-            position: *position + by,
-            attenuation: *attenuation,
-        },
-        LightKind::Spot {
-            position,
-            direction,
-            inner_angle_degrees,
-            outer_angle_degrees,
-            attenuation,
-        } => LightKind::Spot {
-            position: *position + by,
-            direction: *direction,
-            inner_angle_degrees: *inner_angle_degrees,
-            outer_angle_degrees: *outer_angle_degrees,
-            attenuation: *attenuation,
-        },
-        directional => directional.clone(),
-    };
-    Light {
-        kind,
-        ..light.clone()
-    }
+    map_light(light, |p| p + by, |d| d)
 }
 
 /// The scene, camera and lights moved by `by`.

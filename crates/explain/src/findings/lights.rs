@@ -42,6 +42,15 @@ fn diffuse_surface(context: &Context<'_>, node: &RayNode) -> bool {
         .is_some_and(|m| !m.diffuse.is_black())
 }
 
+/// Who sees the point a ray hit, for messages: the camera, or the path that reached it.
+fn seen_by(node: &RayNode) -> &'static str {
+    if node.kind == RayKind::Camera {
+        "the camera"
+    } else {
+        "this path"
+    }
+}
+
 fn light_behind(node: &RayNode, findings: &mut Vec<Finding>) {
     let (Some(hit), Some(local)) = (&node.hit, &node.local) else {
         return;
@@ -51,11 +60,7 @@ fn light_behind(node: &RayNode, findings: &mut Vec<Finding>) {
     if !hit.front_face && hit.object.kind != "plane" {
         return;
     }
-    let seen_by = if node.kind == RayKind::Camera {
-        "the camera"
-    } else {
-        "this path"
-    };
+    let seen_by = seen_by(node);
     for light in &local.lights {
         if light.visibility != Visibility::FacingAway {
             continue;
@@ -96,11 +101,7 @@ fn outside_cone(node: &RayNode, findings: &mut Vec<Finding>) {
     let (Some(hit), Some(local)) = (&node.hit, &node.local) else {
         return;
     };
-    let seen_by = if node.kind == RayKind::Camera {
-        "the camera"
-    } else {
-        "this path"
-    };
+    let seen_by = seen_by(node);
     for light in &local.lights {
         if light.visibility != Visibility::OutsideCone {
             continue;
