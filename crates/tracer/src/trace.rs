@@ -255,8 +255,11 @@ impl<'a> Tracer<'a> {
         let window = coincident_window(ray, first.t, &surface);
         let mut preferred = None;
         let range = ((first.t - window).max(0.0), first.t + window);
+        let normal = surface.geometric_normal;
         scene.crossings_between(ray, range, Crossed::Any, &mut self.scratch, |other| {
-            if scene.item(other.item).object() == object {
+            if scene.item(other.item).object() == object
+                && parallel(scene.surface(ray, &other).geometric_normal, normal)
+            {
                 preferred = Some(other);
                 return false;
             }
@@ -892,6 +895,12 @@ impl<'a> Tracer<'a> {
         });
         for other in near.iter().flatten() {
             let found = scene.surface(ray, other);
+            // Two surfaces that meet at an edge (a wall on a floor) are both crossed there
+            // at the same distance, but they are not in the same place: only a surface
+            // parallel to the hit's is.
+            if !parallel(found.geometric_normal, surface.geometric_normal) {
+                continue;
+            }
             rec.coincident_surface(&CoincidentSurface {
                 t: other.t,
                 object: found.item.object(),
@@ -978,6 +987,17 @@ fn coincident_window(ray: &Ray, t: f32, surface: &Surface<'_>) -> f32 {
     let rounding_of_t = (t + ray.origin.abs().max_element()) * f32::EPSILON * COINCIDENT_T_ULPS;
     (COINCIDENT_BOUNDS * bound / cos).max(rounding_of_t)
 }
+
+/// Whether two unit normals are parallel (either way round): surfaces that cross a ray at
+/// one distance with parallel normals lie in one place there (z-fighting); with others
+/// they only meet at an edge.
+#[inline]
+fn parallel(a: Vec3A, b: Vec3A) -> bool {
+    a.dot(b).abs() > PARALLEL_COS
+}
+
+/// The cosine above which two normals count as parallel: within about 2.6°.
+const PARALLEL_COS: f32 = 0.999;
 
 /// Where a trace's first hit comes from.
 #[derive(Clone, Copy)]
