@@ -13,8 +13,9 @@ use whitted_tracer::{NoObserver, PreparedScene};
 
 use crate::cli::{DiffArgs, RenderOverrides, SceneArgs, TraceArgs};
 use crate::image_output::to_srgb8;
-use crate::render_cmd::{check_image_size, render_options};
+use crate::render_cmd::check_image_size;
 use crate::scene_input::{load_scene, write_json_stdout, write_stdout};
+use crate::setting_flags::apply_render_flags;
 use crate::Failure;
 
 /// `whitted diff`.
@@ -84,8 +85,8 @@ fn pixel_diff(
     scene_b.set.extend(against_set.iter().cloned());
     let loaded_a = load_scene(scene_a, true)?;
     let loaded_b = load_scene(&scene_b, true)?;
-    let options_a = render_options(&loaded_a.scene.settings, overrides);
-    let options_b = render_options(&loaded_b.scene.settings, overrides);
+    let (loaded_a, options_a) = apply_render_flags(loaded_a, overrides)?;
+    let (loaded_b, options_b) = apply_render_flags(loaded_b, overrides)?;
     for options in [&options_a, &options_b] {
         check_request(options, x, y, SampleChoice::All)
             .map_err(|error| Failure::Usage(error.to_string()))?;
@@ -136,7 +137,7 @@ struct RegionDocument<'a> {
 
 fn against_image(args: &DiffArgs, reference_path: &Path) -> Result<(), Failure> {
     let loaded = load_scene(&args.scene, true)?;
-    let options = render_options(&loaded.scene.settings, &args.overrides);
+    let (loaded, options) = apply_render_flags(loaded, &args.overrides)?;
     let reference = image::open(reference_path)
         .map_err(|e| Failure::Message(format!("cannot read {}: {e}", reference_path.display())))?
         .to_rgb8();

@@ -6,13 +6,13 @@ use whitted_tracer::ray_tree::{check_request, SampleChoice};
 use whitted_tracer::PreparedScene;
 
 use crate::cli::ExplainArgs;
-use crate::render_cmd::render_options;
 use crate::scene_input::{load_scene, write_json_stdout, write_stdout};
+use crate::setting_flags::apply_render_flags;
 use crate::Failure;
 
 pub fn explain_pixel(args: &ExplainArgs) -> Result<(), Failure> {
     let loaded = load_scene(&args.scene, false)?;
-    let options = render_options(&loaded.scene.settings, &args.overrides);
+    let (loaded, options) = apply_render_flags(loaded, &args.overrides)?;
     let [x, y] = args.pixel;
     // A pixel outside the image is a usage error (exit 2), found before the BVH build.
     check_request(&options, x, y, SampleChoice::All)

@@ -5,7 +5,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use whitted_ir::{Diagnostic, FileId, Severity, SourceMap, Span, ValidScene};
+use whitted_ir::{Diagnostic, Severity, SourceMap, ValidScene};
 use whitted_lang::{compile_file, CompileOptions, SourceLoader};
 use whitted_mit6837::{CourseOptions, MeshLoader};
 
@@ -117,42 +117,15 @@ pub fn compile(args: &SceneArgs, course: &CourseOptions) -> Compiled {
     let Some(scene) = compiled.scene.take() else {
         return compiled;
     };
-    // `--set` through the language's rows, from the 6.837 scene's own settings.
-    let options = CompileOptions {
-        settings: args.set.clone(),
-        ..CompileOptions::default()
-    };
-    let overridden = whitted_lang::override_settings(&scene.settings, &options);
-    // Its files (the `--set` pseudo-files) join the scene's sources after the scene's own,
-    // so that its diagnostics are shown with the scene's: every span moves by that many.
-    let offset = compiled.sources.files().len() as u32;
-    for (_, file) in overridden.sources.files() {
-        compiled.sources.add(file.clone());
-    }
-    let shift = |span: &mut Span| {
-        if !span.is_detached() {
-            span.file = FileId(span.file.0 + offset);
+    // `--set` through the IR's settings table, from the 6.837 scene's own settings.
+    match crate::setting_flags::apply_course_sets(scene, &args.set) {
+        Ok(scene) => {
+            compiled.sources = scene.sources.clone();
+            compiled.scene = Some(scene);
         }
-    };
-    let mut diagnostics = overridden.diagnostics;
-    for diagnostic in &mut diagnostics {
-        if let Some(span) = &mut diagnostic.span {
-            shift(span);
-        }
-        for label in &mut diagnostic.secondary {
-            shift(&mut label.span);
-        }
-    }
-    compiled.diagnostics.extend(diagnostics);
-    if let Some(settings) = overridden.scene.map(|s| s.settings.clone()) {
-        let mut scene = scene.into_inner();
-        scene.settings = settings;
-        scene.sources = compiled.sources.clone();
-        // The settings passed the same checks in the empty scene; validation checks them
-        // against this scene's objects too.
-        match whitted_ir::validate(scene) {
-            Ok(valid) => compiled.scene = Some(valid),
-            Err(invalid) => compiled.diagnostics.extend(invalid.diagnostics),
+        Err((scene, diagnostics)) => {
+            compiled.sources = scene.sources;
+            compiled.diagnostics.extend(diagnostics);
         }
     }
     compiled

@@ -18,6 +18,7 @@ mod mit6837_cmd;
 mod query_cmd;
 mod render_cmd;
 mod scene_input;
+mod setting_flags;
 mod stats_image;
 mod trace_cmd;
 

@@ -11,8 +11,8 @@ use whitted_tracer::PreparedScene;
 
 use crate::cli::{ImageFormat, QueryArgs};
 use crate::image_output::{write_image, Pixels};
-use crate::render_cmd::{check_image_size, render_options};
 use crate::scene_input::{load_scene, write_json_stdout, write_stdout};
+use crate::setting_flags::apply_render_flags;
 use crate::Failure;
 
 /// The version of `whitted query --json`'s document (docs/query.md).
@@ -52,8 +52,7 @@ struct WitnessDocument {
 
 pub fn query(args: &QueryArgs) -> Result<(), Failure> {
     let loaded = load_scene(&args.scene, true)?;
-    let options = render_options(&loaded.scene.settings, &args.overrides);
-    check_image_size(options.width, options.height)?;
+    let (loaded, options) = apply_render_flags(loaded, &args.overrides)?;
     if let Some(mask) = &args.mask {
         if crate::render_cmd::same_file(mask, &args.scene.scene) {
             return Err(Failure::Usage(format!(

@@ -5,14 +5,15 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use whitted_ir::{limits, Settings, SourceMap};
+use whitted_ir::{limits, SourceMap};
 use whitted_tracer::{
     PreparedScene, RenderObserver, RenderOptions, RenderStats, TileResult, TraversalPath,
 };
 
-use crate::cli::{ImageFormat, RenderArgs, RenderOverrides, StatsFormat};
+use crate::cli::{ImageFormat, RenderArgs, StatsFormat};
 use crate::image_output::{write_image, Pixels};
 use crate::scene_input::{load_scene, write_stdout};
+use crate::setting_flags::apply_render_flags;
 use crate::stats_image::StatsImage;
 use crate::Failure;
 
@@ -26,34 +27,6 @@ impl RenderObserver for ProgressObserver {
         if let Some(bar) = &self.bar {
             bar.inc(u64::from(tile.width) * u64::from(tile.height));
         }
-    }
-}
-
-/// The scene's render settings with the command line's overrides applied: shared by
-/// `render` and `trace`, so that a trace at a given size follows the render at that size.
-pub fn render_options(settings: &Settings, overrides: &RenderOverrides) -> RenderOptions {
-    let mut options = RenderOptions::from_settings(settings);
-    (options.width, options.height) = image_size(
-        (settings.width, settings.height),
-        overrides.width,
-        overrides.height,
-    );
-    options.samples_per_pixel = overrides.spp.unwrap_or(options.samples_per_pixel);
-    options.max_depth = overrides.max_depth.unwrap_or(options.max_depth);
-    options
-}
-
-/// The size of the image to make: both flags give exactly that size; one alone keeps the
-/// scene's aspect ratio, as every image tool does (`--width 320` of a 640x480 scene is
-/// 320x240, not a 320x480 crop), the other side rounded and at least 1.
-fn image_size(scene: (u32, u32), width: Option<u32>, height: Option<u32>) -> (u32, u32) {
-    let (scene_width, scene_height) = (f64::from(scene.0.max(1)), f64::from(scene.1.max(1)));
-    let side = |value: f64| value.round().clamp(1.0, f64::from(u32::MAX)) as u32;
-    match (width, height) {
-        (Some(w), Some(h)) => (w, h),
-        (Some(w), None) => (w, side(f64::from(w) * scene_height / scene_width)),
-        (None, Some(h)) => (side(f64::from(h) * scene_width / scene_height), h),
-        (None, None) => scene,
     }
 }
 
@@ -244,13 +217,12 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     crate::interrupt::install();
 
     let loaded = load_scene(&args.scene, args.quiet)?;
+    let (loaded, options) = apply_render_flags(loaded, &args.overrides)?;
     let compile_seconds = started.elapsed().as_secs_f64();
     refuse_outputs_over_sources(&args.scene.scene, &loaded.scene.sources, &output)?;
     if let Some(stats_image) = &args.stats_image {
         refuse_outputs_over_sources(&args.scene.scene, &loaded.scene.sources, stats_image)?;
     }
-    let options = render_options(&loaded.scene.settings, &args.overrides);
-    check_image_size(options.width, options.height)?;
     let estimate = MemoryEstimate {
         pixels: u64::from(options.width) * u64::from(options.height),
         output: format,
@@ -534,17 +506,6 @@ mod tests {
     use super::*;
 
     const MAX: u64 = whitted_ir::limits::MAX_PIXELS;
-
-    #[test]
-    fn one_side_keeps_the_aspect_ratio_and_both_give_the_size() {
-        assert_eq!(image_size((640, 480), Some(320), None), (320, 240));
-        assert_eq!(image_size((640, 480), None, Some(60)), (80, 60));
-        assert_eq!(image_size((640, 480), Some(100), Some(100)), (100, 100));
-        assert_eq!(image_size((640, 480), None, None), (640, 480));
-        // Rounded, never 0.
-        assert_eq!(image_size((1000, 1), Some(10), None), (10, 1));
-        assert_eq!(image_size((160, 75), Some(33), None), (33, 15));
-    }
 
     fn estimate(pixels: u64, output: ImageFormat, stats: Option<ImageFormat>) -> u64 {
         MemoryEstimate {

@@ -8,13 +8,13 @@ use whitted_tracer::ray_tree::{
 use whitted_tracer::PreparedScene;
 
 use crate::cli::TraceArgs;
-use crate::render_cmd::render_options;
 use crate::scene_input::{load_scene, write_json_stdout, write_stdout};
+use crate::setting_flags::apply_render_flags;
 use crate::Failure;
 
 pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
     let loaded = load_scene(&args.scene, false)?;
-    let options = render_options(&loaded.scene.settings, &args.overrides);
+    let (loaded, options) = apply_render_flags(loaded, &args.overrides)?;
     let [x, y] = args.pixel;
     let which = match args.sample {
         Some(sample) => SampleChoice::One(sample),

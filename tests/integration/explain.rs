@@ -483,3 +483,24 @@ fn a_spot_cone_that_misses_is_outside_the_cone_not_behind() {
         "{findings:#?}"
     );
 }
+
+/// `--max-depth` goes into the scene's settings before it is prepared, so explain speaks of
+/// the depth actually traced, says where it was set (the flag, not the scene's `max_depth 8`)
+/// and the fix changes the flag.
+#[test]
+fn a_depth_given_as_a_flag_is_the_depth_explained_and_fixed() {
+    let output = run(&[
+        "explain",
+        "scenes/glass.scene",
+        "--pixel",
+        "200,100",
+        "--max-depth",
+        "1",
+    ]);
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{text}");
+    assert!(text.contains("max depth 1,"), "{text}");
+    assert!(text.contains("max_depth at <--max-depth 1>:1:1"), "{text}");
+    assert!(text.contains("run with --max-depth 3 instead"), "{text}");
+    assert!(!text.contains("scenes/glass.scene:5"), "{text}");
+}

@@ -23,3 +23,4 @@ mod reshade;
 mod tidy;
 mod trace_cli;
 mod traversal_paths;
+mod write_back;

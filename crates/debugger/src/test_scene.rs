@@ -4,9 +4,9 @@
 use std::sync::Arc;
 
 use whitted_ir::{
-    validate, Attenuation, Camera, Color, DMat4, DVec3, FileId, Handle, Light, LightKind, Material,
-    Object, ObjectKind, Pattern, PatternKind, Projection, Scene, Shape, SourceFile, Span,
-    ValidScene,
+    validate, Attenuation, BlockKind, Camera, Color, DMat4, DVec3, FileId, Handle, Light,
+    LightKind, Material, Object, ObjectKind, Pattern, PatternKind, Projection, Scene, Shape,
+    SourceFile, Span, ValidScene, WrittenBlock, WrittenProperty,
 };
 use whitted_tracer::ray_tree::{trace_pixel, RayTree, SampleChoice};
 use whitted_tracer::{PreparedScene, RenderOptions};
@@ -181,7 +181,98 @@ pub fn whitted_scene() -> ValidScene {
         mirror,
         "sphere \"mirror sphere\"",
     );
+    record_written(&mut scene, file);
     validate(scene).expect("the hand-built scene is valid")
+}
+
+/// The table of written properties, as the language fills it: each block (with the span
+/// the arena keeps for what it made) and where each of its properties' names and values are.
+fn record_written(scene: &mut Scene, file: FileId) {
+    let settings_at = SCENE_TEXT.find("settings {").expect("settings");
+    let settings = Span::new(file, settings_at, settings_at + "settings".len());
+    let light = scene.lights.iter_with_spans().next().map(|(_, _, s)| s);
+    let material = |name: &str| {
+        scene
+            .materials
+            .iter_with_spans()
+            .find(|(_, m, _)| m.name.as_deref() == Some(name))
+            .map(|(_, _, span)| span)
+    };
+    let blocks = [
+        (
+            BlockKind::Settings,
+            Some(settings),
+            &[
+                ("width", "640"),
+                ("height", "480"),
+                ("max_depth", "5"),
+                ("background", "rgb(0.10, 0.30, 0.75)"),
+            ][..],
+        ),
+        (
+            BlockKind::Camera,
+            Some(scene.camera_span),
+            &[
+                ("eye", "<0, 1.6, -6.5>"),
+                ("look_at", "<0, 1, 0>"),
+                ("fov", "45"),
+            ][..],
+        ),
+        (
+            BlockKind::Light,
+            light,
+            &[("position", "<-6, 10, -8>"), ("color", "white")][..],
+        ),
+        (
+            BlockKind::Material,
+            material("glass"),
+            &[
+                ("ambient", "0"),
+                ("diffuse", "0.05"),
+                ("specular", "0.8"),
+                ("shininess", "200"),
+                ("reflective", "0.1"),
+                ("transmissive", "0.9"),
+                ("ior", "1.5"),
+            ][..],
+        ),
+        (
+            BlockKind::Material,
+            material("mirror"),
+            &[
+                ("ambient", "0.05"),
+                ("diffuse", "0.1"),
+                ("specular", "0.8"),
+                ("shininess", "120"),
+                ("reflective", "0.8"),
+            ][..],
+        ),
+    ];
+    for (kind, header, properties) in blocks {
+        let header = header.expect("the block's span");
+        let open =
+            header.start as usize + SCENE_TEXT[header.start as usize..].find('{').expect("{");
+        let close = open + SCENE_TEXT[open..].find('}').expect("}");
+        let block = scene.written.add_block(WrittenBlock {
+            kind,
+            header,
+            body: Span::new(file, open, close + 1),
+        });
+        for (name, value) in properties {
+            let written = format!("{name} {value}");
+            let at = open
+                + SCENE_TEXT[open..close]
+                    .find(&written)
+                    .expect("written in the block");
+            let value_at = at + name.len() + 1;
+            scene.written.add_property(WrittenProperty {
+                block,
+                name,
+                name_span: Span::new(file, at, at + name.len()),
+                value_span: Span::new(file, value_at, value_at + value.len()),
+            });
+        }
+    }
 }
 
 /// The scene with everything a test of the app needs.

@@ -1,56 +1,103 @@
 //! What-if: the values the what-if popup (`w`) can change (render settings, the selected
-//! ray's material, the lights' colours), reading a typed value within the range the scene
-//! language accepts, and a copy of the scene with one value changed, validated again.
+//! ray's material, the lights' colours), each an (owner, row) pair whose row is the IR's
+//! table row for the value (its name, range, and how to read and write it), reading a typed
+//! value within that range, and a copy of the scene with one value changed, validated again.
 
-use whitted_ir::limits::{MAX_DEPTH, MAX_INTENSITY, MAX_IOR, MAX_REFLECTANCE, MIN_IOR, MIN_SIZE};
-use whitted_ir::{validate, Color, Handle, Light, Material, Scene, ValidScene};
+use whitted_ir::properties::{self, ColorLimit, MaterialColor, MaterialNumber};
+use whitted_ir::setting_rows::{self, plain_color, plain_number, SettingKind, SettingRow};
+use whitted_ir::{validate, Handle, Light, Material, Scene, ValidScene};
 
-/// One value the popup can change.
+pub use whitted_ir::setting_rows::{value_text, SettingValue as Value};
+
+/// What holds a value: the settings, a material or a light.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Param {
-    MaxDepth,
-    MinWeight,
-    Epsilon,
-    Ior(Handle<Material>),
-    Reflective(Handle<Material>),
-    Transmissive(Handle<Material>),
-    LightColor(Handle<Light>),
+pub enum Owner {
+    Settings,
+    Material(Handle<Material>),
+    Light(Handle<Light>),
 }
 
-/// A typed value, checked against its range.
+/// The table row of a value: a setting, a material's colour or number, a light's colour.
+#[derive(Clone, Copy, Debug)]
+pub enum Row {
+    Setting(&'static SettingRow),
+    MaterialColor(&'static MaterialColor),
+    MaterialNumber(&'static MaterialNumber),
+    LightColor,
+}
+
+impl Row {
+    /// The property's name in the scene language.
+    pub fn name(self) -> &'static str {
+        match self {
+            Row::Setting(row) => row.name,
+            Row::MaterialColor(row) => row.name,
+            Row::MaterialNumber(row) => row.name,
+            Row::LightColor => "color",
+        }
+    }
+}
+
+impl PartialEq for Row {
+    /// Rows are the same row when they name the same value of the same table.
+    fn eq(&self, other: &Row) -> bool {
+        std::mem::discriminant(self) == std::mem::discriminant(other) && self.name() == other.name()
+    }
+}
+
+/// One value the popup can change: which row, of which owner.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Value {
-    Whole(u32),
-    Number(f64),
-    Color(Color),
+pub struct Param {
+    pub owner: Owner,
+    pub row: Row,
 }
 
 impl Param {
+    pub fn setting(row: &'static SettingRow) -> Param {
+        Param {
+            owner: Owner::Settings,
+            row: Row::Setting(row),
+        }
+    }
+
+    pub fn material_color(h: Handle<Material>, row: &'static MaterialColor) -> Param {
+        Param {
+            owner: Owner::Material(h),
+            row: Row::MaterialColor(row),
+        }
+    }
+
+    pub fn material_number(h: Handle<Material>, row: &'static MaterialNumber) -> Param {
+        Param {
+            owner: Owner::Material(h),
+            row: Row::MaterialNumber(row),
+        }
+    }
+
+    pub fn light_color(h: Handle<Light>) -> Param {
+        Param {
+            owner: Owner::Light(h),
+            row: Row::LightColor,
+        }
+    }
+
     /// The property's name in the scene language.
     pub fn property(self) -> &'static str {
-        match self {
-            Param::MaxDepth => "max_depth",
-            Param::MinWeight => "min_weight",
-            Param::Epsilon => "epsilon",
-            Param::Ior(_) => "ior",
-            Param::Reflective(_) => "reflective",
-            Param::Transmissive(_) => "transmissive",
-            Param::LightColor(_) => "color",
-        }
+        self.row.name()
     }
 
     /// Where the value lives, in words: `settings`, `material glass`, `light sun`.
     pub fn owner(self, scene: &Scene) -> String {
-        match self {
-            Param::MaxDepth | Param::MinWeight | Param::Epsilon => "settings".to_string(),
-            Param::Ior(h) | Param::Reflective(h) | Param::Transmissive(h) => {
+        match self.owner {
+            Owner::Settings => "settings".to_string(),
+            Owner::Material(h) => {
                 let name = scene.materials.get(h).and_then(|m| m.name.clone());
                 format!(
                     "material {}",
                     name.unwrap_or_else(|| format!("#{}", h.index()))
                 )
             }
-            Param::LightColor(h) => {
+            Owner::Light(h) => {
                 let name = scene.lights.get(h).and_then(|l| l.name.clone());
                 format!(
                     "light {}",
@@ -62,40 +109,43 @@ impl Param {
 
     /// The accepted range in words, for the popup and for error messages.
     pub fn range(self) -> String {
-        match self {
-            Param::MaxDepth => format!("a whole number from 0 to {MAX_DEPTH}"),
-            Param::MinWeight => "a number from 0 to 1".to_string(),
-            Param::Epsilon => format!("a number from {MIN_SIZE:e} to 1"),
-            Param::Ior(_) => format!("a number from {MIN_IOR} to {MAX_IOR}"),
-            Param::Reflective(_) | Param::Transmissive(_) => {
-                format!("a grey 0 to {MAX_REFLECTANCE}, or rgb(r, g, b) in that range")
+        let color = |limit: ColorLimit| {
+            format!(
+                "a grey 0 to {}, or rgb(r, g, b) in that range",
+                short(limit.max)
+            )
+        };
+        match self.row {
+            Row::Setting(row) => row.kind.range_in_words(),
+            Row::MaterialColor(row) => color(row.limit),
+            Row::MaterialNumber(row) => {
+                format!("a number from {} to {}", short(row.min), short(row.max))
             }
-            Param::LightColor(_) => {
-                format!("a grey 0 to {MAX_INTENSITY:e}, or rgb(r, g, b) in that range")
-            }
+            Row::LightColor => color(properties::LIGHT_COLOR),
         }
     }
 
-    /// The value in `scene`; `None` for an automatic epsilon or a handle not in the scene.
+    /// The value in `scene`; `None` for an automatic epsilon or an owner not in the scene.
     pub fn current(self, scene: &Scene) -> Option<Value> {
-        let settings = &scene.settings;
-        Some(match self {
-            Param::MaxDepth => Value::Whole(settings.max_depth),
-            Param::MinWeight => Value::Number(settings.min_weight),
-            Param::Epsilon => Value::Number(settings.epsilon?),
-            Param::Ior(h) => Value::Number(scene.materials.get(h)?.ior),
-            Param::Reflective(h) => Value::Color(scene.materials.get(h)?.reflective),
-            Param::Transmissive(h) => Value::Color(scene.materials.get(h)?.transmissive),
-            Param::LightColor(h) => Value::Color(scene.lights.get(h)?.color),
-        })
+        match (self.owner, self.row) {
+            (Owner::Settings, Row::Setting(row)) => (row.get)(&scene.settings),
+            (Owner::Material(h), Row::MaterialColor(row)) => {
+                Some(Value::Color((row.get)(scene.materials.get(h)?)))
+            }
+            (Owner::Material(h), Row::MaterialNumber(row)) => {
+                Some(Value::Number((row.get)(scene.materials.get(h)?)))
+            }
+            (Owner::Light(h), Row::LightColor) => Some(Value::Color(scene.lights.get(h)?.color)),
+            _ => None,
+        }
     }
 
     /// The current value as the scene language writes it (`automatic` for epsilon unset).
     pub fn current_text(self, scene: &Scene) -> String {
-        match self.current(scene) {
-            Some(value) => value_text(value),
-            None if self == Param::Epsilon => "automatic".to_string(),
-            None => "?".to_string(),
+        match (self.current(scene), self.row) {
+            (Some(value), _) => value_text(value),
+            (None, Row::Setting(row)) => row.default.to_string(),
+            (None, _) => "?".to_string(),
         }
     }
 
@@ -103,36 +153,31 @@ impl Param {
     pub fn parse(self, text: &str) -> Result<Value, String> {
         let text = text.trim();
         let out_of_range = || format!("{} must be {}", self.property(), self.range());
-        match self {
-            Param::MaxDepth => {
-                let depth: u32 = text.parse().map_err(|_| out_of_range())?;
-                (depth <= MAX_DEPTH)
-                    .then_some(Value::Whole(depth))
+        let color_within = |max: f64| {
+            let color = plain_color(text).ok_or_else(out_of_range)?;
+            [color.r, color.g, color.b]
+                .iter()
+                .all(|c| (0.0..=max).contains(c))
+                .then_some(Value::Color(color))
+                .ok_or_else(out_of_range)
+        };
+        match self.row {
+            Row::Setting(row) => {
+                if let SettingKind::Number { .. } = row.kind {
+                    // Only plain decimals: no `inf` or `nan`, which Rust's parser takes.
+                    plain_number(text).ok_or_else(out_of_range)?;
+                }
+                row.parse(text).map_err(|_| out_of_range())
+            }
+            Row::MaterialNumber(row) => {
+                let number = plain_number(text).ok_or_else(out_of_range)?;
+                (row.min..=row.max)
+                    .contains(&number)
+                    .then_some(Value::Number(number))
                     .ok_or_else(out_of_range)
             }
-            Param::MinWeight | Param::Epsilon | Param::Ior(_) => {
-                let number = number(text).ok_or_else(out_of_range)?;
-                let fits = match self {
-                    Param::MinWeight => (0.0..=1.0).contains(&number),
-                    Param::Epsilon => (MIN_SIZE..=1.0).contains(&number),
-                    _ => (MIN_IOR..=MAX_IOR).contains(&number),
-                };
-                fits.then_some(Value::Number(number))
-                    .ok_or_else(out_of_range)
-            }
-            Param::Reflective(_) | Param::Transmissive(_) | Param::LightColor(_) => {
-                let max = if matches!(self, Param::LightColor(_)) {
-                    MAX_INTENSITY
-                } else {
-                    MAX_REFLECTANCE
-                };
-                let color = color(text).ok_or_else(out_of_range)?;
-                [color.r, color.g, color.b]
-                    .iter()
-                    .all(|c| (0.0..=max).contains(c))
-                    .then_some(Value::Color(color))
-                    .ok_or_else(out_of_range)
-            }
+            Row::MaterialColor(row) => color_within(row.limit.max),
+            Row::LightColor => color_within(properties::LIGHT_COLOR.max),
         }
     }
 
@@ -140,11 +185,13 @@ impl Param {
     pub fn apply(self, scene: &ValidScene, value: Value) -> Result<ValidScene, String> {
         let mut copy = scene.scene().clone();
         let missing = || format!("{} is no longer in the scene", self.owner(scene));
-        match (self, value) {
-            (Param::MaxDepth, Value::Whole(depth)) => copy.settings.max_depth = depth,
-            (Param::MinWeight, Value::Number(weight)) => copy.settings.min_weight = weight,
-            (Param::Epsilon, Value::Number(epsilon)) => copy.settings.epsilon = Some(epsilon),
-            (Param::Ior(h) | Param::Reflective(h) | Param::Transmissive(h), value) => {
+        let wrong = || format!("{} takes {}", self.property(), self.range());
+        match (self.owner, self.row, value) {
+            (Owner::Settings, Row::Setting(row), value) => {
+                let value = row.check(value).map_err(|_| wrong())?;
+                (row.set)(&mut copy.settings, value);
+            }
+            (Owner::Material(h), Row::MaterialColor(_) | Row::MaterialNumber(_), value) => {
                 let material = copy.materials.get(h).ok_or_else(missing)?.clone();
                 // A pattern's colour parts are copies of their host made by the language
                 // (same definition, same span): a change to the host's value reaches them.
@@ -161,18 +208,17 @@ impl Param {
                     let Some(m) = copy.materials.get_mut(target) else {
                         continue;
                     };
-                    match (self, value) {
-                        (Param::Ior(_), Value::Number(ior)) => m.ior = ior,
-                        (Param::Reflective(_), Value::Color(c)) => m.reflective = c,
-                        (Param::Transmissive(_), Value::Color(c)) => m.transmissive = c,
-                        _ => return Err(format!("{} takes {}", self.property(), self.range())),
+                    match (self.row, value) {
+                        (Row::MaterialColor(row), Value::Color(c)) => (row.set)(m, c),
+                        (Row::MaterialNumber(row), Value::Number(x)) => (row.set)(m, x),
+                        _ => return Err(wrong()),
                     }
                 }
             }
-            (Param::LightColor(h), Value::Color(c)) => {
+            (Owner::Light(h), Row::LightColor, Value::Color(c)) => {
                 copy.lights.get_mut(h).ok_or_else(missing)?.color = c;
             }
-            _ => return Err(format!("{} takes {}", self.property(), self.range())),
+            _ => return Err(wrong()),
         }
         validate(copy).map_err(|invalid| {
             let first = invalid
@@ -187,57 +233,32 @@ impl Param {
 /// The values the popup lists: the render settings, then `material`'s (the selected ray's),
 /// then each light's colour.
 pub fn params(scene: &Scene, material: Option<Handle<Material>>) -> Vec<Param> {
-    let mut params = vec![Param::MaxDepth, Param::MinWeight, Param::Epsilon];
+    let mut params: Vec<Param> = [
+        &setting_rows::MAX_DEPTH,
+        &setting_rows::MIN_WEIGHT,
+        &setting_rows::EPSILON,
+    ]
+    .into_iter()
+    .map(Param::setting)
+    .collect();
     if let Some(h) = material.filter(|&h| scene.materials.contains(h)) {
-        params.extend([Param::Ior(h), Param::Reflective(h), Param::Transmissive(h)]);
+        params.push(Param::material_number(h, &properties::IOR));
+        for name in ["reflective", "transmissive"] {
+            if let Some(row) = properties::material_color(name) {
+                params.push(Param::material_color(h, row));
+            }
+        }
     }
-    params.extend(scene.lights.iter().map(|(h, _)| Param::LightColor(h)));
+    params.extend(scene.lights.iter().map(|(h, _)| Param::light_color(h)));
     params
 }
 
-/// A value as the scene language writes it: `5`, `1.5`, `0.9`, `rgb(1, 0.5, 0)`.
-pub fn value_text(value: Value) -> String {
-    match value {
-        Value::Whole(n) => n.to_string(),
-        Value::Number(x) => number_text(x),
-        Value::Color(c) if c.r == c.g && c.g == c.b => number_text(c.r),
-        Value::Color(c) => format!(
-            "rgb({}, {}, {})",
-            number_text(c.r),
-            number_text(c.g),
-            number_text(c.b)
-        ),
-    }
-}
-
-/// The shortest text that reads back as `x` (`1.5`, `1`, `0.001`).
-fn number_text(x: f64) -> String {
-    format!("{x}")
-}
-
-/// A finite decimal number (no `inf`, no `nan`, which Rust's parser would take).
-fn number(text: &str) -> Option<f64> {
-    let plain = text
-        .chars()
-        .all(|c| c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e' | 'E'));
-    text.parse::<f64>().ok().filter(|x| plain && x.is_finite())
-}
-
-/// A grey (`0.5`), three numbers (`1 0.5 0`) or `rgb(1, 0.5, 0)`.
-fn color(text: &str) -> Option<Color> {
-    let inner = text
-        .strip_prefix("rgb(")
-        .and_then(|rest| rest.strip_suffix(')'))
-        .unwrap_or(text);
-    let parts: Vec<f64> = inner
-        .split(|c: char| c == ',' || c.is_whitespace())
-        .filter(|p| !p.is_empty())
-        .map(number)
-        .collect::<Option<_>>()?;
-    match parts.as_slice() {
-        [grey] => Some(Color::gray(*grey)),
-        [r, g, b] => Some(Color::new(*r, *g, *b)),
-        _ => None,
+/// A limit as the popup shows it: `1`, `1000`, `1e6`.
+fn short(x: f64) -> String {
+    if x >= 1e5 {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
     }
 }
 
@@ -245,6 +266,26 @@ fn color(text: &str) -> Option<Color> {
 mod tests {
     use super::*;
     use crate::test_scene::whitted_scene;
+    use whitted_ir::Color;
+
+    fn ior(h: Handle<Material>) -> Param {
+        Param::material_number(h, &properties::IOR)
+    }
+
+    fn reflective(h: Handle<Material>) -> Param {
+        Param::material_color(h, properties::material_color("reflective").expect("a row"))
+    }
+
+    fn transmissive(h: Handle<Material>) -> Param {
+        Param::material_color(
+            h,
+            properties::material_color("transmissive").expect("a row"),
+        )
+    }
+
+    fn depth() -> Param {
+        Param::setting(&setting_rows::MAX_DEPTH)
+    }
 
     fn glass(scene: &Scene) -> Handle<Material> {
         scene
@@ -293,30 +334,30 @@ mod tests {
     #[test]
     fn values_are_read_within_the_languages_ranges_and_anything_else_is_said_plainly() {
         let h = Handle::from_index(0);
-        assert_eq!(Param::Ior(h).parse(" 1.0 "), Ok(Value::Number(1.0)));
-        assert_eq!(Param::MaxDepth.parse("7"), Ok(Value::Whole(7)));
+        assert_eq!(ior(h).parse(" 1.0 "), Ok(Value::Number(1.0)));
+        assert_eq!(depth().parse("7"), Ok(Value::Whole(7)));
         assert_eq!(
-            Param::Transmissive(h).parse("rgb(1, 0.5, 0)"),
+            transmissive(h).parse("rgb(1, 0.5, 0)"),
             Ok(Value::Color(Color::new(1.0, 0.5, 0.0)))
         );
         assert_eq!(
-            Param::LightColor(Handle::from_index(0)).parse("2 2 2"),
+            Param::light_color(Handle::from_index(0)).parse("2 2 2"),
             Ok(Value::Color(Color::gray(2.0)))
         );
         for (param, text) in [
-            (Param::Ior(h), "0"),
-            (Param::Ior(h), "-1"),
-            (Param::Ior(h), "abc"),
-            (Param::Ior(h), "inf"),
-            (Param::Ior(h), "NaN"),
-            (Param::Ior(h), ""),
-            (Param::MaxDepth, "2.5"),
-            (Param::MaxDepth, "257"),
-            (Param::MinWeight, "1.5"),
-            (Param::Epsilon, "0"),
-            (Param::Reflective(h), "1.2"),
-            (Param::Reflective(h), "rgb(1, 2)"),
-            (Param::LightColor(Handle::from_index(0)), "-1"),
+            (ior(h), "0"),
+            (ior(h), "-1"),
+            (ior(h), "abc"),
+            (ior(h), "inf"),
+            (ior(h), "NaN"),
+            (ior(h), ""),
+            (depth(), "2.5"),
+            (depth(), "257"),
+            (Param::setting(&setting_rows::MIN_WEIGHT), "1.5"),
+            (Param::setting(&setting_rows::EPSILON), "0"),
+            (reflective(h), "1.2"),
+            (reflective(h), "rgb(1, 2)"),
+            (Param::light_color(Handle::from_index(0)), "-1"),
         ] {
             let error = param.parse(text).expect_err(text);
             assert!(
@@ -325,7 +366,7 @@ mod tests {
             );
         }
         assert_eq!(
-            Param::Ior(h).parse("0").unwrap_err(),
+            ior(h).parse("0").unwrap_err(),
             "ior must be a number from 0.001 to 1000"
         );
     }
@@ -334,20 +375,20 @@ mod tests {
     fn applying_changes_one_value_of_a_copy_and_leaves_the_scene_alone() {
         let scene = whitted_scene();
         let glass = glass(&scene);
-        let changed = Param::Ior(glass).apply(&scene, Value::Number(1.0)).unwrap();
+        let changed = ior(glass).apply(&scene, Value::Number(1.0)).unwrap();
         assert_eq!(changed.materials[glass].ior, 1.0);
         assert_eq!(scene.materials[glass].ior, 1.5);
         let mut expected = scene.scene().clone();
         expected.materials.get_mut(glass).unwrap().ior = 1.0;
         assert_eq!(format!("{:?}", changed.scene()), format!("{expected:?}"));
-        let deeper = Param::MaxDepth.apply(&scene, Value::Whole(9)).unwrap();
+        let deeper = depth().apply(&scene, Value::Whole(9)).unwrap();
         assert_eq!(deeper.settings.max_depth, 9);
         let light = Handle::from_index(0);
-        let red = Param::LightColor(light)
+        let red = Param::light_color(light)
             .apply(&scene, Value::Color(Color::new(1.0, 0.0, 0.0)))
             .unwrap();
         assert_eq!(red.lights[light].color, Color::new(1.0, 0.0, 0.0));
-        assert!(Param::MaxDepth.apply(&scene, Value::Number(1.0)).is_err());
+        assert!(depth().apply(&scene, Value::Number(1.0)).is_err());
     }
 
     #[test]
@@ -359,7 +400,7 @@ mod tests {
             .find(|(_, m)| m.name.as_deref() == Some("floor_tiles"))
             .expect("the floor's material");
         let pattern = material.pattern.clone().expect("a checker");
-        let changed = Param::Reflective(tiles)
+        let changed = reflective(tiles)
             .apply(&scene, Value::Color(Color::gray(0.5)))
             .unwrap();
         assert_eq!(changed.materials[pattern.a].reflective, Color::gray(0.5));

@@ -20,7 +20,7 @@ use crate::event::Event;
 use crate::line_input::{InputOutcome, LineInput};
 use crate::terminal::{panic_text, take_worker_panic};
 use crate::trace_job::{TraceFailure, TraceJob, Traced};
-use crate::what_if::{params, value_text, Param, Value};
+use crate::what_if::{params, value_text, Owner, Param, Value};
 use crate::write_back::{write_back, WriteBack};
 
 /// The popup, open on one picked pixel.
@@ -104,7 +104,7 @@ impl WhatIf {
         // Start on the material's first value when there is one: the likely question.
         let selected = params
             .iter()
-            .position(|p| matches!(p, Param::Ior(_)))
+            .position(|p| matches!(p.owner, Owner::Material(_)))
             .unwrap_or(0);
         WhatIf {
             pixel: (x, y),
@@ -258,7 +258,7 @@ impl WhatIf {
         }
     }
 
-    /// `W`: the change as a file edit, or the line to add, or why it cannot be written.
+    /// `W`: the change as a file edit, or why it cannot be written.
     fn write_back(&mut self) -> Vec<Effect> {
         let Some(outcome) = &self.outcome else {
             self.note = Some(Note {
@@ -286,16 +286,6 @@ impl WhatIf {
                     contents,
                     line,
                 }]
-            }
-            WriteBack::Add { line_to_add, place } => {
-                self.note = Some(Note {
-                    text: format!(
-                        "{} is not written in the scene (a default): add `{line_to_add}` {place}",
-                        param.property()
-                    ),
-                    is_error: false,
-                });
-                Vec::new()
             }
             WriteBack::Refused(why) => {
                 self.note = Some(Note {
@@ -459,7 +449,10 @@ mod tests {
     fn a_lower_max_depth_removes_rays_and_the_list_accounts_for_every_one() {
         let mut what_if = popup();
         what_if.selected = 0;
-        assert_eq!(what_if.selected_param(), Some(Param::MaxDepth));
+        assert_eq!(
+            what_if.selected_param(),
+            Some(Param::setting(&whitted_ir::setting_rows::MAX_DEPTH))
+        );
         change_to(&mut what_if, "1");
         let outcome = what_if.outcome.as_ref().expect("a re-trace");
         let removed: usize = outcome
@@ -474,7 +467,7 @@ mod tests {
     }
 
     #[test]
-    fn w_writes_the_change_on_its_line_or_says_what_to_add() {
+    fn w_writes_the_change_on_its_line_or_adds_it_to_its_block() {
         let mut what_if = popup();
         assert!(what_if.handle_key(key(KeyCode::Char('W'))).1.is_empty());
         assert!(what_if
@@ -504,17 +497,26 @@ mod tests {
             "wrote scenes/whitted.scene:15; reloading"
         );
 
-        // The mirror writes no ior: the line to add, and where.
+        // The mirror writes no ior: it is added to the mirror's block, on its line.
         let loaded = LoadedScene::new(whitted_scene());
         let mirror = material_named(&loaded.scene, "mirror");
         let mut what_if = WhatIf::open(loaded, glass_pixel_tree(), Some(mirror), 100_000);
         change_to(&mut what_if, "1.3");
         let (_, effects) = what_if.handle_key(key(KeyCode::Char('W')));
-        assert!(effects.is_empty());
+        let [Effect::WriteScene { contents, line, .. }] = effects.as_slice() else {
+            panic!("{effects:?}");
+        };
+        assert_eq!(*line, 17);
         assert_eq!(
-            what_if.note.as_ref().unwrap().text,
-            "ior is not written in the scene (a default): add `ior 1.3` inside material mirror at scenes/whitted.scene:17:1"
+            contents.as_str(),
+            SCENE_TEXT.replace("reflective 0.8 }", "reflective 0.8 ior 1.3 }")
         );
+        assert!(what_if
+            .note
+            .as_ref()
+            .unwrap()
+            .text
+            .starts_with("writing scenes/whitted.scene:17: material mirror {"));
     }
 
     #[test]

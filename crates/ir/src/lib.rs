@@ -13,8 +13,10 @@ pub mod properties;
 mod provenance;
 mod ranges;
 mod scene;
+pub mod setting_rows;
 mod source;
 mod validate;
+mod written;
 
 pub use arena::{Arena, Handle};
 pub use diagnostic::{Diagnostic, Label, Severity};
@@ -24,11 +26,12 @@ pub use print::print;
 pub use provenance::{ArgValue, FrameId, Provenance, Site, SiteId, SiteKind, Step};
 pub use scene::{
     Attenuation, Camera, Color, CsgOp, Fresnel, Highlight, Light, LightKind, Material, Object,
-    ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, Scene, Settings,
-    ShadowMode, Shape, WorldFromObject,
+    ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, Scene, SceneFormat,
+    Settings, ShadowMode, Shape, WorldFromObject,
 };
 pub use source::{FileId, LineCol, SourceFile, SourceMap, Span};
 pub use validate::{validate, InvalidScene, ValidScene};
+pub use written::{BlockId, BlockKind, Written, WrittenBlock, WrittenProperty};
 
 /// Re-exported so that every crate names the same vector and matrix types.
 pub use glam::{DMat4, DVec3};

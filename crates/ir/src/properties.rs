@@ -114,6 +114,40 @@ pub fn material_color(name: &str) -> Option<&'static MaterialColor> {
     MATERIAL_COLORS.iter().find(|row| row.name == name)
 }
 
+/// One number of a material, with the range validation holds it to.
+#[derive(Clone, Copy, Debug)]
+pub struct MaterialNumber {
+    pub name: &'static str,
+    pub get: fn(&Material) -> f64,
+    pub set: fn(&mut Material, f64),
+    pub min: f64,
+    pub max: f64,
+}
+
+/// The index of refraction.
+pub const IOR: MaterialNumber = MaterialNumber {
+    name: "ior",
+    get: |m| m.ior,
+    set: |m, x| m.ior = x,
+    min: crate::limits::MIN_IOR,
+    max: crate::limits::MAX_IOR,
+};
+
+/// The Phong exponent.
+pub const SHININESS: MaterialNumber = MaterialNumber {
+    name: "shininess",
+    get: |m| m.shininess,
+    set: |m, x| m.shininess = x,
+    min: 0.0,
+    max: MAX_INTENSITY,
+};
+
+/// The numbers of a material that a tool may change (the debugger's what-if).
+pub const MATERIAL_NUMBERS: &[MaterialNumber] = &[IOR, SHININESS];
+
+/// A light's colour: the one value of a light a tool may change.
+pub const LIGHT_COLOR: ColorLimit = INTENSITY;
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,8 +2,9 @@
 //! tracer turns into f32 stays finite there, and so do the products it forms from them
 //! (intensity times coefficient, squared coordinates in a shape's own space).
 //!
-//! Each error names the property, its value and the limit, at the light, material, object
-//! or camera that has it.
+//! Each error names the property, its value and the limit in words, at the value where the
+//! scene wrote it (the scene's table of written properties) or else at the light, material,
+//! object or camera that has it.
 
 use glam::{DMat4, DVec3};
 
@@ -14,10 +15,14 @@ use crate::limits::{
 };
 use crate::scene::{Color, LightKind, Material, Object, ObjectKind, Projection, Scene, Shape};
 use crate::source::Span;
+use crate::written::{BlockKind, Written};
 
 /// Checks every number of `scene` against its limit, adding an error for each that is out.
 pub(crate) fn check(scene: &Scene, errors: &mut Vec<Diagnostic>) {
-    let mut ranges = Ranges { errors };
+    let mut ranges = Ranges {
+        errors,
+        written: &scene.written,
+    };
     ranges.settings(scene);
     let camera = &scene.camera;
     let span = scene.camera_span;
@@ -32,12 +37,12 @@ pub(crate) fn check(scene: &Scene, errors: &mut Vec<Diagnostic>) {
         ranges.size("camera's `height`", view_height, span);
     }
     for (_, light, span) in scene.lights.iter_with_spans() {
-        ranges.color(
+        ranges.written_color(
+            (BlockKind::Light, span, "color"),
             "light's `color`",
             &light.color,
             MAX_INTENSITY,
             "largest intensity",
-            span,
         );
         match &light.kind {
             LightKind::Point {
@@ -82,13 +87,80 @@ pub(crate) fn check(scene: &Scene, errors: &mut Vec<Diagnostic>) {
 
 struct Ranges<'a> {
     errors: &'a mut Vec<Diagnostic>,
+    written: &'a Written,
+}
+
+/// A number as a message shows it: plain unless very large or very small (`90`, `0.001`,
+/// `1e12`).
+fn shown(value: f64) -> String {
+    let magnitude = value.abs();
+    if magnitude == 0.0 || (1e-4..1e7).contains(&magnitude) {
+        format!("{value}")
+    } else {
+        format!("{value:e}")
+    }
 }
 
 impl Ranges<'_> {
     fn out_of_range(&mut self, what: &str, value: f64, rule: String, span: Span) {
+        let value = shown(value);
         self.errors.push(
-            Diagnostic::error(format!("the {what} is {value:e}, {rule}"), span)
+            Diagnostic::error(format!("the {what} is {value}, {rule}"), span)
                 .with_hint("see \"Limits\" in docs/language.md"),
+        );
+    }
+
+    /// Where the block of `kind` made at `header` wrote `name`'s value, if it did.
+    fn value_of(&self, kind: BlockKind, header: Span, name: &str) -> Option<Span> {
+        self.written
+            .properties_in(kind, header, name)
+            .last()
+            .map(|p| p.value_span)
+    }
+
+    /// A colour past its limit: at the value when the scene wrote it, with the range in words.
+    fn written_color(
+        &mut self,
+        (kind, header, name): (BlockKind, Span, &str),
+        what: &str,
+        c: &Color,
+        max: f64,
+        limit: &str,
+    ) {
+        let Some(value) = c
+            .components()
+            .into_iter()
+            .find(|v| v.is_finite() && *v > max)
+        else {
+            return;
+        };
+        let Some(at) = self.value_of(kind, header, name) else {
+            self.color(what, c, max, limit, header);
+            return;
+        };
+        let fraction = if max == 1.0 {
+            format!(
+                " (a fraction of the light: {} for {}%)",
+                shown(value / 100.0),
+                shown(value)
+            )
+        } else {
+            String::new()
+        };
+        self.errors.push(
+            Diagnostic::error(
+                format!(
+                    "the {what} is {}, past the {limit} limit ({})",
+                    shown(value),
+                    shown(max)
+                ),
+                at,
+            )
+            .with_label(format!("{} here", shown(value)))
+            .with_hint(format!(
+                "`{name}` takes a colour whose components are each from 0 to {}{fraction}",
+                shown(max)
+            )),
         );
     }
 
@@ -217,7 +289,8 @@ impl Ranges<'_> {
             for row in crate::properties::MATERIAL_COLORS {
                 if row.limit == limit {
                     let what = format!("material's `{}`", row.name);
-                    self.color(&what, &(row.get)(m), limit.max, limit.name, span);
+                    let at = (BlockKind::Material, span, row.name);
+                    self.written_color(at, &what, &(row.get)(m), limit.max, limit.name);
                 }
             }
         }

@@ -11,6 +11,7 @@ use crate::arena::{Arena, Handle};
 use crate::mesh::Mesh;
 use crate::provenance::Provenance;
 use crate::source::{SourceMap, Span};
+use crate::written::Written;
 
 /// A linear RGB triple. Not clamped: light intensities may exceed 1.
 #[derive(Clone, Copy, Debug, PartialEq, Default, Serialize)]
@@ -592,6 +593,21 @@ pub struct Scene {
     pub sources: SourceMap,
     /// How each object was made: the imports, calls and loop iterations around it.
     pub provenance: Provenance,
+    /// Where each setting and each property of the camera, lights and materials was written.
+    pub written: Written,
+    /// Which front end read the scene: write-back edits only the language it knows.
+    pub format: SceneFormat,
+}
+
+/// The language a scene was written in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SceneFormat {
+    /// whitted's scene language (`.scene`).
+    #[default]
+    Whitted,
+    /// The MIT 6.837 course's scene files (`.txt`).
+    Mit6837,
 }
 
 impl Default for Span {

@@ -42,7 +42,7 @@ pub fn compile_file(
     on_big_stack(loader, move |loader, max_depth| {
         let display = path.to_string_lossy().into_owned();
         match loader.load(&path) {
-            Ok(bytes) => compile_root(&path, display, bytes, loader, options, max_depth, None),
+            Ok(bytes) => compile_root(&path, display, bytes, loader, options, max_depth),
             Err(error) => Compilation {
                 sources: SourceMap::new(),
                 scene: None,
@@ -77,48 +77,7 @@ pub fn compile_bytes(
     let path = normalize(Path::new(name));
     let bytes = bytes.to_vec();
     on_big_stack(loader, move |loader, max_depth| {
-        compile_root(
-            &path,
-            name.to_string(),
-            bytes,
-            loader,
-            options,
-            max_depth,
-            None,
-        )
-    })
-}
-
-/// `--set NAME=VALUE` for a scene that another front end made (the MIT 6.837 format):
-/// `options.settings` applied to `base` by the same rows and checks as for a scene in the
-/// language. The result's `scene` is an empty scene whose settings are the overridden ones;
-/// its `sources` are an empty `<--set>` file and the `--set` pseudo-files its diagnostics
-/// point into.
-pub fn override_settings(base: &whitted_ir::Settings, options: &CompileOptions) -> Compilation {
-    struct NoFiles;
-    impl SourceLoader for NoFiles {
-        fn load(&mut self, path: &Path) -> std::io::Result<Vec<u8>> {
-            Err(std::io::Error::new(
-                std::io::ErrorKind::NotFound,
-                format!(
-                    "{} is not read when only settings are overridden",
-                    path.display()
-                ),
-            ))
-        }
-    }
-    let base = base.clone();
-    on_big_stack(&mut NoFiles, move |loader, max_depth| {
-        let path = normalize(Path::new("<--set>"));
-        compile_root(
-            &path,
-            "<--set>".to_string(),
-            Vec::new(),
-            loader,
-            options,
-            max_depth,
-            Some(base),
-        )
+        compile_root(&path, name.to_string(), bytes, loader, options, max_depth)
     })
 }
 
@@ -482,7 +441,6 @@ fn compile_root(
     loader: &mut dyn SourceLoader,
     options: &CompileOptions,
     max_evaluation_depth: usize,
-    base_settings: Option<whitted_ir::Settings>,
 ) -> Compilation {
     let limits = &options.limits;
     let mut loading = Loading {
@@ -584,7 +542,6 @@ fn compile_root(
         crate::eval::CommandLine {
             defines: &defines,
             overrides: &overrides,
-            base_settings,
         },
         sources.clone(),
         max_evaluation_depth,

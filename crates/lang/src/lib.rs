@@ -31,7 +31,7 @@ mod value;
 
 pub use whitted_ir::{Diagnostic, SourceMap};
 
-pub use compile::{compile_bytes, compile_file, compile_source, override_settings};
+pub use compile::{compile_bytes, compile_file, compile_source};
 pub use render::render_diagnostics;
 
 /// Supplies file contents for the root file and for imports; the library never touches the

@@ -15,6 +15,7 @@
 //! `center`, `radius`, ..." reads in that order.
 
 use whitted_ir::limits;
+use whitted_ir::setting_rows::{self as S, SettingKind, SettingRow};
 
 use crate::schema::{CameraTag, Context, LightTag, ObjectTag};
 
@@ -130,7 +131,7 @@ pub struct Row {
 /// The table: the `Prop` enum, its names and the rows, all from one list.
 macro_rules! properties {
     ($( $prop:ident $name:literal {
-        $( $block:expr => $kind:expr, $default:literal, $doc:literal; )+
+        $( $block:expr => $kind:expr, $default:expr, $doc:expr; )+
     } )+) => {
         /// Every property name the language knows. Which blocks accept each, and what it
         /// takes there, is in [`ROWS`]; `height` and `ambient` mean different things in
@@ -165,6 +166,19 @@ macro_rules! properties {
 use Block::*;
 use Kind::*;
 
+/// A setting's kind in the language, from its row in the IR's settings table.
+const fn setting_kind(row: &SettingRow) -> Kind {
+    match row.kind {
+        SettingKind::Whole { min, max } => Whole {
+            min: min as f64,
+            max: max as f64,
+        },
+        SettingKind::Number { min, open, max } => Number { min, open, max },
+        SettingKind::LightColor => LightColor,
+        SettingKind::Word(words) => Word(words),
+    }
+}
+
 const ANY: f64 = f64::INFINITY;
 const CAMERAS: &[CameraTag] = &[CameraTag::Perspective, CameraTag::Orthographic];
 const POSITIONED: &[LightTag] = &[LightTag::Point, LightTag::Spot];
@@ -185,42 +199,42 @@ properties! {
         Camera(&[CameraTag::Perspective]) => Number { min: 0.0, open: true, max: 179.0 }, "45", "vertical field of view in degrees";
     }
     Width "width" {
-        Settings => Whole { min: 1.0, max: limits::MAX_IMAGE_SIDE as f64 }, "640", "image width in pixels";
+        Settings => setting_kind(&S::WIDTH), S::WIDTH.default, S::WIDTH.doc;
     }
     Height "height" {
         Camera(&[CameraTag::Orthographic]) => Number { min: 0.0, open: true, max: ANY }, "4", "height of the view in scene units";
-        Settings => Whole { min: 1.0, max: limits::MAX_IMAGE_SIDE as f64 }, "480", "image height in pixels";
+        Settings => setting_kind(&S::HEIGHT), S::HEIGHT.default, S::HEIGHT.doc;
     }
     MaxDepth "max_depth" {
-        Settings => Whole { min: 0.0, max: limits::MAX_DEPTH as f64 }, "5", "rays deeper than this are not traced (the camera ray is depth 0)";
+        Settings => setting_kind(&S::MAX_DEPTH), S::MAX_DEPTH.default, S::MAX_DEPTH.doc;
     }
     MinWeight "min_weight" {
-        Settings => Number { min: 0.0, open: false, max: 1.0 }, "0.001", "a reflected or refracted ray contributing less is not traced";
+        Settings => setting_kind(&S::MIN_WEIGHT), S::MIN_WEIGHT.default, S::MIN_WEIGHT.doc;
     }
     Samples "samples" {
-        Settings => Whole { min: 1.0, max: limits::MAX_SAMPLES_PER_PIXEL as f64 }, "1", "samples per pixel";
+        Settings => setting_kind(&S::SAMPLES), S::SAMPLES.default, S::SAMPLES.doc;
     }
     Background "background" {
-        Settings => LightColor, "black", "the colour of rays that hit nothing";
+        Settings => setting_kind(&S::BACKGROUND), S::BACKGROUND.default, S::BACKGROUND.doc;
     }
     Ambient "ambient" {
-        Settings => LightColor, "white", "the global ambient light";
+        Settings => setting_kind(&S::AMBIENT), S::AMBIENT.default, S::AMBIENT.doc;
         Material => Color, "0.1", "ka: how much of the global ambient light it reflects";
     }
     Epsilon "epsilon" {
-        Settings => Number { min: limits::MIN_SIZE, open: false, max: 1.0 }, "automatic", "how far off a surface secondary rays start";
+        Settings => setting_kind(&S::EPSILON), S::EPSILON.default, S::EPSILON.doc;
     }
     Shadows "shadows" {
-        Settings => Word(&["opaque", "filtered", "none"]), "opaque", "whether transparent objects let light through to what they shadow (`none`: no shadow rays at all)";
+        Settings => setting_kind(&S::SHADOWS), S::SHADOWS.default, S::SHADOWS.doc;
     }
     Highlight "highlight" {
-        Settings => Word(&["phong", "blinn"]), "phong", "the specular model: Phong ks·(R·V)^n or Blinn-Phong ks·(N·H)^n";
+        Settings => setting_kind(&S::HIGHLIGHT), S::HIGHLIGHT.default, S::HIGHLIGHT.doc;
     }
     ShadeBack "shade_back" {
-        Settings => Word(&["on", "off"]), "on", "whether lights shade a surface seen from its back (`off`: only its ambient, emission, reflection and refraction)";
+        Settings => setting_kind(&S::SHADE_BACK), S::SHADE_BACK.default, S::SHADE_BACK.doc;
     }
     AttenuationClamp "attenuation_clamp" {
-        Settings => Word(&["on", "off"]), "on", "whether point and spot lights' distance attenuation is clamped at 1";
+        Settings => setting_kind(&S::ATTENUATION_CLAMP), S::ATTENUATION_CLAMP.default, S::ATTENUATION_CLAMP.doc;
     }
     Position "position" {
         Light(POSITIONED) => Vector, "", "where the light is";
@@ -591,6 +605,31 @@ mod tests {
             assert!(
                 colours.iter().any(|row| row.prop.name() == ir.name),
                 "the IR's `{}` has no material row here",
+                ir.name
+            );
+        }
+    }
+
+    /// The language's settings are exactly the IR's settings table, each with its row's
+    /// kind, default and doc (a setting added to one table and not the other fails here).
+    #[test]
+    fn settings_are_the_ir_settings_table() {
+        use whitted_ir::setting_rows::SETTINGS;
+        let ours: Vec<&Row> = ROWS
+            .iter()
+            .filter(|row| row.block == Block::Settings)
+            .collect();
+        assert_eq!(ours.len(), SETTINGS.len());
+        for ir in SETTINGS {
+            let row = ours
+                .iter()
+                .find(|row| row.prop.name() == ir.name)
+                .unwrap_or_else(|| panic!("the IR's setting `{}` has no row here", ir.name));
+            assert_eq!(row.kind, setting_kind(ir), "`{}`", ir.name);
+            assert_eq!(
+                (row.default, row.doc),
+                (ir.default, ir.doc),
+                "`{}`",
                 ir.name
             );
         }

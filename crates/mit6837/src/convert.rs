@@ -12,9 +12,9 @@
 use std::path::{Path, PathBuf};
 
 use whitted_ir::{
-    limits, Attenuation, Camera, Color, DMat4, DVec3, Diagnostic, Fresnel, Handle, Highlight,
-    Light, LightKind, Material, Projection, Scene, Settings, ShadowMode, SourceFile, SourceMap,
-    Span,
+    limits, Attenuation, BlockKind, Camera, Color, DMat4, DVec3, Diagnostic, Fresnel, Handle,
+    Highlight, Light, LightKind, Material, Projection, Scene, SceneFormat, Settings, ShadowMode,
+    SourceFile, SourceMap, Span, WrittenBlock, WrittenProperty,
 };
 
 use crate::reader::{Read, Reader};
@@ -84,6 +84,7 @@ pub fn convert(
     // light white (unless the scene gives one).
     let ambient = ambient.or((scene.lights.is_empty()).then_some(Color::WHITE));
     scene.settings = settings(options, background, ambient);
+    scene.format = SceneFormat::Mit6837;
     let sources = scene.sources.clone();
     match whitted_ir::validate(scene) {
         Ok(valid) => Conversion {
@@ -293,19 +294,21 @@ impl<'a> Converter<'a, '_> {
         let last = if orthographic { "size" } else { "angle" };
         let known = ["center", "direction", "up", last];
         let (mut center, mut direction, mut up, mut extent) = (None, None, None, None);
-        let span = self.fields(keyword, &known, |this, field| {
-            match field.text {
-                "center" => center = Some(this.reader.vector("the camera's center")?),
-                "direction" => direction = Some(this.direction("the camera's direction")?),
-                "up" => up = Some(this.direction("the camera's up")?),
-                "size" if orthographic => extent = Some(this.reader.number("the view's size")?),
-                "angle" if !orthographic => {
-                    extent = Some(this.reader.number("the field of view in degrees")?)
+        let names = [("center", "eye"), ("up", "up")];
+        let span =
+            self.written_fields(keyword, BlockKind::Camera, &names, &known, |this, field| {
+                match field.text {
+                    "center" => center = Some(this.reader.vector("the camera's center")?),
+                    "direction" => direction = Some(this.direction("the camera's direction")?),
+                    "up" => up = Some(this.direction("the camera's up")?),
+                    "size" if orthographic => extent = Some(this.reader.number("the view's size")?),
+                    "angle" if !orthographic => {
+                        extent = Some(this.reader.number("the field of view in degrees")?)
+                    }
+                    _ => return Ok(false),
                 }
-                _ => return Ok(false),
-            }
-            Ok(true)
-        })?;
+                Ok(true)
+            })?;
         let (Some(center), Some(direction), Some(up), Some(extent)) =
             (center, direction, up, extent)
         else {
@@ -337,14 +340,22 @@ impl<'a> Converter<'a, '_> {
 
     fn background(&mut self, keyword: Token<'a>) -> Read<()> {
         let (mut color, mut ambient) = (None, None);
-        self.fields(keyword, &["color", "ambientLight"], |this, field| {
-            match field.text {
-                "color" => color = Some(this.color("the background colour")?),
-                "ambientLight" => ambient = Some(this.color("the ambient light")?),
-                _ => return Ok(false),
-            }
-            Ok(true)
-        })?;
+        let names = [("color", "background"), ("ambientLight", "ambient")];
+        let known = ["color", "ambientLight"];
+        self.written_fields(
+            keyword,
+            BlockKind::Settings,
+            &names,
+            &known,
+            |this, field| {
+                match field.text {
+                    "color" => color = Some(this.color("the background colour")?),
+                    "ambientLight" => ambient = Some(this.color("the ambient light")?),
+                    _ => return Ok(false),
+                }
+                Ok(true)
+            },
+        )?;
         self.background = color;
         self.ambient = ambient;
         Ok(())
@@ -392,14 +403,16 @@ impl<'a> Converter<'a, '_> {
     fn directional_light(&mut self, keyword: Token<'a>) -> Read<()> {
         let known = ["direction", "color"];
         let (mut direction, mut color) = (None, None);
-        let span = self.fields(keyword, &known, |this, field| {
-            match field.text {
-                "direction" => direction = Some(this.direction("the light's direction")?),
-                "color" => color = Some(this.color("the light's colour")?),
-                _ => return Ok(false),
-            }
-            Ok(true)
-        })?;
+        let names = [("direction", "direction"), ("color", "color")];
+        let span =
+            self.written_fields(keyword, BlockKind::Light, &names, &known, |this, field| {
+                match field.text {
+                    "direction" => direction = Some(this.direction("the light's direction")?),
+                    "color" => color = Some(this.color("the light's colour")?),
+                    _ => return Ok(false),
+                }
+                Ok(true)
+            })?;
         let (Some(direction), Some(color)) = (direction, color) else {
             return self.missing(span, keyword.text, &known);
         };
@@ -417,32 +430,38 @@ impl<'a> Converter<'a, '_> {
     fn point_light(&mut self, keyword: Token<'a>) -> Read<()> {
         let known = ["position", "color", "attenuation"];
         let (mut position, mut color, mut attenuation) = (None, None, None);
-        let span = self.fields(keyword, &known, |this, field| {
-            match field.text {
-                "position" => position = Some(this.reader.vector("the light's position")?),
-                "color" => color = Some(this.color("the light's colour")?),
-                "attenuation" => {
-                    let at = this.reader.span(field);
-                    let terms = this.reader.vector("an attenuation term")?;
-                    if terms.min_element() < 0.0 || terms == DVec3::ZERO {
-                        return Err(Box::new(
-                            Diagnostic::error(
-                                "the attenuation terms must be at least 0 and not all 0",
-                                at,
-                            )
-                            .with_hint("the light falls off as 1 / (a + b·d + c·d²)"),
-                        ));
+        let names = [
+            ("position", "position"),
+            ("color", "color"),
+            ("attenuation", "attenuation"),
+        ];
+        let span =
+            self.written_fields(keyword, BlockKind::Light, &names, &known, |this, field| {
+                match field.text {
+                    "position" => position = Some(this.reader.vector("the light's position")?),
+                    "color" => color = Some(this.color("the light's colour")?),
+                    "attenuation" => {
+                        let at = this.reader.span(field);
+                        let terms = this.reader.vector("an attenuation term")?;
+                        if terms.min_element() < 0.0 || terms == DVec3::ZERO {
+                            return Err(Box::new(
+                                Diagnostic::error(
+                                    "the attenuation terms must be at least 0 and not all 0",
+                                    at,
+                                )
+                                .with_hint("the light falls off as 1 / (a + b·d + c·d²)"),
+                            ));
+                        }
+                        attenuation = Some(Attenuation {
+                            constant: terms.x,
+                            linear: terms.y,
+                            quadratic: terms.z,
+                        });
                     }
-                    attenuation = Some(Attenuation {
-                        constant: terms.x,
-                        linear: terms.y,
-                        quadratic: terms.z,
-                    });
+                    _ => return Ok(false),
                 }
-                _ => return Ok(false),
-            }
-            Ok(true)
-        })?;
+                Ok(true)
+            })?;
         let (Some(position), Some(color)) = (position, color) else {
             return self.missing(span, keyword.text, &known[..2]);
         };
@@ -535,18 +554,32 @@ impl<'a> Converter<'a, '_> {
             fresnel: Fresnel::Off,
             ..Material::default()
         };
-        let span = self.fields(keyword, &known, |this, field| {
-            match field.text {
-                "diffuseColor" => m.diffuse = this.color("the diffuse colour")?,
-                "specularColor" => m.specular = this.color("the specular colour")?,
-                "exponent" => m.shininess = this.reader.number("the specular exponent")?,
-                "reflectiveColor" => m.reflective = this.color("the reflective colour")?,
-                "transparentColor" => m.transmissive = this.color("the transparent colour")?,
-                "indexOfRefraction" => m.ior = this.reader.number("the index of refraction")?,
-                _ => return Ok(false),
-            }
-            Ok(true)
-        })?;
+        let names = [
+            ("diffuseColor", "diffuse"),
+            ("specularColor", "specular"),
+            ("exponent", "shininess"),
+            ("reflectiveColor", "reflective"),
+            ("transparentColor", "transmissive"),
+            ("indexOfRefraction", "ior"),
+        ];
+        let span = self.written_fields(
+            keyword,
+            BlockKind::Material,
+            &names,
+            &known,
+            |this, field| {
+                match field.text {
+                    "diffuseColor" => m.diffuse = this.color("the diffuse colour")?,
+                    "specularColor" => m.specular = this.color("the specular colour")?,
+                    "exponent" => m.shininess = this.reader.number("the specular exponent")?,
+                    "reflectiveColor" => m.reflective = this.color("the reflective colour")?,
+                    "transparentColor" => m.transmissive = this.color("the transparent colour")?,
+                    "indexOfRefraction" => m.ior = this.reader.number("the index of refraction")?,
+                    _ => return Ok(false),
+                }
+                Ok(true)
+            },
+        )?;
         let handle = self.scene.materials.append(m, span);
         self.materials.push(handle);
         Ok(())
@@ -593,6 +626,44 @@ impl<'a> Converter<'a, '_> {
                 ));
             }
         }
+    }
+
+    /// [`Converter::fields`] for a block whose fields are settings or properties of the
+    /// language (`names`: each field's name there): records where each was written in the
+    /// scene's table, as the language does for its own blocks.
+    pub(crate) fn written_fields(
+        &mut self,
+        keyword: Token<'a>,
+        kind: BlockKind,
+        names: &[(&str, &'static str)],
+        known: &[&str],
+        mut field: impl FnMut(&mut Self, Token<'a>) -> Read<bool>,
+    ) -> Read<Span> {
+        let body_start = self.reader.tokens.peek().map_or(keyword.end, |t| t.start);
+        let mut found: Vec<(Token<'a>, usize, usize)> = Vec::new();
+        let span = self.fields(keyword, known, |this, name| {
+            let start = this.reader.tokens.peek().map_or(name.end, |t| t.start);
+            let known = field(this, name)?;
+            found.push((name, start, this.reader.tokens.last_end()));
+            Ok(known)
+        })?;
+        let file = self.reader.file;
+        let block = self.scene.written.add_block(WrittenBlock {
+            kind,
+            header: span,
+            body: Span::new(file, body_start, span.end as usize),
+        });
+        for (name, start, end) in found {
+            if let Some((_, language)) = names.iter().find(|(ours, _)| *ours == name.text) {
+                self.scene.written.add_property(WrittenProperty {
+                    block,
+                    name: language,
+                    name_span: self.reader.span(name),
+                    value_span: Span::new(file, start, end.max(start)),
+                });
+            }
+        }
+        Ok(span)
     }
 
     /// The error for a block that lacks a required field.

@@ -628,3 +628,43 @@ fn mutated_scenes_never_panic() {
     // Otherwise the renders above would check nothing.
     assert!(converted > 50, "only {converted} mutated scenes converted");
 }
+
+/// The 6.837 reader fills the scene's table of written settings and properties as the
+/// language does, under the language's names, at the field's value.
+#[test]
+fn settings_and_properties_are_recorded_where_they_are_written() {
+    use whitted_ir::{BlockKind, SceneFormat};
+    let scene = scene_of(SCENE);
+    assert_eq!(scene.format, SceneFormat::Mit6837);
+    let text = |span: whitted_ir::Span| {
+        let file = scene.sources.get(span.file).expect("the file");
+        file.text[span.start as usize..span.end as usize].to_string()
+    };
+    let background = scene.written.setting("background").expect("background");
+    assert_eq!(text(background.name_span), "color");
+    assert_eq!(text(background.value_span), "0.1 0.2 0.3");
+    let ambient = scene.written.setting("ambient").expect("ambient");
+    assert_eq!(text(ambient.value_span), "0.2 0.2 0.2");
+    assert!(
+        scene.written.setting("max_depth").is_none(),
+        "-bounces is not in the file"
+    );
+    let (phong, _) = scene.materials.iter().next().expect("a material");
+    let exponent: Vec<_> = scene
+        .written
+        .properties_in(
+            BlockKind::Material,
+            scene.materials.span(phong),
+            "shininess",
+        )
+        .map(|p| text(p.value_span))
+        .collect();
+    assert_eq!(exponent, ["20"]);
+    let (point, _) = scene.lights.iter().nth(1).expect("two lights");
+    let attenuation: Vec<_> = scene
+        .written
+        .properties_in(BlockKind::Light, scene.lights.span(point), "attenuation")
+        .map(|p| text(p.value_span))
+        .collect();
+    assert_eq!(attenuation, ["1 0.5 0.25"]);
+}

@@ -19,6 +19,8 @@ pub struct Tokens<'a> {
     text: &'a str,
     position: usize,
     peeked: Option<Option<Token<'a>>>,
+    /// Where the last token taken ends (a field's value ends there).
+    last_end: usize,
 }
 
 impl<'a> Tokens<'a> {
@@ -27,6 +29,7 @@ impl<'a> Tokens<'a> {
             text,
             position: 0,
             peeked: None,
+            last_end: 0,
         }
     }
 
@@ -40,10 +43,19 @@ impl<'a> Tokens<'a> {
     }
 
     pub fn next_token(&mut self) -> Option<Token<'a>> {
-        match self.peeked.take() {
+        let token = match self.peeked.take() {
             Some(token) => token,
             None => self.scan(),
+        };
+        if let Some(token) = &token {
+            self.last_end = token.end;
         }
+        token
+    }
+
+    /// Where the last token taken ends.
+    pub fn last_end(&self) -> usize {
+        self.last_end
     }
 
     /// Where the text ends (for "the file ends before ..." messages).

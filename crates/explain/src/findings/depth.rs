@@ -83,8 +83,16 @@ fn is_tir(node: &RayNode) -> bool {
 /// `location` is where the setting is written (`written`), which may be a `--set` flag's
 /// pseudo-file (`<--set max_depth=4>`).
 fn how_to_set(name: &str, value: &str, location: &str, written: bool) -> String {
-    if location.starts_with("<--set") {
-        format!("run with --set {name}={value} instead")
+    // A setting given on the command line is changed there: `<--max-depth 1>:1:1`.
+    let flag = location
+        .strip_prefix('<')
+        .and_then(|rest| rest.split([' ', '>']).next())
+        .filter(|flag| flag.starts_with("--"));
+    if let Some(flag) = flag {
+        match flag {
+            "--set" => format!("run with --set {name}={value} instead"),
+            _ => format!("run with {flag} {value} instead"),
+        }
     } else if written {
         format!("set `{name} {value}` there (or run with --set {name}={value})")
     } else {

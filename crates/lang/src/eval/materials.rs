@@ -2,7 +2,9 @@
 //! the IR on first use, with inheritance already applied. A pattern of two colours becomes
 //! two derived IR materials (the host material with each colour as its diffuse).
 
-use whitted_ir::{DMat4, DVec3, Diagnostic, Handle, Material, Pattern, PatternKind, Span};
+use whitted_ir::{
+    BlockKind, DMat4, DVec3, Diagnostic, Handle, Material, Pattern, PatternKind, Span,
+};
 
 use super::builders::{MaterialBuilder, PropSet, Target};
 use super::{Abort, Eval, Evaluator};
@@ -74,7 +76,9 @@ impl<'a> Evaluator<'a> {
                 pattern,
                 set: PropSet::new(),
             })));
+        let previous = self.enter_written_block(BlockKind::Material, body.header, body.block.span);
         let result = self.items(&body.block.items);
+        self.leave_written_block(previous);
         let builder = match self.targets.pop() {
             Some(Target::Material(builder)) => builder,
             _ => return Err(Abort::Reported),

@@ -19,6 +19,7 @@ mod objects;
 mod properties;
 mod provenance;
 mod strings;
+mod written;
 
 use std::borrow::Borrow;
 use std::collections::HashSet;
@@ -125,15 +126,14 @@ pub(crate) struct Evaluator<'a> {
     settings_set: Vec<(crate::schema::Prop, Span)>,
     /// The active imports, calls and loop iterations, for each object's instantiation stack.
     trail: provenance::Trail,
+    /// Where settings and properties were written, for the scene's side table.
+    written: written::WrittenRecorder,
 }
 
 /// What the command line adds to a scene: `-D` constants and `--set` settings.
 pub(crate) struct CommandLine<'a> {
     pub defines: &'a [Define],
     pub overrides: &'a [crate::compile::SettingOverride],
-    /// The settings a scene starts from (`None`: the IR's defaults); another front end's
-    /// scene, when only its settings are overridden.
-    pub base_settings: Option<whitted_ir::Settings>,
 }
 
 impl<'a> Evaluator<'a> {
@@ -146,14 +146,9 @@ impl<'a> Evaluator<'a> {
         sources: whitted_ir::SourceMap,
         max_depth: usize,
     ) -> Self {
-        let CommandLine {
-            defines,
-            overrides,
-            base_settings,
-        } = command_line;
+        let CommandLine { defines, overrides } = command_line;
         let scene = Scene {
             sources,
-            settings: base_settings.unwrap_or_default(),
             ..Scene::default()
         };
         Evaluator {
@@ -189,6 +184,7 @@ impl<'a> Evaluator<'a> {
             camera_span: None,
             settings_set: Vec::new(),
             trail: provenance::Trail::default(),
+            written: written::WrittenRecorder::default(),
         }
     }
 
@@ -237,6 +233,7 @@ impl<'a> Evaluator<'a> {
                 crate::compile::OverrideValue::Expr(expr) => (self.eval(expr)?, None),
             };
             self.apply_setting(setting.prop, value, setting.value_span, word)?;
+            self.record_override(setting.prop, setting.value_span);
         }
         Ok(())
     }
@@ -432,7 +429,7 @@ impl<'a> Evaluator<'a> {
                 let value = self.eval(value)?;
                 return Ok(Flow::Return(value));
             }
-            ItemKind::Settings(body) => self.settings(body)?,
+            ItemKind::Settings(body) => self.settings(item.span, body)?,
             ItemKind::Camera { tag, body, kind } => {
                 if let Some(tag) = tag {
                     let header = Span::new(

@@ -11,6 +11,8 @@ use whitted_ir::{
     Span,
 };
 
+use whitted_ir::BlockKind;
+
 use super::builders::*;
 use super::{inherit, Abort, Eval, Evaluator, Sink};
 use crate::ast::*;
@@ -292,10 +294,14 @@ impl<'a> Evaluator<'a> {
         Ok(placement)
     }
 
-    pub(super) fn settings(&mut self, body: &Block) -> Eval<()> {
+    pub(super) fn settings(&mut self, item: Span, body: &Block) -> Eval<()> {
+        let start = item.start as usize;
+        let header = Span::new(item.file, start, start + "settings".len());
+        let previous = self.enter_written_block(BlockKind::Settings, header, body.span);
         self.targets.push(Target::Settings);
         let result = self.items(&body.items);
         self.targets.pop();
+        self.leave_written_block(previous);
         result.map(|_| ())
     }
 
@@ -314,8 +320,10 @@ impl<'a> Evaluator<'a> {
             );
         }
         let errors_before = self.error_events;
+        let previous = self.enter_written_block(BlockKind::Camera, header, body.span);
         self.targets.push(Target::Camera(CameraBuilder::new(tag)));
         let result = self.items(&body.items);
+        self.leave_written_block(previous);
         let builder = match self.targets.pop() {
             Some(Target::Camera(builder)) => builder,
             _ => return Err(Abort::Reported),
@@ -346,8 +354,10 @@ impl<'a> Evaluator<'a> {
             );
         }
         let errors_before = self.error_events;
+        let previous = self.enter_written_block(BlockKind::Light, header, body.span);
         self.targets.push(Target::Light(LightBuilder::new()));
         let result = self.items(&body.items);
+        self.leave_written_block(previous);
         let builder = match self.targets.pop() {
             Some(Target::Light(builder)) => builder,
             _ => return Err(Abort::Reported),

@@ -2,7 +2,8 @@
 //! what the block builds (a shape's parameters, a transform, a setting, the camera, a light,
 //! a material).
 
-use whitted_ir::{Attenuation, Color, DMat4, DVec3, Diagnostic, Highlight, ShadowMode, Span};
+use whitted_ir::setting_rows::{self, SettingKind, SettingValue};
+use whitted_ir::{Attenuation, Color, DMat4, DVec3, Diagnostic, Span};
 
 use super::builders::*;
 use super::{Abort, Eval, Evaluator};
@@ -33,6 +34,12 @@ impl<'a> Evaluator<'a> {
         }
         let values = self.values(property, prop)?;
         let span = property.name.span;
+        if matches!(
+            self.targets.last(),
+            Some(Target::Settings | Target::Camera(_) | Target::Light(_) | Target::Material(_))
+        ) {
+            self.record_written(property, prop);
+        }
         match self.targets.last() {
             Some(Target::Object(_))
             | Some(Target::Modifiers(..))
@@ -441,35 +448,21 @@ impl<'a> Evaluator<'a> {
             return Ok(());
         };
         let value = self.convert(row, value, value_span)?;
+        let Some(ir_row) = setting_rows::setting(prop.name()) else {
+            return Ok(());
+        };
+        // What each setting means is its row in the IR's table: the field it sets.
+        let value = match ir_row.kind {
+            SettingKind::Whole { .. } => SettingValue::Whole(value.number() as u32),
+            SettingKind::Number { .. } => SettingValue::Number(value.number()),
+            SettingKind::LightColor => SettingValue::Color(value.color()),
+            SettingKind::Word(words) => match word.and_then(|w| words.iter().find(|x| **x == w)) {
+                Some(word) => SettingValue::Word(word),
+                None => return Ok(()),
+            },
+        };
         let mut settings = self.scene.settings.clone();
-        // What each setting means: the field it sets (its kind and range are its row's).
-        match prop {
-            Prop::Width => settings.width = value.number() as u32,
-            Prop::Height => settings.height = value.number() as u32,
-            Prop::MaxDepth => settings.max_depth = value.number() as u32,
-            Prop::Samples => settings.samples_per_pixel = value.number() as u32,
-            Prop::MinWeight => settings.min_weight = value.number(),
-            Prop::Epsilon => settings.epsilon = Some(value.number()),
-            Prop::Background => settings.background = value.color(),
-            Prop::Ambient => settings.ambient = value.color(),
-            Prop::Shadows => {
-                settings.shadows = match word {
-                    Some("filtered") => ShadowMode::Filtered,
-                    Some("none") => ShadowMode::None,
-                    _ => ShadowMode::Opaque,
-                }
-            }
-            Prop::Highlight => {
-                settings.highlight = if word == Some("blinn") {
-                    Highlight::Blinn
-                } else {
-                    Highlight::Phong
-                }
-            }
-            Prop::ShadeBack => settings.shade_back = word != Some("off"),
-            Prop::AttenuationClamp => settings.attenuation_clamp = word != Some("off"),
-            _ => {}
-        }
+        (ir_row.set)(&mut settings, value);
         let pixels = u64::from(settings.width) * u64::from(settings.height);
         if pixels > limits::MAX_PIXELS {
             return self.fail(

@@ -100,6 +100,14 @@ fn mistaken_values() {
                 "a camera looking along `up`",
                 "camera perspective { eye <0, 5, 0> look_at <0, 0, 0> }\nsphere { }\n",
             ),
+            (
+                "a reflectance written as a percentage",
+                "material m {\n    diffuse 0.5\n    transmissive 90\n}\nsphere { material m }\n",
+            ),
+            (
+                "a light brighter than the largest intensity",
+                "light point { position <0, 5, 0> color rgb(1, 2e7, 1) }\nsphere { }\n",
+            ),
         ],
     );
 }

@@ -16,3 +16,4 @@ mod provenance;
 mod scenes;
 mod second_step;
 mod support;
+mod written;
