@@ -11,7 +11,7 @@ use whitted_tracer::PreparedScene;
 
 use crate::cli::{ImageFormat, QueryArgs};
 use crate::image_output::{write_image, Pixels};
-use crate::render_cmd::{check_image_size, render_options};
+use crate::render_cmd::render_options;
 use crate::scene_input::{load_scene, write_json_stdout, write_stdout};
 use crate::Failure;
 
@@ -53,8 +53,9 @@ struct WitnessDocument {
 pub fn query(args: &QueryArgs) -> Result<(), Failure> {
     let loaded = load_scene(&args.scene, true)?;
     let options = render_options(&loaded.scene.settings, &args.overrides);
-    check_image_size(options.width, options.height)?;
+    crate::request::check_size(&args.overrides, options.width, options.height)?;
     if let Some(mask) = &args.mask {
+        crate::render_cmd::check_output_folder(mask)?;
         if crate::render_cmd::same_file(mask, &args.scene.scene) {
             return Err(Failure::Usage(format!(
                 "--mask {} would overwrite the scene",
