@@ -61,6 +61,8 @@ fn rows(dir: &Path) -> Vec<Row> {
     // A scene whose name has an image's extension, to be named as its own output.
     let ppm_scene = dir.join("scene.ppm");
     std::fs::copy("scenes/whitted.scene", &ppm_scene).expect("copied");
+    let imports = dir.join("imports.scene");
+    std::fs::write(&imports, "import \"no-such-part.scene\"\n").expect("writable");
     let small_ref = dir.join("ref.png");
     image::RgbImage::new(8, 8)
         .save(&small_ref)
@@ -126,6 +128,9 @@ fn rows(dir: &Path) -> Vec<Row> {
     let ok = "scenes/whitted.scene";
     let course = text(&course);
     rows.extend([
+        // Files that cannot be read as a scene.
+        row(&["check", dir_text], 1, dir_text),
+        row(&["check", text(&imports)], 1, "no-such-part.scene"),
         // A pixel outside the image.
         row(
             &["trace", ok, "--pixel", "9999,9999"],
@@ -305,4 +310,22 @@ fn every_subcommand_follows_the_exit_code_rule() {
     );
     // Nothing was written by the failing renders.
     assert!(!dir.path().join("big.exr").exists());
+}
+
+/// Output that cannot be written is an IO error: exit 1, saying where.
+#[test]
+fn an_unwritable_stdout_is_an_io_error() {
+    let Ok(full) = std::fs::File::create("/dev/full") else {
+        eprintln!("skipped: no /dev/full");
+        return;
+    };
+    let output = Command::new(env!("CARGO_BIN_EXE_whitted"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["ir", "scenes/whitted.scene"])
+        .stdout(full)
+        .output()
+        .expect("the whitted binary runs");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("cannot write to stdout"), "{stderr}");
 }
