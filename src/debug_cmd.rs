@@ -19,13 +19,11 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
     crate::render_cmd::check_image_size(settings.width, settings.height)?;
     if let Some([x, y]) = args.pixel {
         if x >= settings.width || y >= settings.height {
-            return Err(Failure::Usage(format!(
-                "pixel ({x}, {y}) is outside the {}x{} image (x must be 0 to {}, y 0 to {})",
+            return Err(crate::request::pixel_outside(
+                [x, y],
                 settings.width,
                 settings.height,
-                settings.width.saturating_sub(1),
-                settings.height.saturating_sub(1)
-            )));
+            ));
         }
     }
     let watch = watch_list(

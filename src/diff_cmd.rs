@@ -8,12 +8,10 @@ use serde::Serialize;
 use whitted_explain::diff::{diff_pixel, format_text, Side};
 use whitted_explain::regions::{differing_regions, Region};
 use whitted_explain::{explain, format_summary, ExplanationDocument};
-use whitted_tracer::ray_tree::{check_request, SampleChoice};
 use whitted_tracer::{NoObserver, PreparedScene};
 
 use crate::cli::{DiffArgs, RenderOverrides, SceneArgs, TraceArgs};
 use crate::image_output::to_srgb8;
-use crate::render_cmd::check_image_size;
 use crate::scene_input::{load_scene, write_json_stdout, write_stdout};
 use crate::setting_flags::apply_render_flags;
 use crate::Failure;
@@ -88,8 +86,7 @@ fn pixel_diff(
     let (loaded_a, options_a) = apply_render_flags(loaded_a, overrides)?;
     let (loaded_b, options_b) = apply_render_flags(loaded_b, overrides)?;
     for options in [&options_a, &options_b] {
-        check_request(options, x, y, SampleChoice::All)
-            .map_err(|error| Failure::Usage(error.to_string()))?;
+        crate::request::check_pixel(options, [x, y], None)?;
     }
     let prepared_a = PreparedScene::new(&loaded_a.scene);
     let prepared_b = PreparedScene::new(&loaded_b.scene);
@@ -103,7 +100,7 @@ fn pixel_diff(
         scene: &loaded_b.scene,
         options: &options_b,
     };
-    let diff = diff_pixel(side_a, side_b, x, y).map_err(|e| Failure::Usage(e.to_string()))?;
+    let diff = diff_pixel(side_a, side_b, x, y).map_err(|e| crate::request::trace_failure(&e))?;
     if json {
         return write_json_stdout(&diff);
     }
@@ -150,7 +147,6 @@ fn against_image(args: &DiffArgs, reference_path: &Path) -> Result<(), Failure> 
             options.height
         )));
     }
-    check_image_size(width, height)?;
     let prepared = PreparedScene::new(&loaded.scene);
     let Some((image, _)) = whitted_tracer::render(&prepared, &options, &NoObserver) else {
         return Err(Failure::Message("the render was cancelled".into()));

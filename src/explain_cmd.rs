@@ -2,7 +2,6 @@
 //! findings, `whitted_explain`), print it as text or JSON.
 
 use whitted_explain::{explain, format_text};
-use whitted_tracer::ray_tree::{check_request, SampleChoice};
 use whitted_tracer::PreparedScene;
 
 use crate::cli::ExplainArgs;
@@ -14,12 +13,12 @@ pub fn explain_pixel(args: &ExplainArgs) -> Result<(), Failure> {
     let loaded = load_scene(&args.scene, false)?;
     let (loaded, options) = apply_render_flags(loaded, &args.overrides)?;
     let [x, y] = args.pixel;
-    // A pixel outside the image is a usage error (exit 2), found before the BVH build.
-    check_request(&options, x, y, SampleChoice::All)
-        .map_err(|error| Failure::Usage(error.to_string()))?;
+    // A pixel the image cannot have is found before the BVH build (the size was checked
+    // when the flags were applied).
+    crate::request::check_pixel(&options, args.pixel, None)?;
     let prepared = PreparedScene::new(&loaded.scene);
     let explanation = explain(&prepared, &loaded.scene, &options, x, y)
-        .map_err(|error| Failure::Usage(error.to_string()))?;
+        .map_err(|error| crate::request::trace_failure(&error))?;
     if args.json {
         write_json_stdout(&explanation.document())
     } else {

@@ -5,7 +5,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use whitted_ir::{Diagnostic, Severity, SourceMap, ValidScene};
+use whitted_ir::{Diagnostic, Severity, SourceFile, SourceMap, Span, ValidScene};
 use whitted_lang::{compile_file, CompileOptions, SourceLoader};
 use whitted_mit6837::{CourseOptions, MeshLoader};
 
@@ -100,14 +100,20 @@ pub fn compile(args: &SceneArgs, course: &CourseOptions) -> Compiled {
         scene: conversion.scene,
         diagnostics: conversion.diagnostics,
     };
-    if let Some((name, _)) = args.define.first() {
+    if let Some((name, value)) = args.define.first() {
         compiled.scene = None;
+        // In the flag's pseudo-file, as the language puts its `-D` errors: the command line
+        // is at fault (exit 2), and the message quotes it.
+        let file = compiled.sources.add(SourceFile::new(
+            format!("<-D {name}>"),
+            format!("{name}={value}"),
+        ));
         compiled.diagnostics.push(Diagnostic::new(
             Severity::Error,
             format!(
                 "-D {name}: a 6.837 scene has no constants to override (use --set for settings)"
             ),
-            None,
+            Some(Span::new(file, 0, name.len())),
         ));
         return compiled;
     }

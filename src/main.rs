@@ -1,7 +1,7 @@
 //! The `whitted` command line: the only place that reads files, prints and exits.
 //!
-//! Exit codes: 0 success; 1 the scene has errors or an IO error; 2 bad command-line usage
-//! (clap's own code for usage errors).
+//! Exit codes: 0 success; 1 the scene or a file; 2 the command line; 128 + N a signal
+//! (the rule is in `failure.rs`).
 // A program, not a library: it prints its results and sets its exit status.
 #![allow(clippy::print_stdout, clippy::print_stderr, clippy::exit)]
 
@@ -11,12 +11,14 @@ mod cpu_time;
 mod debug_cmd;
 mod diff_cmd;
 mod explain_cmd;
+mod failure;
 mod front_end;
 mod image_output;
 mod interrupt;
 mod mit6837_cmd;
 mod query_cmd;
 mod render_cmd;
+mod request;
 mod scene_input;
 mod setting_flags;
 mod stats_image;
@@ -29,24 +31,7 @@ use clap::Parser;
 use whitted_tracer::TraversalPath;
 
 use cli::{Cli, Command};
-
-/// How a command failed, so that `main` can pick the exit code and print one clear line.
-pub enum Failure {
-    /// The scene had errors; its diagnostics were already printed.
-    SceneErrors,
-    /// Anything else the user must fix (a missing file, an unwritable output): one line.
-    Message(String),
-    /// Bad usage that clap could not catch (e.g. a pixel outside the image).
-    Usage(String),
-    /// Stopped by this signal after cleaning up: exit as a shell expects (128 + its number).
-    Signal(i32),
-}
-
-impl From<std::io::Error> for Failure {
-    fn from(error: std::io::Error) -> Self {
-        Failure::Message(error.to_string())
-    }
-}
+pub use failure::Failure;
 
 /// Where the BVH walk's child test may be forced, to compare the paths' speed or to rule
 /// one out: every path renders the same image.
@@ -88,15 +73,11 @@ fn main() -> ExitCode {
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(Failure::SceneErrors) => ExitCode::from(1),
-        Err(Failure::Message(message)) => {
-            let _ = writeln!(std::io::stderr(), "error: {message}");
-            ExitCode::from(1)
+        Err(failure) => {
+            if let Some(message) = failure.message() {
+                let _ = writeln!(std::io::stderr(), "error: {message}");
+            }
+            ExitCode::from(failure.exit_code())
         }
-        Err(Failure::Usage(message)) => {
-            let _ = writeln!(std::io::stderr(), "error: {message}");
-            ExitCode::from(2)
-        }
-        Err(Failure::Signal(signal)) => ExitCode::from(128u8.saturating_add(signal as u8)),
     }
 }

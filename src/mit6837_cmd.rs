@@ -118,6 +118,15 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
                 };
                 let width = side(value("a width and a height")?, "width")?;
                 let height = side(value("a width and a height")?, "height")?;
+                // Past the pixels limit the compiler would blame the scene for the flag's size.
+                let pixels = u64::from(width) * u64::from(height);
+                if pixels > limits::MAX_PIXELS {
+                    return Err(format!(
+                        "`-size {width} {height}` asks for {pixels} pixels, more than the pixels \
+                         limit ({}, about 11585x11585)",
+                        limits::MAX_PIXELS
+                    ));
+                }
                 size = Some((width, height));
             }
             "-output" => output = Some(image_path(value("an image file")?, "-output")?),

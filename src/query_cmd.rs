@@ -54,6 +54,7 @@ pub fn query(args: &QueryArgs) -> Result<(), Failure> {
     let loaded = load_scene(&args.scene, true)?;
     let (loaded, options) = apply_render_flags(loaded, &args.overrides)?;
     if let Some(mask) = &args.mask {
+        crate::render_cmd::check_output_folder(mask)?;
         if crate::render_cmd::same_file(mask, &args.scene.scene) {
             return Err(Failure::Usage(format!(
                 "--mask {} would overwrite the scene",

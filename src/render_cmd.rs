@@ -92,15 +92,18 @@ impl MemoryEstimate {
             .saturating_add(self.objects.saturating_mul(PREPARED_BYTES_PER_OBJECT))
     }
 
-    fn check(&self) -> Result<(), Failure> {
+    /// `asked` says what made the image's size, for the message. Objects alone stay far
+    /// below the limit (`limits::MAX_OBJECTS`), so a refusal is always the size and formats
+    /// the command line asked for: a usage error.
+    fn check(&self, asked: &str) -> Result<(), Failure> {
         let bytes = self.bytes();
         let limit = whitted_ir::limits::MAX_RENDER_MEMORY_BYTES;
         if bytes > limit {
             let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
-            return Err(Failure::Message(format!(
-                "this render would need about {:.1} GiB of memory, more than the render memory \
-                 limit of {:.0} GiB: make the image smaller, or write 8-bit images (.png, .ppm) \
-                 rather than .exr or .hdr",
+            return Err(Failure::Usage(format!(
+                "{asked} would need about {:.1} GiB of memory to render, more than the render \
+                 memory limit of {:.0} GiB: make the image smaller, or write 8-bit images \
+                 (.png, .ppm) rather than .exr or .hdr",
                 gib(bytes),
                 gib(limit)
             )));
@@ -232,7 +235,11 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
             .map(|path| ImageFormat::from_path(path).unwrap_or(ImageFormat::Png)),
         objects: loaded.scene.objects.len() as u64,
     };
-    estimate.check()?;
+    let asked = crate::request::size_flags(&args.overrides).map_or_else(
+        || format!("a {}x{} image", options.width, options.height),
+        |flags| format!("`{flags}`"),
+    );
+    estimate.check(&asked)?;
     let objects = loaded.scene.objects.len();
     // What would make samples reach the ray budget, said while the IR (and its sources) is
     // at hand: the report after the render needs it only if pixels were cut.
@@ -552,7 +559,7 @@ mod tests {
                     stats_image: stats,
                     objects: whitted_ir::limits::MAX_OBJECTS as u64,
                 };
-                assert!(estimate.check().is_ok(), "{output:?} {stats:?}");
+                assert!(estimate.check("the size").is_ok(), "{output:?} {stats:?}");
             }
             let estimate = MemoryEstimate {
                 pixels: MAX,
@@ -560,7 +567,10 @@ mod tests {
                 stats_image: Some(Exr),
                 objects: 0,
             };
-            assert!(estimate.check().is_err(), "{output:?} with EXR heat maps");
+            assert!(
+                estimate.check("the size").is_err(),
+                "{output:?} with EXR heat maps"
+            );
         }
     }
 }

@@ -14,7 +14,6 @@ use whitted_ir::{
 use whitted_tracer::RenderOptions;
 
 use crate::cli::RenderOverrides;
-use crate::render_cmd::check_image_size;
 use crate::scene_input::Loaded;
 use crate::Failure;
 
@@ -39,7 +38,7 @@ pub fn apply_render_flags(
         overrides.width,
         overrides.height,
     );
-    check_image_size(width, height)?;
+    crate::request::check_size(overrides, width, height)?;
     let mut assignments = Vec::new();
     // A side worked out from the other keeps the scene's aspect ratio; it is recorded under
     // the flag that decided it.

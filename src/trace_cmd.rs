@@ -2,9 +2,7 @@
 
 use std::io::IsTerminal;
 
-use whitted_tracer::ray_tree::{
-    check_request, format_text, trace_pixel, SampleChoice, TextOptions,
-};
+use whitted_tracer::ray_tree::{format_text, trace_pixel, SampleChoice, TextOptions};
 use whitted_tracer::PreparedScene;
 
 use crate::cli::TraceArgs;
@@ -21,11 +19,10 @@ pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
         None => SampleChoice::All,
     };
     // Check the request before the BVH build, which is the slow part on big scenes.
-    // A pixel or sample that does not exist is a usage error (exit 2), like a malformed one.
-    check_request(&options, x, y, which).map_err(|error| Failure::Usage(error.to_string()))?;
+    crate::request::check_pixel(&options, args.pixel, args.sample)?;
     let prepared = PreparedScene::new(&loaded.scene);
     let tree = trace_pixel(&prepared, &loaded.scene, &options, x, y, which)
-        .map_err(|error| Failure::Usage(error.to_string()))?;
+        .map_err(|error| crate::request::trace_failure(&error))?;
     if args.json {
         write_json_stdout(&tree.document())
     } else {

@@ -422,9 +422,12 @@ fn an_image_too_large_for_memory_is_refused_before_rendering() {
         "-o",
         out.to_str().unwrap(),
     ]);
-    assert_eq!(output.status.code(), Some(1));
+    // The size is the command line's: a usage error quoting the flags.
+    assert_eq!(output.status.code(), Some(2));
     assert!(
-        stderr(&output).contains("more than the pixels limit (134217728"),
+        stderr(&output).contains(
+            "`--width 30000 --height 30000` asks for 900000000 pixels, more than the pixels limit (134217728"
+        ),
         "{}",
         stderr(&output)
     );

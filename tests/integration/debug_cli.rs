@@ -34,7 +34,7 @@ fn a_pixel_outside_the_image_is_an_error() {
     let output = debug(&["scenes/whitted.scene", "--pixel", "640,10"]);
     assert_eq!(output.status.code(), Some(2));
     assert!(
-        stderr(&output).contains("pixel (640, 10) is outside the 640x480 image"),
+        stderr(&output).contains("`--pixel 640,10` is outside the 640x480 image"),
         "{}",
         stderr(&output)
     );

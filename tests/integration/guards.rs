@@ -302,7 +302,7 @@ fn a_render_over_the_memory_limit_is_refused_before_any_work() {
         ],
         Duration::from_secs(60),
     );
-    assert_eq!(output.status.code(), Some(1), "{}", stderr(&output));
+    assert_eq!(output.status.code(), Some(2), "{}", stderr(&output));
     assert!(
         stderr(&output).contains("more than the render memory limit of 8 GiB"),
         "{}",

@@ -8,6 +8,7 @@ mod conventions;
 mod debug_cli;
 mod debug_tmux;
 mod diff;
+mod exit_codes;
 mod explain;
 mod extremes;
 mod front_end_oracles;

@@ -253,11 +253,12 @@ fn bad_course_flags_are_usage_errors_that_name_the_flag() {
     assert!(output.status.success());
     assert!(stdout(&output).starts_with("usage: whitted mit6837 -input SCENE.txt -size W H"));
 
-    // -D has nothing to override in a 6.837 scene.
+    // -D has nothing to override in a 6.837 scene: the command line is wrong, not the scene.
     let output = whitted(&["check", SPHERES, "-D", "N=3"]);
-    assert_eq!(output.status.code(), Some(1));
+    assert_eq!(output.status.code(), Some(2));
     assert!(
-        stderr(&output).contains("a 6.837 scene has no constants"),
+        stderr(&output).contains("a 6.837 scene has no constants")
+            && stderr(&output).contains("(in `-D N`)"),
         "{}",
         stderr(&output)
     );

@@ -242,7 +242,7 @@ fn bad_requests_are_one_clear_line() {
         (
             &["trace", "scenes/whitted.scene", "--pixel", "640,10"],
             2,
-            "error: pixel (640, 10) is outside the 640x480 image (x must be 0 to 639, y 0 to 479)",
+            "error: `--pixel 640,10` is outside the 640x480 image (x must be 0 to 639, y 0 to 479)",
         ),
         (
             &[
@@ -256,7 +256,7 @@ fn bad_requests_are_one_clear_line() {
                 "8",
             ],
             2,
-            "error: pixel (10, 10) is outside the 8x8 image (x must be 0 to 7, y 0 to 7)",
+            "error: `--pixel 10,10` is outside the 8x8 image (x must be 0 to 7, y 0 to 7)",
         ),
         (
             &[
@@ -268,7 +268,7 @@ fn bad_requests_are_one_clear_line() {
                 "1",
             ],
             2,
-            "error: there is no sample 1: the image has 1 sample per pixel (sample 0)",
+            "error: `--sample 1` is not a sample of the pixel: the image has 1 sample per pixel (sample 0)",
         ),
         (
             &[
@@ -280,7 +280,7 @@ fn bad_requests_are_one_clear_line() {
                 "16",
             ],
             2,
-            "error: there is no sample 16: the image has 16 samples per pixel (0 to 15)",
+            "error: `--sample 16` is not a sample of the pixel: the image has 16 samples per pixel (0 to 15)",
         ),
         (
             &["trace", "no/such.scene", "--pixel", "1,1"],
