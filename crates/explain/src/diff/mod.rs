@@ -596,29 +596,16 @@ impl Walk<'_> {
     }
 }
 
-/// `file:line:col` of the word `field` inside a material's definition, when it is written
-/// there (an inherited value is written in the parent: the material's own line is used).
+/// `file:line:col` of the property `field` in a material's definition, when it is written
+/// there (the scene's table of written properties; an inherited value is written in the
+/// parent, and the material's own line is used).
 fn property_location(scene: &Scene, material: Handle<Material>, field: &str) -> Option<String> {
-    let span = scene.materials.span(material);
-    let file = scene.sources.get(span.file)?;
-    // The span may cover only the material's header: look on to the end of its block.
-    let rest = file.text.get(span.start as usize..)?;
-    let text = &rest[..rest.find('}').map_or(rest.len(), |end| end + 1)];
-    let word = |c: char| c.is_ascii_alphanumeric() || c == '_';
-    let mut from = 0;
-    while let Some(at) = text[from..].find(field) {
-        let start = from + at;
-        let end = start + field.len();
-        let before = text[..start].chars().next_back().is_some_and(word);
-        let after = text[end..].chars().next().is_some_and(word);
-        if !before && !after {
-            let offset = span.start as usize + start;
-            let at = whitted_ir::Span::new(span.file, offset, offset + field.len());
-            return Some(scene.sources.location(at));
-        }
-        from = end;
-    }
-    None
+    let header = scene.materials.span(material);
+    scene
+        .written
+        .properties_in(whitted_ir::BlockKind::Material, header, field)
+        .last()
+        .map(|written| scene.sources.location(written.name_span))
 }
 
 fn hit_label(hit: &HitInfo) -> String {

@@ -157,3 +157,26 @@ fn the_limits_section_lists_every_limit_once_with_its_value() {
         }
     }
 }
+
+/// The settings table in docs/language.md has a line for every setting of the IR's table,
+/// with the row's default: a setting added to the table and not to the docs fails here.
+#[test]
+fn the_settings_table_lists_every_setting_with_its_default() {
+    let markdown = language_md();
+    let start = markdown.find("## Settings").expect("a Settings section");
+    let section = &markdown[start..];
+    let section = &section[..section[3..].find("\n## ").map_or(section.len(), |i| i + 3)];
+    let lines: Vec<&str> = section.lines().filter(|l| l.starts_with("| `")).collect();
+    for row in whitted_ir::setting_rows::SETTINGS {
+        let name = format!("`{}`", row.name);
+        let line = lines
+            .iter()
+            .find(|l| l.split('|').nth(1).is_some_and(|cell| cell.contains(&name)))
+            .unwrap_or_else(|| panic!("docs/language.md's settings table has no {name}"));
+        assert!(
+            line.split('|').nth(2).is_some_and(|d| d.contains(row.default)),
+            "{name}'s default is {} but the docs say: {line}",
+            row.default
+        );
+    }
+}
