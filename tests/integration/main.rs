@@ -21,6 +21,7 @@ mod query;
 mod ray_budget;
 mod ray_trees;
 mod reshade;
+mod sampling;
 mod tidy;
 mod trace_cli;
 mod traversal_paths;

@@ -65,6 +65,18 @@ pub enum Highlight {
     Blinn,
 }
 
+/// Where a pixel's samples fall.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Sampling {
+    /// Stratified and jittered (Kensler's correlated multi-jitter): no grid pattern to alias.
+    Jittered,
+    /// A regular grid of sample positions at the centres of equal cells (the course's
+    /// uniform sampler): repeatable by hand, and aliasing a fine pattern the same way in
+    /// every pixel.
+    Grid,
+}
+
 /// Render settings. Defaults live here so that the language, the CLI and tests agree.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Settings {
@@ -76,6 +88,8 @@ pub struct Settings {
     /// product of coefficients from the eye) is below this on every channel is not traced.
     pub min_weight: f64,
     pub samples_per_pixel: u32,
+    /// Where those samples fall in the pixel.
+    pub sampling: Sampling,
     pub background: Color,
     /// The global ambient light `Ia`.
     pub ambient: Color,
@@ -101,6 +115,7 @@ impl Default for Settings {
             max_depth: 5,
             min_weight: 0.001,
             samples_per_pixel: 1,
+            sampling: Sampling::Jittered,
             background: Color::BLACK,
             ambient: Color::WHITE,
             epsilon: None,

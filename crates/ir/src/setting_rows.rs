@@ -13,7 +13,7 @@
 //! the kind, default and doc from the row); then give it meaning in the tracer.
 
 use crate::limits::{self, MAX_INTENSITY};
-use crate::scene::{Color, Highlight, Settings, ShadowMode};
+use crate::scene::{Color, Highlight, Sampling, Settings, ShadowMode};
 
 /// The value a setting takes, with its range.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -150,6 +150,25 @@ pub const SAMPLES: SettingRow = SettingRow {
     set: |s, v| s.samples_per_pixel = whole(v),
 };
 
+pub const SAMPLING: SettingRow = SettingRow {
+    name: "sampling",
+    kind: SettingKind::Word(&["jittered", "grid"]),
+    default: "jittered",
+    doc: "where a pixel's samples fall: `jittered` (stratified, no pattern to alias) or `grid` (a regular grid, the course's uniform sampler)",
+    get: |s| {
+        Some(SettingValue::Word(match s.sampling {
+            Sampling::Jittered => "jittered",
+            Sampling::Grid => "grid",
+        }))
+    },
+    set: |s, v| {
+        s.sampling = match word(v) {
+            "grid" => Sampling::Grid,
+            _ => Sampling::Jittered,
+        }
+    },
+};
+
 pub const BACKGROUND: SettingRow = SettingRow {
     name: "background",
     kind: SettingKind::LightColor,
@@ -246,6 +265,7 @@ pub const SETTINGS: &[SettingRow] = &[
     MAX_DEPTH,
     MIN_WEIGHT,
     SAMPLES,
+    SAMPLING,
     BACKGROUND,
     AMBIENT,
     EPSILON,

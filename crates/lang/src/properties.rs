@@ -214,6 +214,9 @@ properties! {
     Samples "samples" {
         Settings => setting_kind(&S::SAMPLES), S::SAMPLES.default, S::SAMPLES.doc;
     }
+    Sampling "sampling" {
+        Settings => setting_kind(&S::SAMPLING), S::SAMPLING.default, S::SAMPLING.doc;
+    }
     Background "background" {
         Settings => setting_kind(&S::BACKGROUND), S::BACKGROUND.default, S::BACKGROUND.doc;
     }

@@ -116,6 +116,7 @@ fn settings(
         max_depth: options.bounces,
         min_weight: options.weight,
         samples_per_pixel: 1,
+        sampling: whitted_ir::Sampling::Jittered,
         background: background.unwrap_or(DEFAULT_BACKGROUND),
         ambient: ambient.unwrap_or(Color::BLACK),
         // The error-bounded offset, not the course's fixed epsilon: it differs from the

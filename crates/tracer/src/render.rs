@@ -16,7 +16,7 @@ use std::time::Instant;
 
 use glam::Vec3A;
 use rayon::prelude::*;
-use whitted_ir::{Camera, Settings};
+use whitted_ir::{Camera, Sampling, Settings};
 
 use crate::bvh::PACKET;
 use crate::camera::PreparedCamera;
@@ -240,7 +240,14 @@ pub fn trace_pixel_preferring<R: Recorder>(
     rec: &mut R,
 ) -> Option<[f32; 3]> {
     let mut tracer = Tracer::new(scene, options.depth_limit(), options.min_weight);
-    let ray = camera_ray(&scene.camera, options, x, y, sample);
+    let ray = camera_ray(
+        &scene.camera,
+        scene.settings().sampling,
+        options,
+        x,
+        y,
+        sample,
+    );
     tracer
         .trace_preferring(&ray, object, rec)
         .map(|c| c.to_array())
@@ -256,20 +263,28 @@ pub(crate) fn trace_sample<R: Recorder>(
     sample: u32,
     rec: &mut R,
 ) -> Vec3A {
-    let ray = camera_ray(&scene.camera, options, x, y, sample);
+    let ray = camera_ray(
+        &scene.camera,
+        scene.settings().sampling,
+        options,
+        x,
+        y,
+        sample,
+    );
     tracer.trace(&ray, &PathState::camera(), rec)
 }
 
-/// The camera ray of sample `sample` of pixel `(x, y)`.
+/// The camera ray of sample `sample` of pixel `(x, y)`, the sample placed by `sampling`.
 #[inline]
 fn camera_ray(
     camera: &PreparedCamera,
+    sampling: Sampling,
     options: &RenderOptions,
     x: u32,
     y: u32,
     sample: u32,
 ) -> Ray {
-    let (dx, dy) = sample_offset(x, y, sample, options.samples());
+    let (dx, dy) = sample_offset(x, y, sample, options.samples(), sampling);
     camera.ray(x as f32 + dx, y as f32 + dy, options.width, options.height)
 }
 
@@ -331,7 +346,8 @@ fn render_recorded<R: Recorder + Default + Send>(
                 let x0 = (index as u32 % tiles_x) * TILE_SIZE;
                 let y0 = (index as u32 / tiles_x) * TILE_SIZE;
                 let band = bands.get((y0 / TILE_SIZE) as usize)?;
-                render_tile::<R>(worker, camera, options, observer, band, x0, y0)
+                let view = (camera, scene.settings().sampling);
+                render_tile::<R>(worker, view, options, observer, band, x0, y0)
             },
         )
         .try_reduce(RayCounters::default, |mut a, b| {
@@ -363,7 +379,7 @@ fn render_recorded<R: Recorder + Default + Send>(
 /// of the image. Returns the tile's ray counts, or `None` when the observer cancels.
 fn render_tile<R: Recorder + Default>(
     worker: &mut Worker<'_, R>,
-    camera: &PreparedCamera,
+    (camera, sampling): (&PreparedCamera, Sampling),
     options: &RenderOptions,
     observer: &dyn RenderObserver,
     band: &Mutex<Band<'_, R>>,
@@ -385,7 +401,7 @@ fn render_tile<R: Recorder + Default>(
         rays.clear();
         for x in x0..x0 + width {
             for sample in 0..samples {
-                rays.push(camera_ray(camera, options, x, y, sample));
+                rays.push(camera_ray(camera, sampling, options, x, y, sample));
             }
         }
         // Neighbouring camera rays find their first hits together: a packet shares the

@@ -3,16 +3,37 @@
 //!
 //! One sample sits at the pixel centre. More samples use Kensler's correlated multi-jittered
 //! pattern (Pixar technical memo 13-01): stratified on a jittered grid and in each axis on
-//! its own, for any count (not only squares), with hashing instead of random state.
+//! its own, for any count (not only squares), with hashing instead of random state; or, with
+//! `sampling grid`, the centres of a regular grid's cells, the same in every pixel.
+
+use whitted_ir::Sampling;
 
 /// The sample's offset inside the pixel, each coordinate in `[0, 1)`.
 #[inline]
-pub fn sample_offset(x: u32, y: u32, sample: u32, samples: u32) -> (f32, f32) {
+pub fn sample_offset(x: u32, y: u32, sample: u32, samples: u32, sampling: Sampling) -> (f32, f32) {
     if samples <= 1 {
         return (0.5, 0.5);
     }
-    let pattern = pixel_seed(x, y);
-    correlated_multi_jitter(sample % samples, samples, pattern)
+    match sampling {
+        Sampling::Jittered => {
+            let pattern = pixel_seed(x, y);
+            correlated_multi_jitter(sample % samples, samples, pattern)
+        }
+        Sampling::Grid => grid(sample % samples, samples),
+    }
+}
+
+/// The centre of cell `sample` of a grid of `columns` x `rows` cells, row by row: as square
+/// as the count allows (4 is 2 x 2, 8 is 2 x 4); a count that is not a product of its
+/// columns leaves the last row short (5 is 2 x 3 with one cell empty).
+fn grid(sample: u32, samples: u32) -> (f32, f32) {
+    let columns = ((samples as f32).sqrt() as u32).max(1);
+    let rows = samples.div_ceil(columns);
+    let (column, row) = (sample % columns, sample / columns);
+    (
+        (column as f32 + 0.5) / columns as f32,
+        (row as f32 + 0.5) / rows as f32,
+    )
 }
 
 /// A well-mixed 32-bit seed per pixel.
@@ -99,7 +120,8 @@ mod tests {
 
     #[test]
     fn one_sample_is_the_pixel_centre() {
-        assert_eq!(sample_offset(3, 7, 0, 1), (0.5, 0.5));
+        assert_eq!(sample_offset(3, 7, 0, 1, Sampling::Jittered), (0.5, 0.5));
+        assert_eq!(sample_offset(3, 7, 0, 1, Sampling::Grid), (0.5, 0.5));
     }
 
     #[test]
@@ -109,7 +131,7 @@ mod tests {
             let mut x_strata = vec![0; samples as usize];
             let mut y_strata = vec![0; samples as usize];
             for k in 0..samples {
-                let (sx, sy) = sample_offset(x, y, k, samples);
+                let (sx, sy) = sample_offset(x, y, k, samples, Sampling::Jittered);
                 assert!((0.0..1.0).contains(&sx) && (0.0..1.0).contains(&sy));
                 y_strata[(sy * samples as f32) as usize] += 1;
                 x_strata[((sx * samples as f32) as usize).min(samples as usize - 1)] += 1;
@@ -127,7 +149,32 @@ mod tests {
 
     #[test]
     fn pattern_is_a_pure_function_and_differs_between_pixels() {
-        assert_eq!(sample_offset(5, 6, 3, 8), sample_offset(5, 6, 3, 8));
-        assert_ne!(sample_offset(5, 6, 3, 8), sample_offset(6, 5, 3, 8));
+        let jittered = |x, y| sample_offset(x, y, 3, 8, Sampling::Jittered);
+        assert_eq!(jittered(5, 6), jittered(5, 6));
+        assert_ne!(jittered(5, 6), jittered(6, 5));
+    }
+
+    /// The grid, worked by hand: 4 samples are the centres of a 2 x 2 grid, 8 of 2 x 4, the
+    /// same in every pixel.
+    #[test]
+    fn a_grid_puts_samples_at_the_centres_of_equal_cells() {
+        let grid = |x, y, k, n| sample_offset(x, y, k, n, Sampling::Grid);
+        let four: Vec<_> = (0..4).map(|k| grid(0, 0, k, 4)).collect();
+        assert_eq!(
+            four,
+            [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)]
+        );
+        assert_eq!(grid(0, 0, 5, 8), (0.75, 0.625));
+        assert_eq!(grid(9, 4, 5, 8), grid(0, 0, 5, 8));
+        assert_eq!(
+            grid(0, 0, 2, 3),
+            (0.5, 2.5 / 3.0),
+            "3 samples: one column of three"
+        );
+        assert_eq!(
+            grid(0, 0, 4, 5),
+            (0.25, 2.5 / 3.0),
+            "5: 2 x 3, one cell empty"
+        );
     }
 }

@@ -174,7 +174,9 @@ fn the_settings_table_lists_every_setting_with_its_default() {
             .find(|l| l.split('|').nth(1).is_some_and(|cell| cell.contains(&name)))
             .unwrap_or_else(|| panic!("docs/language.md's settings table has no {name}"));
         assert!(
-            line.split('|').nth(2).is_some_and(|d| d.contains(row.default)),
+            line.split('|')
+                .nth(2)
+                .is_some_and(|d| d.contains(row.default)),
             "{name}'s default is {} but the docs say: {line}",
             row.default
         );
