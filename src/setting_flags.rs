@@ -168,11 +168,16 @@ pub fn apply_course_sets(
         let name_span = Span::new(file, 0, name.len());
         let value_span = Span::new(file, name.len() + 1, text.len());
         let Some(row) = setting_rows::setting(name) else {
-            let names: Vec<&str> = setting_rows::setting_names().collect();
+            let names: Vec<String> = setting_rows::setting_names()
+                .map(|n| format!("`{n}`"))
+                .collect();
+            let (last, rest) = names
+                .split_last()
+                .map_or(("", &[][..]), |(l, r)| (l.as_str(), r));
             diagnostics.push(
                 Diagnostic::error(format!("there is no setting `{name}`"), name_span)
                     .with_label("not a setting")
-                    .with_hint(format!("the settings are {}", names.join(", "))),
+                    .with_hint(format!("the settings are {} and {last}", rest.join(", "))),
             );
             continue;
         };
