@@ -233,7 +233,7 @@ impl Triangle {
     }
 }
 
-/// Half of `bounds.rs`'s padding of BVH boxes (2⁻²⁰ of the magnitude, plus 1e-6): the room
+/// Half of whitted-bvh's `bounds.rs` padding of BVH boxes (2⁻²⁰ of the magnitude, plus 1e-6): the room
 /// a vertex's own rounding needs.
 const HIT_RELATIVE_PAD: f32 = 1.0 / (1u32 << 21) as f32;
 const HIT_ABSOLUTE_PAD: f32 = 5e-7;

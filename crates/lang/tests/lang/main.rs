@@ -12,7 +12,7 @@ mod limits;
 mod material_colors;
 mod meshes;
 mod overrides;
+mod programming_constructs;
 mod provenance;
 mod scenes;
-mod second_step;
 mod support;
