@@ -7,9 +7,10 @@
 //! obvhs's visit order with the fastest child test the CPU has (`simd`, see
 //! [`TraversalPath`]). [`Bound`] is what an object's box can be (empty, finite, infinite).
 //!
-//! This crate knows nothing of scenes or shapes: callers hand it boxes and get back
-//! primitive indices in walk order. It is the one library crate with `unsafe` code (the
-//! SIMD walks in `simd`), kept apart so that everything else can deny it.
+//! This crate knows nothing of scenes: callers work out their objects' bounds (with
+//! [`Bound`]), hand over the finite boxes, and get back primitive indices in walk order. It
+//! is the one library crate with `unsafe` code (the SIMD walks in `simd`), kept apart so
+//! that everything else can deny it.
 
 mod binary;
 mod bounds;
