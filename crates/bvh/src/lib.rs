@@ -21,7 +21,6 @@ pub mod testing;
 mod walk;
 mod wide;
 
-pub use binary::MORTON_MIN_PRIMITIVES;
 pub use bounds::{inverse_direction, segment_entry, segment_touches_box, Bound};
 pub use ray::Ray;
 pub use walk::{
