@@ -21,7 +21,7 @@ pub mod testing;
 mod walk;
 mod wide;
 
-pub use bounds::{inverse_direction, segment_entry, segment_touches_box, Bound};
+pub use bounds::{inverse_direction, Bound};
 pub use ray::Ray;
 pub use walk::{
     force_traversal_path, Bvh, PacketEntry, PathUnavailable, Step, TraversalPath, MAX_PRIMITIVES,
