@@ -179,6 +179,7 @@ fn every_path_architecture_md_names_exists() {
     let crates: Vec<PathBuf> = [
         "crates/ir",
         "crates/lang",
+        "crates/bvh",
         "crates/tracer",
         "crates/debugger",
     ]

@@ -7,16 +7,18 @@ use anyhow::{bail, Context};
 
 use crate::{cargo, run_cargo, workspace_root};
 
-/// Which crates each workspace crate must never depend on (DESIGN.md, "Dependency directions").
-/// `ir <- lang`, `ir <- mit6837`, `ir <- tracer <- debugger`, `tracer <- explain <- debugger`;
-/// the tracer never sees syntax, the debugger never parses, and the two front ends know
-/// nothing of each other or of what comes after the IR.
+/// Which crates each workspace crate must never depend on. Dependencies flow one way, from
+/// the scene description towards the pictures: `ir <- lang`, `ir <- mit6837`,
+/// `ir <- bvh <- tracer <- debugger`, `tracer <- explain <- debugger`. The BVH knows boxes and
+/// rays, not scenes; the tracer never sees syntax, the debugger never parses, and the two
+/// front ends know nothing of each other or of what comes after the IR.
 const FORBIDDEN: &[(&str, &[&str])] = &[
     (
         "whitted-ir",
         &[
             "whitted-lang",
             "whitted-mit6837",
+            "whitted-bvh",
             "whitted-tracer",
             "whitted-debugger",
             "pest",
@@ -26,6 +28,7 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
         "whitted-mit6837",
         &[
             "whitted-lang",
+            "whitted-bvh",
             "whitted-tracer",
             "whitted-debugger",
             "pest",
@@ -36,8 +39,22 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
         "whitted-lang",
         &[
             "whitted-mit6837",
+            "whitted-bvh",
             "whitted-tracer",
             "whitted-debugger",
+            "ratatui",
+        ],
+    ),
+    // The BVH is geometry only: boxes in, primitive indices out, whoever the caller is.
+    (
+        "whitted-bvh",
+        &[
+            "whitted-lang",
+            "whitted-mit6837",
+            "whitted-tracer",
+            "whitted-explain",
+            "whitted-debugger",
+            "pest",
             "ratatui",
         ],
     ),
@@ -77,6 +94,7 @@ const REQUIRED: &[(&str, &str)] = &[
     ("whitted-lang", "whitted-ir"),
     ("whitted-mit6837", "whitted-ir"),
     ("whitted-tracer", "whitted-ir"),
+    ("whitted-tracer", "whitted-bvh"),
     ("whitted-debugger", "whitted-tracer"),
     ("whitted-debugger", "whitted-explain"),
     ("whitted-explain", "whitted-tracer"),

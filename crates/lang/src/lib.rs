@@ -5,14 +5,15 @@
 //! (`lexical`); the pest grammar (`grammar/scene.pest`) and the tree it builds (`parser`,
 //! `ast`); name resolution and static checks (`resolve`); evaluation straight into the IR
 //! (`eval`); and the IR validator. [`compile_file`] runs them all; [`render_diagnostics`]
-//! turns the result into rustc-style text. The library never touches the disk (imports go
-//! through a [`SourceLoader`]) and never prints.
+//! (`diagnostic_text`) turns the result into rustc-style text. The library never touches the
+//! disk (imports go through a [`SourceLoader`]) and never prints.
 
 mod ast;
 #[cfg(test)]
 mod ast_dump;
 mod builtins;
 mod compile;
+mod diagnostic_text;
 mod eval;
 mod hints;
 mod intern;
@@ -21,7 +22,6 @@ mod mesh;
 mod parser;
 mod properties;
 mod random;
-mod render;
 mod resolve;
 mod schema;
 mod strings;
@@ -32,7 +32,7 @@ mod value;
 pub use whitted_ir::{Diagnostic, SourceMap};
 
 pub use compile::{compile_bytes, compile_file, compile_source};
-pub use render::render_diagnostics;
+pub use diagnostic_text::render_diagnostics;
 
 /// Supplies file contents for the root file and for imports; the library never touches the
 /// disk.

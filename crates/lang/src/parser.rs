@@ -15,8 +15,8 @@ use crate::intern::Interner;
 use crate::lexical;
 use crate::syntax_error;
 
-mod constructs;
 mod fast;
+mod indexing_and_expression_bodies;
 
 #[derive(pest_derive::Parser)]
 #[grammar = "../../grammar/scene.pest"]
@@ -106,7 +106,7 @@ fn parse_file_with_pest(
 ) -> Result<Vec<Item>, Diagnostic> {
     let mut pairs = parse_rule(Rule::file, text).map_err(|error| {
         let diagnostic = syntax_error::translate(&error, text, cx.file, Some(brackets));
-        constructs::expression_body_hint(diagnostic, text, brackets)
+        indexing_and_expression_bodies::expression_body_hint(diagnostic, text, brackets)
     })?;
     let Some(file) = pairs.next() else {
         return Ok(Vec::new());

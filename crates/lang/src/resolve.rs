@@ -15,7 +15,7 @@ use whitted_ir::{Diagnostic, Span};
 use crate::ast::*;
 use crate::builtins::{Constant, Function};
 
-mod constructs;
+mod assignments_and_strings;
 mod expressions;
 mod properties;
 mod scopes;

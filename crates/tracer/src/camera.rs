@@ -4,7 +4,7 @@
 use glam::Vec3A;
 use whitted_ir::{Camera, Projection};
 
-use crate::ray::Ray;
+use whitted_bvh::Ray;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct PreparedCamera {

@@ -22,11 +22,11 @@ use glam::{UVec2, Vec3A};
 use obvhs::aabb::Aabb;
 use whitted_ir::CsgOp;
 
-use crate::bounds::{inverse_direction, Bound};
-use crate::bvh::{Bvh, Step};
-use crate::ray::Ray;
 use crate::scene::Leaf;
 use crate::shapes::{Geometry, Part, RawSpan};
+use whitted_bvh::Ray;
+use whitted_bvh::{inverse_direction, Bound};
+use whitted_bvh::{Bvh, Step};
 
 /// A point where the ray crosses into or out of a solid.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -6,11 +6,6 @@
 //! [`trace_pixel_with`] runs the same code for one pixel sample with any recorder (ray
 //! trees, statistics), so a recorded tree is always what the renderer computed.
 
-mod bounds;
-mod bvh;
-mod bvh_build;
-mod bvh_simd;
-mod bvh_wide;
 mod camera;
 mod csg;
 pub mod display;
@@ -22,7 +17,6 @@ mod mesh;
 mod noise;
 pub mod optics;
 mod query;
-mod ray;
 pub mod ray_tree;
 mod recorder;
 mod render;
@@ -37,7 +31,7 @@ mod trace;
 #[cfg(test)]
 mod tests;
 
-pub use bvh::{force_traversal_path, PathUnavailable, TraversalPath};
+// The BVH lives in whitted-bvh; the walk the renderer takes is part of this API.
 pub use recorder::{
     CoincidentSurface, Interface, LightSample, NoRecord, NoShadowRay, PixelStats, RayKind,
     RayStart, Recorder, ShadowRay, ShadowResult, SkippedRay, SurfaceHit, Termination,
@@ -49,6 +43,7 @@ pub use render::{
     TILE_SIZE,
 };
 pub use scene::PreparedScene;
+pub use whitted_bvh::{force_traversal_path, PathUnavailable, TraversalPath};
 
 /// Re-exported so that recorder users name the same vector type as the tracer.
 pub use glam::Vec3A;

@@ -21,11 +21,11 @@ use glam::{Affine3A, DAffine3, DVec3, Mat3A, UVec2, Vec3, Vec3A};
 use obvhs::aabb::Aabb;
 use whitted_ir::Mesh;
 
-use crate::bounds::Bound;
-use crate::bvh::{Bvh, Step};
 use crate::hit_error::{self, BoundedPoint};
-use crate::ray::Ray;
 use crate::shapes::{triangle_hit, triangle_hit_uv, Part, RawSpan};
+use whitted_bvh::Bound;
+use whitted_bvh::Ray;
+use whitted_bvh::{Bvh, Step};
 
 /// Up to this many triangles a loop beats building and walking a BVH.
 const LINEAR_LIMIT: usize = 4;
@@ -233,7 +233,7 @@ impl Triangle {
     }
 }
 
-/// Half of `bounds.rs`'s padding of BVH boxes (2⁻²⁰ of the magnitude, plus 1e-6): the room
+/// Half of whitted-bvh's `bounds.rs` padding of BVH boxes (2⁻²⁰ of the magnitude, plus 1e-6): the room
 /// a vertex's own rounding needs.
 const HIT_RELATIVE_PAD: f32 = 1.0 / (1u32 << 21) as f32;
 const HIT_ABSOLUTE_PAD: f32 = 5e-7;

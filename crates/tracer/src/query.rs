@@ -10,12 +10,12 @@
 use glam::{UVec2, Vec3A};
 use whitted_ir::{Handle, Material};
 
-use crate::bvh::{Bvh, PacketEntry, Step, PACKET};
 use crate::csg::CsgScratch;
 use crate::hit_error;
-use crate::ray::Ray;
 use crate::scene::{Item, Leaf, PreparedScene};
 use crate::shapes::{plane_first_hit, sphere_first_hit, unit_normal, Geometry, Part};
+use whitted_bvh::Ray;
+use whitted_bvh::{Bvh, PacketEntry, Step, PACKET};
 
 /// Up to this many bounded items a plain loop beats walking the BVH.
 pub(crate) const LINEAR_LIMIT: usize = 4;

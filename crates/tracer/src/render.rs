@@ -18,14 +18,14 @@ use glam::Vec3A;
 use rayon::prelude::*;
 use whitted_ir::{Camera, Sampling, Settings};
 
-use crate::bvh::PACKET;
 use crate::camera::PreparedCamera;
 use crate::query::Hit;
-use crate::ray::Ray;
 use crate::recorder::{NoRecord, PixelStats, Recorder};
 use crate::sampling::sample_offset;
 use crate::scene::PreparedScene;
 use crate::trace::{PathState, RayCounters, Tracer};
+use whitted_bvh::Ray;
+use whitted_bvh::PACKET;
 
 /// Side of the square tiles that workers take one at a time.
 pub const TILE_SIZE: u32 = 16;

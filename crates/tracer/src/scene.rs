@@ -12,8 +12,6 @@ use whitted_ir::{
     CsgOp, Handle, Material, Object, ObjectKind, Scene, Settings, ShadowMode, Shape, ValidScene,
 };
 
-use crate::bounds::Bound;
-use crate::bvh::Bvh;
 use crate::camera::PreparedCamera;
 use crate::csg::{ChildAccel, CsgNode, CsgTree, NO_ACCEL};
 use crate::hit_error;
@@ -22,6 +20,8 @@ use crate::material::{color, PatternFrame, PreparedMaterial, Snap};
 use crate::mesh::{MeshInstance, PreparedMesh};
 use crate::query::Surface;
 use crate::shapes::Geometry;
+use whitted_bvh::Bound;
+use whitted_bvh::Bvh;
 
 /// A primitive shape ready to intersect, with what shading needs to know about it.
 #[derive(Clone, Debug)]
@@ -581,7 +581,7 @@ fn node_bound(node: &CsgNode) -> Bound {
 /// them, and the items are moved, not copied, so that no second copy of a million items
 /// exists at the peak.
 fn build_bvh(items: Vec<Item>, aabbs: Vec<Aabb>) -> (Vec<Item>, Option<Bvh>) {
-    if items.is_empty() || items.len() > crate::bvh::MAX_PRIMITIVES {
+    if items.is_empty() || items.len() > whitted_bvh::MAX_PRIMITIVES {
         return (items, None);
     }
     let count = items.len();

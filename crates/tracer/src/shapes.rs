@@ -11,11 +11,11 @@
 use glam::{DAffine3, DMat3, DMat4, DVec3, DVec4, Mat3A, Vec3A};
 use whitted_ir::{Quadric, Shape};
 
-use crate::bounds::Bound;
 use crate::hit_error::{self, BoundedPoint};
 use crate::mesh::MeshInstance;
-use crate::ray::Ray;
 use crate::solve::{quadratic_f32, quadratic_f64};
+use whitted_bvh::Bound;
+use whitted_bvh::Ray;
 
 /// Which part of a shape a boundary lies on, so that the normal is computed for the right
 /// face even at an edge: cylinder and cone walls and caps, box faces `axis·2 + side`, and

@@ -15,17 +15,17 @@
 use glam::Vec3A;
 use whitted_ir::{Fresnel, Handle, Highlight, Material, Object, ShadowMode};
 
-use crate::bvh::PACKET;
 use crate::material::PreparedMaterial;
 use crate::media::{same_medium, Medium, MediumStack};
 use crate::optics::{beer_lambert, fresnel_exact, max_channel, reflect, refract, schlick};
 use crate::query::{Crossed, Hit, Scratch, Shadow, Surface};
-use crate::ray::Ray;
 use crate::recorder::{
     CoincidentSurface, Interface, LightSample, NoShadowRay, RayKind, RayStart, Recorder, ShadowRay,
     ShadowResult, SkippedRay, SurfaceHit, Termination,
 };
 use crate::scene::PreparedScene;
+use whitted_bvh::Ray;
+use whitted_bvh::PACKET;
 
 /// Surfaces within this many error bounds of a hit along the ray are reported as
 /// coincident with it (the bound is a bound: rounding rarely reaches it, a z-fight's two

@@ -81,7 +81,7 @@ pub struct Passed {
 /// A failed check, with what to show.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Failure {
-    /// A short class for counting and deduplicating ("panic at crates/tracer/src/bvh.rs:88").
+    /// A short class for counting and deduplicating ("panic at crates/bvh/src/walk.rs:88").
     pub class: String,
     pub detail: String,
 }

@@ -822,7 +822,7 @@ impl Generator<'_> {
                 };
                 match self.rng.below(4) {
                     0 => format!("for i in 0..{n} {{ {body} }}"),
-                    // The second step's constructs: `step`, `while` with assignment, arrays
+                    // The programming constructs: `step`, `while` with assignment, arrays
                     // indexed by the loop variable and names formatted from it.
                     1 => format!("for i in {n}..0 step -{} {{ {body} }}", self.rng.below(4) + 1),
                     // In a block of its own, so that two loops do not define `i` twice.

@@ -4,8 +4,9 @@
 //! pass the hard cap fails (the process aborts with Rust's "memory allocation failed"
 //! message) instead of taking the machine down.
 //!
-//! The one place in the workspace allowed `unsafe` code: a global allocator cannot be
-//! written without it, and this one only forwards to the system allocator.
+//! Allowed `unsafe` code (as are the binary's allocator and whitted-bvh's SIMD walks): a
+//! global allocator cannot be written without it, and this one only forwards to the system
+//! allocator.
 #![allow(unsafe_code)]
 
 use std::alloc::{GlobalAlloc, Layout, System};

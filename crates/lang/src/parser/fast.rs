@@ -15,7 +15,7 @@
 
 use whitted_ir::Span;
 
-use super::constructs::index_expr;
+use super::indexing_and_expression_bodies::index_expr;
 use super::{combine, field_expr, hex_color, ExprPart, ParseContext};
 use crate::ast::*;
 

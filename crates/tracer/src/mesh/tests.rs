@@ -10,11 +10,11 @@ use whitted_ir::{Color, CsgOp, Material, Mesh, Shape};
 
 use super::PreparedMesh;
 use crate::query::Scratch;
-use crate::ray::Ray;
 use crate::render::{render, Image, NoObserver};
 use crate::scene::PreparedScene;
 use crate::testing::{glass, matte, plane_y, sphere, tessellated_sphere, SceneBuilder};
 use crate::tests::{options, prepare};
+use whitted_bvh::Ray;
 
 /// splitmix64, so that every generated ray is reproducible.
 struct Rng(u64);
@@ -487,19 +487,17 @@ fn filtered_shadows_cross_a_mesh_solid_at_each_surface() {
 /// come in the binned SAH's order, while a scene-level BVH over the same boxes changes.
 #[test]
 fn meshes_keep_the_binned_sah_tree() {
-    use crate::bvh::Bvh;
-    use crate::bvh_build::{MORTON_MIN_FOR_TESTS, MORTON_MIN_PRIMITIVES};
+    use whitted_bvh::testing::with_morton_top;
+    use whitted_bvh::Bvh;
     let mesh = terrain(40, &mut Rng(17));
     let sah = PreparedMesh::new(&mesh);
-    MORTON_MIN_FOR_TESTS.set(2);
-    let forced = PreparedMesh::new(&mesh);
+    let forced = with_morton_top(|| PreparedMesh::new(&mesh));
     let corners: Vec<Vec3A> = sah.triangles.iter().map(|t| Vec3A::from(t.a)).collect();
     let aabbs: Vec<obvhs::aabb::Aabb> = corners
         .iter()
         .map(|&a| obvhs::aabb::Aabb::new(a, a + 1.0))
         .collect();
-    let (_, morton_order) = Bvh::build(&aabbs);
-    MORTON_MIN_FOR_TESTS.set(MORTON_MIN_PRIMITIVES);
+    let (_, morton_order) = with_morton_top(|| Bvh::build(&aabbs));
     let (_, sah_order) = Bvh::build(&aabbs);
     assert_eq!(forced.triangles, sah.triangles);
     assert_ne!(morton_order, sah_order, "the Morton top was not forced");

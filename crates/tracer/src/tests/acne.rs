@@ -353,7 +353,7 @@ fn thin_rim_blocks(epsilon: Option<f64>) -> bool {
     let scene = prepare(b);
     let mut tracer = crate::trace::Tracer::new(&scene, 1, 0.001);
     let mut tape = super::Tape::default();
-    let ray = crate::ray::Ray::new(
+    let ray = whitted_bvh::Ray::new(
         glam::Vec3A::new(-0.0002, 0.5, 0.3),
         glam::Vec3A::new(0.0, -1.0, 0.0),
     );

@@ -11,11 +11,12 @@ use whitted_ir::{CsgOp, Handle, Light, LightKind, Material, Quadric, QuadricForm
 
 use super::{options, prepare, trace_tree};
 use crate::query::{item_hit, Scratch};
-use crate::ray::Ray;
 use crate::recorder::ShadowResult;
 use crate::scene::PreparedScene;
 use crate::shapes::Geometry;
 use crate::testing::{matte, plane_y, sphere, SceneBuilder};
+use whitted_bvh::testing::with_morton_top;
+use whitted_bvh::Ray;
 
 /// A small deterministic generator (xorshift64*), so that every case can be replayed.
 pub(super) struct Rng(u64);
@@ -68,7 +69,7 @@ fn size(rng: &mut Rng) -> f64 {
     match rng.below(40) {
         // Extreme sizes broke the BVH build (issue 10: `sphere { radius 1e19 }` panicked).
         // Validation now refuses sizes past the largest coordinate and below the smallest
-        // size limits (bvh_build.rs tests the builder itself up to 3e38), so these are the
+        // size limits (whitted-bvh's `binary` tests the builder itself up to 3e38), so these are the
         // extremes a scene can still reach the tracer with.
         39 => rng.range(1e6, 2e8),
         38 => rng.range(1e-7, 1e-6),
@@ -482,7 +483,7 @@ fn regression_straight_down_directional_light_casts_a_shadow() {
 
 /// Issue 10: `sphere { radius 1e19 } sphere { }` panicked in the BVH build (obvhs's
 /// converter found only infinite costs). Validation now refuses radii past the largest
-/// coordinate limit (and bvh_build.rs builds boxes up to 3e38 directly); the largest and
+/// coordinate limit (and whitted-bvh's `binary` tests build boxes up to 3e38 directly); the largest and
 /// smallest sizes validation accepts must build, and render without NaN.
 #[test]
 fn regression_huge_sphere_builds_and_renders() {
@@ -603,7 +604,7 @@ fn accelerated_csg_agrees_with_the_plain_loop() {
 /// far below the size that gets one): the walk must be right whichever build made its tree.
 #[test]
 fn bvh_queries_agree_with_brute_force_on_morton_trees() {
-    let result = with_morton_trees(|| sweep(5001, SCENES / 3, RAYS_PER_SCENE));
+    let result = with_morton_top(|| sweep(5001, SCENES / 3, RAYS_PER_SCENE));
     assert_sweep_agrees(result, 100_000);
 }
 
@@ -619,17 +620,8 @@ fn a_morton_tree_renders_the_image_of_a_sah_tree() {
         options.width = 96;
         options.height = 72;
         let sah = PreparedScene::new(&valid);
-        let morton = with_morton_trees(|| PreparedScene::new(&valid));
+        let morton = with_morton_top(|| PreparedScene::new(&valid));
         let image = |scene: &PreparedScene| render(scene, &options, &NoObserver).expect("done").0;
         assert_eq!(image(&sah).pixels, image(&morton).pixels);
     }
-}
-
-/// Runs `f` with every BVH built on this thread given a Morton top.
-fn with_morton_trees<R>(f: impl FnOnce() -> R) -> R {
-    use crate::bvh_build::{MORTON_MIN_FOR_TESTS, MORTON_MIN_PRIMITIVES};
-    MORTON_MIN_FOR_TESTS.set(2);
-    let result = f();
-    MORTON_MIN_FOR_TESTS.set(MORTON_MIN_PRIMITIVES);
-    result
 }

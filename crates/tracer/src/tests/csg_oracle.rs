@@ -14,12 +14,12 @@ use whitted_ir::{CsgOp, Handle, Material, Object, Shape};
 
 use super::bvh_oracle::Rng;
 use super::prepare;
-use crate::bounds::Bound;
 use crate::csg::{Boundary, CsgNode, CsgScratch, CsgTree};
 use crate::query::Scratch;
-use crate::ray::Ray;
 use crate::scene::{Item, PreparedScene};
 use crate::testing::{matte, plane_y, sphere, SceneBuilder};
+use whitted_bvh::Bound;
+use whitted_bvh::Ray;
 
 /// A hit as plain bits, so that `-0.0` and `0.0` (or two NaNs) never compare equal by
 /// accident.

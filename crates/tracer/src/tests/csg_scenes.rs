@@ -6,9 +6,9 @@ use whitted_ir::{CsgOp, Handle, Object, Quadric, QuadricForm, Shape};
 
 use super::prepare;
 use crate::query::Scratch;
-use crate::ray::Ray;
 use crate::scene::PreparedScene;
 use crate::testing::{matte, sphere, SceneBuilder};
+use whitted_bvh::Ray;
 
 struct Hit {
     t: f32,

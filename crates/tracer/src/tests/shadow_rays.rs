@@ -200,7 +200,7 @@ fn filter_scene(build: Filter, camera: Option<(DVec3, DVec3)>) -> PreparedScene 
 /// What a shadow ray from `from` towards `to` lets through.
 fn shadow_transmittance(scene: &PreparedScene, from: DVec3, to: DVec3) -> Vec3A {
     let direction = (to - from).normalize().as_vec3a();
-    let ray = crate::ray::Ray::new(from.as_vec3a(), direction);
+    let ray = whitted_bvh::Ray::new(from.as_vec3a(), direction);
     let mut scratch = crate::query::Scratch::default();
     match scene.filter_shadow(&ray, 0.0, f32::INFINITY, &mut scratch) {
         crate::query::Shadow::Clear => Vec3A::ONE,

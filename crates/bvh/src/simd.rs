@@ -9,13 +9,13 @@
 //! for the newer instruction sets, with the visitor (the shape tests) inlined into it.
 
 // Intrinsics that read memory, and functions compiled for CPU features, are unsafe to call;
-// each call below says why it is sound. Nothing else in the tracer is unsafe.
+// each call below says why it is sound. Nothing else in the library crates is unsafe.
 #![allow(unsafe_code)]
 
 use glam::UVec2;
 
-use crate::bvh::{Bvh, PacketEntry, Step, TraversalPath, PACKET};
 use crate::ray::Ray;
+use crate::walk::{Bvh, PacketEntry, Step, TraversalPath, PACKET};
 
 /// A SIMD child test this CPU was found to run: only [`SimdPath::detect`] makes one, so
 /// holding one is the proof that its walk's instructions exist here.
@@ -122,8 +122,8 @@ mod x86 {
     use glam::UVec2;
 
     use crate::bounds::inverse_direction;
-    use crate::bvh::{Bvh, ChildTest, PacketEntry, PerRayTest, Step, WideNode, PACKET};
     use crate::ray::Ray;
+    use crate::walk::{Bvh, ChildTest, PacketEntry, PerRayTest, Step, WideNode, PACKET};
 
     /// The features the AVX2 walk is compiled for (`bmi1` and `lzcnt` give the walk's bit
     /// scans one instruction each).

@@ -1,4 +1,4 @@
-//! Builds the binary BVH that `bvh_wide` converts into obvhs's wide nodes: a binned SAH
+//! Builds the binary BVH that `wide` converts into obvhs's wide nodes: a binned SAH
 //! build with a median fallback, in O(n log n) for any finite input.
 //!
 //! obvhs's own PLOC builder is not used, because two kinds of input break it:
@@ -48,7 +48,7 @@ use obvhs::bvh2::node::Bvh2Node;
 use obvhs::bvh2::Bvh2;
 use rayon::prelude::*;
 
-use crate::bvh_wide::{decide, leaf_costs, BinaryTree, Decision};
+use crate::wide::{decide, leaf_costs, BinaryTree, Decision};
 
 /// Bins per axis for the surface area heuristic.
 const BINS: usize = 16;
@@ -275,18 +275,12 @@ pub fn build_bvh2(aabbs: impl Into<Vec<Aabb>>) -> Built {
     build_bvh2_with(aabbs, morton_min_primitives())
 }
 
-#[cfg(test)]
-thread_local! {
-    /// What [`build_bvh2`] takes for [`MORTON_MIN_PRIMITIVES`] on this thread: tests lower
-    /// it to walk, render and compare Morton-topped trees of small scenes.
-    pub static MORTON_MIN_FOR_TESTS: std::cell::Cell<usize> =
-        const { std::cell::Cell::new(MORTON_MIN_PRIMITIVES) };
-}
-
+/// What [`build_bvh2`] takes for [`MORTON_MIN_PRIMITIVES`]: the constant, except that tests
+/// may lower it on their thread (`testing::with_morton_top`).
 fn morton_min_primitives() -> usize {
-    #[cfg(test)]
-    return MORTON_MIN_FOR_TESTS.get();
-    #[cfg(not(test))]
+    #[cfg(any(test, feature = "testing"))]
+    return crate::testing::MORTON_MIN.get();
+    #[cfg(not(any(test, feature = "testing")))]
     MORTON_MIN_PRIMITIVES
 }
 
@@ -856,8 +850,8 @@ fn morton_split(codes: &[u32]) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh_wide::tests::Random;
-    use crate::bvh_wide::{convert, DecidedBvh2};
+    use crate::testing::Random;
+    use crate::wide::{convert, DecidedBvh2};
     use obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh;
     use obvhs::cwbvh::node::CwBvhNode;
 
@@ -1189,7 +1183,7 @@ mod tests {
     /// it replaced through obvhs's own converter: the walk's order must not change.
     #[test]
     fn builds_the_tree_of_the_index_build() {
-        for (name, aabbs) in crate::bvh_wide::tests::inputs() {
+        for (name, aabbs) in crate::testing::inputs() {
             let tree = build_bvh2(&aabbs[..]).tree;
             let Some((nodes, order)) = convert(&tree, |n: &CwBvhNode| Some(*n)) else {
                 panic!("{name}: no conversion");
@@ -1206,7 +1200,7 @@ mod tests {
     /// reads it (the fallback when this converter gives up).
     #[test]
     fn the_obvhs_layout_holds_the_same_tree() {
-        for (name, aabbs) in crate::bvh_wide::tests::inputs() {
+        for (name, aabbs) in crate::testing::inputs() {
             let tree = build_bvh2(&aabbs[..]).tree;
             let bvh2 = tree.to_bvh2();
             let ours = convert(&tree, |n: &CwBvhNode| Some(*n));

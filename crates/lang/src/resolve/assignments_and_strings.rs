@@ -1,5 +1,6 @@
-//! Names in the constructs of the language's second step: assignments (`i = i + 1;`, only to
-//! `let` bindings of the same function or file) and the `{name}` holes of formatted strings.
+//! Names in assignments (`i = i + 1;`, only to `let` bindings of the same function or file)
+//! and in the `{name}` holes of formatted strings, and the string after an object's name that
+//! shows its braces are missing (`sphere "ball"`).
 
 use whitted_ir::Diagnostic;
 

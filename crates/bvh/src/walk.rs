@@ -1,6 +1,6 @@
 //! The BVH over bounded objects, in obvhs's compressed wide layout (`CwBvh`, eight children
-//! per node, child boxes quantised to bytes); this module builds it through `bvh_build` and
-//! `bvh_wide` and walks it.
+//! per node, child boxes quantised to bytes); this module builds it through `binary` and
+//! `wide` and walks it.
 //!
 //! The walk visits primitives in exactly obvhs's traversal order (its `traverse!` macro: the
 //! same node groups, octant-sorted child order and hit masks; a test compares the two visit
@@ -29,7 +29,7 @@
 //!
 //! The child test has three implementations with bit-identical results
 //! ([`TraversalPath`]): two 4-lane SSE2 halves, which every x86-64 has, and AVX2 and
-//! AVX-512 ones (`bvh_simd`). Each BVH takes the fastest the CPU offers when it is built
+//! AVX-512 ones (`simd`). Each BVH takes the fastest the CPU offers when it is built
 //! (or the one [`force_traversal_path`] names), so one binary runs anywhere.
 
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -39,16 +39,16 @@ use obvhs::aabb::Aabb;
 use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::CwBvh;
 
+use crate::binary::{build_bvh2, build_bvh2_with, round_down, round_up, BuildScale, Built};
 use crate::bounds::inverse_direction;
-use crate::bvh_build::{build_bvh2, build_bvh2_with, round_down, round_up, BuildScale, Built};
-use crate::bvh_simd::{self, SimdPath};
-use crate::bvh_wide;
 use crate::ray::Ray;
+use crate::simd::{self, SimdPath};
+use crate::wide;
 
 /// Children's box planes of one node, a row of eight children per plane: `rows[axis * 2]`
 /// holds the minima along `axis`, `rows[axis * 2 + 1]` the maxima. A row is two 16-byte
 /// loads for the baseline's 4-lane test and one 32-byte load for the 8-lane tests
-/// (`bvh_simd`).
+/// (`simd`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C, align(32))]
 pub(crate) struct NodePlanes {
@@ -318,10 +318,10 @@ pub enum Step {
     Stop,
 }
 
-/// Our binary BVH (see `bvh_build`) converted by obvhs, with leaves of up to three
+/// Our binary BVH (see `binary`) converted by obvhs, with leaves of up to three
 /// primitives as `BvhBuildParams::medium_build()` would make them; the boxes it holds are
 /// in build space, `scale` times the world. The walk's tests compare with obvhs's nodes;
-/// builds convert with `bvh_wide`, which makes the same nodes.
+/// builds convert with `wide`, which makes the same nodes.
 #[cfg(test)]
 fn build_cwbvh(aabbs: &[Aabb]) -> (CwBvh, BuildScale) {
     let built = build_bvh2(aabbs);
@@ -333,8 +333,8 @@ fn build_cwbvh(aabbs: &[Aabb]) -> (CwBvh, BuildScale) {
 pub const MAX_PRIMITIVES: usize = u32::MAX as usize;
 
 impl Bvh {
-    /// Builds the binary BVH (`bvh_build`, parallel on the current rayon pool) and converts
-    /// it into obvhs's wide nodes (`bvh_wide`). Returns the BVH and `primitive_indices`: the input index of each
+    /// Builds the binary BVH (`binary`, parallel on the current rayon pool) and converts
+    /// it into obvhs's wide nodes (`wide`). Returns the BVH and `primitive_indices`: the input index of each
     /// BVH primitive id.
     pub fn build(aabbs: &[Aabb]) -> (Bvh, Vec<u32>) {
         Self::build_from_vec(aabbs.to_vec())
@@ -364,7 +364,7 @@ impl Bvh {
 
     fn from_built(built: Built) -> (Bvh, Vec<u32>) {
         let scale = built.scale;
-        let converted = bvh_wide::convert(&built.tree, |node| WideNode::new(node, scale));
+        let converted = wide::convert(&built.tree, |node| WideNode::new(node, scale));
         match converted {
             Some((nodes, primitive_indices)) => (Bvh::new(nodes), primitive_indices),
             // A tree obvhs's converter reads outside its tables on, or whose metadata the walk
@@ -410,7 +410,7 @@ impl Bvh {
                 self.traverse_with(&NodeQuery::new(ray, tmin), ray, tmax, stack, visit);
             }
             ChildTestPath::Simd(simd) => {
-                bvh_simd::traverse(simd, self, ray, tmin, tmax, stack, visit);
+                simd::traverse(simd, self, ray, tmin, tmax, stack, visit);
             }
         }
     }
@@ -536,7 +536,7 @@ impl Bvh {
                 self.traverse_packet_with(test, rays, tmax, stack, visit);
             }
             ChildTestPath::Simd(simd) => {
-                bvh_simd::traverse_packet(simd, self, rays, tmin, tmax, stack, visit);
+                simd::traverse_packet(simd, self, rays, tmin, tmax, stack, visit);
             }
         }
         true
@@ -832,7 +832,7 @@ fn dequantise(node: &CwBvhNode, build_scale: BuildScale) -> NodePlanes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh_wide::tests::Random;
+    use crate::testing::Random;
     use obvhs::cwbvh::node::extract_byte64;
 
     /// The walk as it was first written, straight from obvhs's `traverse!` (hit masks from
@@ -1089,7 +1089,7 @@ mod tests {
             return;
         }
         let mut random = Random(0x5eed_1234);
-        let mut sets = crate::bvh_wide::tests::inputs();
+        let mut sets = crate::testing::inputs();
         // Boxes sharing faces and edges exactly, and a flat one across them.
         let mut shared: Vec<Aabb> = (0..60)
             .map(|i| {

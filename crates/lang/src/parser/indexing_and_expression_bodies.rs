@@ -1,6 +1,6 @@
-//! Tree building for the constructs of the language's second step: expression-bodied
-//! functions (`fn square(x) = x * x;`) and indexing (`colours[i % 2]`). Arrays, `while`,
-//! `step` and assignments are built in the item and primary matches of the parent module.
+//! Tree building for expression-bodied functions (`fn square(x) = x * x;`) and indexing
+//! (`colours[i % 2]`), and the hint for `fn f(x) { x * x }`. Arrays, `while`, `step` and
+//! assignments are built in the item and primary matches of the parent module.
 
 use pest::iterators::Pair;
 use pest::Parser as _;
@@ -139,7 +139,7 @@ mod tests {
     }
 
     #[test]
-    fn the_second_step_parses() {
+    fn indexing_and_expression_bodies_parse() {
         insta::assert_snapshot!(dump(
             r#"fn sq(x) = x * x;
 let a = [1, [2, 3], "s {a}",];

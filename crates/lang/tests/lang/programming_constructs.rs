@@ -1,4 +1,4 @@
-//! The constructs of the language's second step (issue 15): arrays and indexing, `for ...
+//! The language's programming constructs (added in issue 15): arrays and indexing, `for ...
 //! step`, `while` and assignment, `rand`, formatted strings and expression-bodied functions.
 //! Values are checked against oracles written here (a `Vec`, a formula, a hash by hand).
 
@@ -331,9 +331,9 @@ fn expression_functions_are_values() {
 // ---- errors ----------------------------------------------------------------------------------
 
 #[test]
-fn second_step_errors() {
+fn programming_construct_errors() {
     check_errors(
-        "second_step_errors",
+        "programming_construct_errors",
         &[
             (
                 "an index out of range",
