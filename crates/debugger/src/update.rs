@@ -109,7 +109,8 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
         }
         Action::WhatIf => open_what_if(app),
         Action::QueryPrompt => {
-            app.query.prompt = Some(LineInput::new(&app.query.last_text));
+            // Empty, not the last query: ↑ brings that back when it is wanted.
+            app.query.prompt = Some(LineInput::with_history(&app.query.history));
         }
         Action::NextMatch => step_match(app, false),
         Action::PreviousMatch => step_match(app, true),
@@ -288,8 +289,10 @@ fn input_key(app: &mut App, key: KeyEvent) -> Vec<Effect> {
                 app.query.overlay = None;
                 return Vec::new();
             }
-            // Kept even when wrong, so that `:` brings it back to be fixed.
-            app.query.last_text = text.clone();
+            // Kept even when wrong, so that ↑ in the next prompt brings it back to be fixed.
+            if app.query.history.last() != Some(&text) {
+                app.query.history.push(text.clone());
+            }
             let scene = std::sync::Arc::clone(&app.loaded.scene);
             match app.query.start(&text, &app.loaded, &app.options, &scene) {
                 Ok(()) => {
