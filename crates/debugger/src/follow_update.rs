@@ -88,8 +88,14 @@ pub fn run_to_event(app: &mut App, forward: bool) {
     }
 }
 
+/// `x`: the explanation in the inspector's place, with the keyboard (as `v` gives it to the
+/// 3D view), so that the keys that follow (`z`, ↑↓, Enter) act on what was just opened and
+/// not on the pane that had the focus before; `x` again brings the inspector back.
 pub fn toggle_explain(app: &mut App) {
     app.explain_open = !app.explain_open;
+    if app.explain_open {
+        app.focus = Focus::Inspector;
+    }
     if app.explain_open && app.picked.is_none() {
         app.set_message("pick a pixel (Enter) to explain it", false);
     }
@@ -225,7 +231,7 @@ mod tests {
         let mut app = picked_app();
         update(&mut app, Action::ToggleExplain);
         assert!(app.explain_open);
-        app.focus = Focus::Inspector;
+        assert_eq!(app.focus, Focus::Inspector, "x gives it the keyboard");
         let picked = app.picked.as_ref().unwrap();
         let explanation = picked.explanation.ready().unwrap().clone();
         // The second contribution (the first is usually the camera ray's own light).

@@ -84,6 +84,8 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
         Action::TreePage(rows) => tree(app, |t| t.page(rows as isize)),
         Action::TreeToggle => tree(app, |t| t.toggle()),
         Action::InspectorScroll(lines) => scroll_inspector(app, lines),
+        // The explanation does not scroll sideways: the hidden inspector must not either.
+        Action::InspectorScrollSideways(_) if app.explain_open => {}
         Action::InspectorScrollSideways(columns) => {
             app.inspector_columns =
                 (i32::from(app.inspector_columns) + columns).clamp(0, 500) as u16;
@@ -131,6 +133,9 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
             let state = if app.show_hit_point { "on" } else { "off" };
             app.set_message(format!("hit-point mark {state}"), false);
         }
+        // After a failed reload the errors are in the source pane's place: the keys must
+        // not scroll the hidden source.
+        Action::SourceScroll { .. } | Action::SourceScrollHome if app.errors.is_some() => {}
         Action::SourceScroll { lines, columns } => scroll_source(app, lines, columns),
         Action::SourceScrollHome => {
             app.source_scroll = SourceScroll {
@@ -953,6 +958,41 @@ mod tests {
         update(&mut app, Action::ToggleZoom);
         update(&mut app, Action::Cancel);
         assert!(!app.zoomed && !app.should_quit);
+    }
+
+    /// Keys act on the pane that shows: with the explanation (or the errors) in a pane's
+    /// place, the keys of the pane it hides do nothing to it.
+    #[test]
+    fn keys_never_act_on_a_hidden_pane() {
+        let mut app = picked_app();
+        app.focus = Focus::Tree;
+        update(&mut app, Action::ToggleExplain);
+        assert_eq!(
+            app.focus,
+            Focus::Inspector,
+            "x gives the explanation the keyboard"
+        );
+        update(&mut app, Action::ToggleZoom);
+        assert_eq!(app.panes().unwrap().inspector, Rect::new(0, 0, 120, 39));
+        update(&mut app, Action::InspectorScrollSideways(8));
+        assert_eq!(app.inspector_columns, 0);
+        update(&mut app, Action::ToggleExplain);
+        update(&mut app, Action::InspectorScrollSideways(8));
+        assert_eq!(app.inspector_columns, 8);
+
+        app.errors = Some(crate::app::SceneErrors {
+            diagnostics: Vec::new(),
+            sources: whitted_ir::SourceMap::new(),
+        });
+        app.focus = Focus::Source;
+        update(
+            &mut app,
+            Action::SourceScroll {
+                lines: 3,
+                columns: 8,
+            },
+        );
+        assert_eq!((app.source_scroll.lines, app.source_scroll.columns), (0, 0));
     }
 
     fn search(app: &mut App, query: &str) {
