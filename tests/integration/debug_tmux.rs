@@ -946,12 +946,15 @@ fn at_80x24_the_unfocused_inspector_shows_values_first_and_whole_source_location
         inspector.iter().any(|l| l == "scenes/whitted.scene:20:1"),
         "the glass sphere's definition on a line by itself:\n{screen}"
     );
+    // The value first, whole; its field name after it, on the next line if need be.
     let pixel = inspector
         .iter()
-        .find(|l| l.contains("pixel 400,270"))
+        .position(|l| l.contains("pixel 400,270"))
         .unwrap_or_else(|| panic!("the pixel's line:\n{screen}"));
     assert!(
-        pixel.starts_with("██ 0.189 0.292 0.693"),
+        inspector[pixel.saturating_sub(1)..=pixel]
+            .iter()
+            .any(|l| l.starts_with("██ 0.189 0.292 0.693")),
         "the value first, whole:\n{screen}"
     );
 }
