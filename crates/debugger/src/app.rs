@@ -19,7 +19,7 @@ use crate::image_view::{ColorDepth, Viewport};
 use crate::layout::{self, Arrangement, Panes};
 use crate::line_input::LineInput;
 use crate::query_job::QueryState;
-use crate::ray_view_state::{BackdropJob, BackdropRendered, RayViewState};
+use crate::ray_view::state::{BackdropJob, BackdropRendered, RayViewState};
 use crate::search::Search;
 use crate::trace_job::{Explained, TraceFailure, TraceJob, Traced};
 use crate::tree_view::TreeView;

@@ -1,7 +1,7 @@
 //! The explanation pane (`x`, in the inspector's place): why the picked pixel has its
 //! colour, from the explain library: each main contribution with its share and swatch, then
 //! each finding with its `file:line:col` and message. The selected entry is highlighted;
-//! Enter goes to its ray or line (`follow_update.rs`).
+//! Enter goes to its ray or line (`follow/update.rs`).
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;

@@ -1,14 +1,14 @@
 //! Drawing: the whole screen as a function of the [`App`] (`impl Widget for &App`). Each pane
-//! has its own module; none of them changes state.
+//! has its own module (the 3D ray view's is `ray_view/draw.rs`, with the rest of that
+//! feature); none of them changes state.
 
-mod braille;
+pub(crate) mod braille;
 mod errors_pane;
 mod explain_pane;
 pub mod format;
 mod help;
 mod image_pane;
 mod inspector;
-mod ray_view_pane;
 #[cfg(test)]
 mod snapshot_tests;
 pub(crate) mod source_pane;
@@ -34,7 +34,7 @@ impl Widget for &App {
         // Zoomed, the panes other than the focused one are empty: not drawn.
         if !panes.image.is_empty() {
             match &self.ray_view {
-                Some(view) => ray_view_pane::draw(self, view, panes.image, buf),
+                Some(view) => crate::ray_view::draw::draw(self, view, panes.image, buf),
                 None => image_pane::draw(self, panes.image, buf),
             }
         }
@@ -67,7 +67,7 @@ impl Widget for &App {
 /// A pane's frame and title. The pane with the keyboard has a thick yellow border and its
 /// title in black on yellow, so it stands out even in a 16-colour or monochrome terminal
 /// (the border's shape differs, not only its colour).
-fn pane_block(title: Line<'static>, focused: bool) -> Block<'static> {
+pub(crate) fn pane_block(title: Line<'static>, focused: bool) -> Block<'static> {
     if focused {
         Block::bordered()
             .border_type(BorderType::Thick)

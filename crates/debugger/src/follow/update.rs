@@ -1,7 +1,7 @@
 //! How the keys that follow what matters change the [`App`]: `a` (light rays), `p` (the
 //! heaviest child), `[ ] { }` (stepping in the tracer's order), `x` and, in the explanation,
 //! ↑↓ and Enter. Called from [`crate::update::update`]; the tree logic itself is in
-//! `tree_view.rs`, `follow.rs`, `stepping.rs` and `explain_view.rs`.
+//! `tree_view.rs`, `follow/mod.rs`, `stepping.rs` and `explain_view.rs`.
 
 use crate::action::Focus;
 use crate::app::App;

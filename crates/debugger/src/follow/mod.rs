@@ -1,5 +1,8 @@
 //! `p`: following the path that matters down the picked pixel's tree, one heaviest child at
-//! a time.
+//! a time. What all the keys that follow what matters (`a`, `p`, `[ ] { }`, `x`) do to the
+//! [`App`](crate::app::App) is in [`update`].
+
+pub(crate) mod update;
 
 use crate::tree_view::{NodeId, TreeView};
 

@@ -240,7 +240,7 @@ pub fn clip_to_rect(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::orbit::OrbitCamera;
+    use crate::ray_view::orbit::OrbitCamera;
 
     fn camera() -> Camera {
         Camera {
