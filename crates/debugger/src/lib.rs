@@ -10,7 +10,7 @@
 pub mod action;
 pub mod app;
 pub mod event;
-pub mod explain_view;
+pub mod explain;
 pub mod follow;
 pub mod framebuffer;
 pub mod heat_map;

@@ -159,10 +159,10 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
         Action::Export => return export(app),
         Action::ToggleShowAll => follow_update::toggle_show_all(app),
         Action::FollowHeaviest => follow_update::follow_heaviest(app),
-        Action::ToggleExplain => follow_update::toggle_explain(app),
+        Action::ToggleExplain => crate::explain::update::toggle_explain(app),
         Action::Step { forward } => follow_update::step(app, forward),
         Action::RunToEvent { forward } => follow_update::run_to_event(app, forward),
-        Action::ExplainGo => follow_update::go(app),
+        Action::ExplainGo => crate::explain::update::go(app),
         Action::ToggleRayView => {
             app.toggle_ray_view();
             app.focus = Focus::Image;
@@ -510,7 +510,7 @@ fn tree(app: &mut App, navigate: impl FnOnce(&mut crate::tree_view::TreeView)) {
 
 fn scroll_inspector(app: &mut App, lines: i32) {
     if app.explain_open {
-        return follow_update::move_explain_selection(app, lines);
+        return crate::explain::update::move_explain_selection(app, lines);
     }
     app.inspector_scroll = if lines == i32::MIN {
         0

@@ -1,10 +1,9 @@
 //! Drawing: the whole screen as a function of the [`App`] (`impl Widget for &App`). Each pane
-//! has its own module (the 3D ray view's is `ray_view/draw.rs`, with the rest of that
-//! feature); none of them changes state.
+//! has its own module (the 3D ray view's and the explanation's are `draw.rs` in their
+//! feature's folder, `ray_view/` and `explain/`); none of them changes state.
 
 pub(crate) mod braille;
 mod errors_pane;
-mod explain_pane;
 pub mod format;
 mod help;
 mod image_pane;
@@ -43,7 +42,7 @@ impl Widget for &App {
         }
         if !panes.inspector.is_empty() {
             if self.explain_open {
-                explain_pane::draw(self, panes.inspector, buf);
+                crate::explain::draw::draw(self, panes.inspector, buf);
             } else {
                 inspector::draw(self, panes.inspector, buf);
             }
