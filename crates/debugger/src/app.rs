@@ -22,7 +22,7 @@ use crate::query_job::QueryState;
 use crate::ray_view::state::{BackdropJob, BackdropRendered, RayViewState};
 use crate::search::Search;
 use crate::trace_job::{Explained, TraceFailure, TraceJob, Traced};
-use crate::tree_view::TreeView;
+use crate::tree::state::TreeView;
 use crate::what_if_state::WhatIf;
 
 /// A scene ready to render and trace: the IR (names, spans, sources) and its prepared form.

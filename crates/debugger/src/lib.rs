@@ -30,7 +30,7 @@ mod session;
 pub mod stepping;
 mod terminal;
 pub mod trace_job;
-pub mod tree_view;
+pub mod tree;
 pub mod ui;
 pub mod update;
 mod watch;

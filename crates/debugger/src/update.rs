@@ -361,7 +361,7 @@ fn search_step(app: &mut App, forward: bool) {
 }
 
 /// Selects a ray of the picked tree (opening its ancestors) and shows it.
-fn select_ray(app: &mut App, id: crate::tree_view::NodeId) {
+fn select_ray(app: &mut App, id: crate::tree::state::NodeId) {
     tree(app, |t| t.select(id));
 }
 
@@ -491,21 +491,9 @@ fn wheel(app: &mut App, column: u16, row: u16, lines: i32) {
     }
 }
 
-/// Runs a tree navigation, keeps the selection in view, and resets the inspector's scroll
-/// when another ray is selected.
-fn tree(app: &mut App, navigate: impl FnOnce(&mut crate::tree_view::TreeView)) {
-    let rows = app.tree_rows();
-    let Some(picked) = &mut app.picked else {
-        app.set_message("no ray tree yet: move the cursor and press Enter", false);
-        return;
-    };
-    let before = picked.tree.selected();
-    navigate(&mut picked.tree);
-    picked.tree.keep_selection_in_view(rows);
-    if picked.tree.selected() != before {
-        app.inspector_scroll = 0;
-        app.source_focus = None;
-    }
+/// Runs a tree navigation ([`crate::tree::update::with_tree`]).
+fn tree(app: &mut App, navigate: impl FnOnce(&mut crate::tree::state::TreeView)) {
+    crate::tree::update::with_tree(app, navigate);
 }
 
 fn scroll_inspector(app: &mut App, lines: i32) {

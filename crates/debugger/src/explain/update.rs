@@ -5,7 +5,7 @@
 use crate::action::Focus;
 use crate::app::App;
 use crate::explain::state::{self as explain_view, Jump};
-use crate::follow::update::with_tree;
+use crate::tree::update::with_tree;
 
 /// `x`: the explanation in the inspector's place, with the keyboard (as `v` gives it to the
 /// 3D view), so that the keys that follow (`z`, ↑↓, Enter) act on what was just opened and

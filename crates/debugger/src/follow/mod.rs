@@ -4,7 +4,7 @@
 
 pub(crate) mod update;
 
-use crate::tree_view::{NodeId, TreeView};
+use crate::tree::state::{NodeId, TreeView};
 
 /// The child of `id` that brings the most to the pixel ([`TreeView::contribution`], summed
 /// over the channels); the first of equals. `None` for a ray without children.

@@ -1,31 +1,12 @@
 //! How the keys that follow what matters change the [`App`]: `a` (light rays), `p` (the
 //! heaviest child), `[ ] { }` (stepping in the tracer's order); `x` and the explanation's keys
 //! are in `explain/update.rs`. Called from [`crate::update::update`]; the tree logic itself
-//! is in `tree_view.rs`, `follow/mod.rs` and `stepping.rs`.
+//! is in `tree/state.rs`, `follow/mod.rs` and `stepping.rs`.
 
 use crate::app::App;
 use crate::follow;
 use crate::stepping;
-use crate::tree_view::TreeView;
-
-/// Runs `change` on the picked tree, keeps the selection in view, and resets what follows
-/// the selected ray (the inspector's scroll, a finding's line) when it moved. What `change`
-/// returns is handed back; `None` with a message when no pixel is picked.
-pub(crate) fn with_tree<T>(app: &mut App, change: impl FnOnce(&mut TreeView) -> T) -> Option<T> {
-    let rows = app.tree_rows();
-    let Some(picked) = &mut app.picked else {
-        app.set_message("no ray tree yet: move the cursor and press Enter", false);
-        return None;
-    };
-    let before = picked.tree.selected();
-    let answer = change(&mut picked.tree);
-    picked.tree.keep_selection_in_view(rows);
-    if picked.tree.selected() != before {
-        app.inspector_scroll = 0;
-        app.source_focus = None;
-    }
-    Some(answer)
-}
+use crate::tree::update::with_tree;
 
 pub fn toggle_show_all(app: &mut App) {
     let Some(hidden) = with_tree(app, |tree| {

@@ -20,7 +20,7 @@ use crate::action::Focus;
 use crate::app::App;
 use crate::hit_point::hit_point_view;
 use crate::image_view::ColorDepth;
-use crate::tree_view::{NodeId, TreeView};
+use crate::tree::state::{NodeId, TreeView};
 
 use super::format::{self, number, swatch, vector};
 use super::pane_block;

@@ -1,6 +1,6 @@
 //! Drawing: the whole screen as a function of the [`App`] (`impl Widget for &App`). Each pane
-//! has its own module (the 3D ray view's and the explanation's are `draw.rs` in their
-//! feature's folder, `ray_view/` and `explain/`); none of them changes state.
+//! has its own module (the ray tree's, the 3D ray view's and the explanation's are `draw.rs`
+//! in their feature's folder: `tree/`, `ray_view/`, `explain/`); none of them changes state.
 
 pub(crate) mod braille;
 mod errors_pane;
@@ -12,7 +12,6 @@ mod inspector;
 mod snapshot_tests;
 pub(crate) mod source_pane;
 mod status;
-mod tree_pane;
 mod what_if_popup;
 
 use ratatui::buffer::Buffer;
@@ -38,7 +37,7 @@ impl Widget for &App {
             }
         }
         if !panes.tree.is_empty() {
-            tree_pane::draw(self, panes.tree, buf);
+            crate::tree::draw::draw(self, panes.tree, buf);
         }
         if !panes.inspector.is_empty() {
             if self.explain_open {

@@ -14,10 +14,10 @@ use crate::action::Focus;
 use crate::app::App;
 use crate::image_view::ColorDepth;
 use crate::stepping;
-use crate::tree_view::{NodeId, TreeView};
+use crate::tree::state::{NodeId, TreeView};
 
-use super::format::{self, swatch};
-use super::pane_block;
+use crate::ui::format::{self, swatch};
+use crate::ui::pane_block;
 
 pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let focused = app.focus == Focus::Tree;
