@@ -43,6 +43,20 @@ pub fn update(app: &mut App, action: Action) -> Vec<Effect> {
 }
 
 fn apply(app: &mut App, action: Action) -> Vec<Effect> {
+    // `+ - f` and the pans act on the image from any pane, but not while another pane is
+    // zoomed over it: the change could not be seen.
+    let image_hidden = app.zoomed && app.focus != Focus::Image;
+    let moves_the_image = matches!(
+        action,
+        Action::ZoomIn | Action::ZoomOut | Action::Fit | Action::Pan { .. }
+    );
+    if image_hidden && moves_the_image {
+        app.set_message(
+            "the image is hidden by the zoomed pane: z shows the layout",
+            false,
+        );
+        return Vec::new();
+    }
     if app.ray_view.is_some() && crate::ray_view::update::action(app, action) {
         return Vec::new();
     }
@@ -895,6 +909,26 @@ mod tests {
         update(&mut app, Action::ToggleExplain);
         update(&mut app, Action::InspectorScrollSideways(8));
         assert_eq!(app.inspector_columns, 8);
+
+        // Another pane zoomed over the image: the image's keys leave it alone.
+        app.focus = Focus::Tree;
+        assert!(app.zoomed, "still zoomed from above");
+        let view = app.view;
+        for action in [
+            Action::ZoomIn,
+            Action::Fit,
+            Action::Pan {
+                columns: 4,
+                rows: 0,
+            },
+        ] {
+            update(&mut app, action);
+            assert_eq!(app.view, view, "{action:?}");
+        }
+        assert!(app.message.as_ref().unwrap().text.contains("z shows"));
+        update(&mut app, Action::ToggleZoom);
+        update(&mut app, Action::ZoomIn);
+        assert_ne!(app.view, view, "unzoomed, + zooms the image from the tree");
 
         app.errors = Some(crate::app::SceneErrors {
             diagnostics: Vec::new(),
