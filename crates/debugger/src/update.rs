@@ -13,7 +13,7 @@ use crate::follow::update as follow_update;
 use crate::image_view::Viewport;
 use crate::layout;
 use crate::line_input::{InputOutcome, LineInput};
-use crate::search::Search;
+use crate::search;
 use crate::what_if_state::WhatIf;
 
 /// Applies one action; returns what the event loop must do about it.
@@ -105,20 +105,11 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
                 (i32::from(app.inspector_columns) + columns).clamp(0, 500) as u16;
         }
         Action::ToggleZoom => app.zoomed = !app.zoomed,
-        Action::StartSearch => {
-            if app.picked.is_some() {
-                app.search_prompt = Some(crate::line_input::LineInput::new(""));
-            } else {
-                app.set_message(
-                    "no ray tree to search: move the cursor and press Enter",
-                    false,
-                );
-            }
-        }
+        Action::StartSearch => search::update::start(app),
         // The search prompt, the query prompt and the what-if popup each take every key.
         Action::PromptKey(key) => {
             if app.search_prompt.is_some() {
-                prompt_key(app, key);
+                search::update::prompt_key(app, key);
             } else {
                 return input_key(app, key);
             }
@@ -130,7 +121,7 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
         }
         Action::NextMatch => step_match(app, false),
         Action::PreviousMatch => step_match(app, true),
-        Action::SearchStep { forward } => search_step(app, forward),
+        Action::SearchStep { forward } => search::update::step(app, forward),
         Action::ToggleOverlay(kind) => {
             app.overlay = if app.overlay == Some(kind) {
                 None
@@ -329,54 +320,6 @@ fn cancel(app: &mut App) {
     } else {
         app.set_message("Esc closes and leaves modes; q quits", false);
     }
-}
-
-/// A key for the `/` prompt: editing keys edit, Enter searches, Esc closes it.
-fn prompt_key(app: &mut App, key: KeyEvent) {
-    let Some(prompt) = &mut app.search_prompt else {
-        return;
-    };
-    match prompt.handle(key) {
-        InputOutcome::Edited | InputOutcome::Ignored => {}
-        InputOutcome::Cancelled => app.search_prompt = None,
-        InputOutcome::Submitted => {
-            let query = prompt.text().trim().to_string();
-            app.search_prompt = None;
-            if query.is_empty() {
-                return;
-            }
-            let Some(picked) = &app.picked else {
-                return;
-            };
-            let search = Search::new(&query, &picked.tree);
-            app.set_message(search.describe(), false);
-            if let Some(id) = search.current_match() {
-                select_ray(app, id);
-                // The match is a tree row: n / N step from there.
-                app.focus = Focus::Tree;
-            }
-            app.search = Some(search);
-        }
-    }
-}
-
-/// `n` / `N`: the next or previous ray matching the last search.
-fn search_step(app: &mut App, forward: bool) {
-    let Some(search) = &mut app.search else {
-        app.set_message("no search yet: / searches the ray tree", false);
-        return;
-    };
-    let target = search.step(forward);
-    let description = search.describe();
-    app.set_message(description, false);
-    if let Some(id) = target {
-        select_ray(app, id);
-    }
-}
-
-/// Selects a ray of the picked tree (opening its ancestors) and shows it.
-fn select_ray(app: &mut App, id: crate::tree::state::NodeId) {
-    tree(app, |t| t.select(id));
 }
 
 /// The image point zooming keeps in place: the centre of the cursor pixel.
