@@ -216,7 +216,7 @@ fn pick_the_glass_sphere_walk_to_the_transmitted_ray_export_and_quit() {
         "it hits the far side:\n{screen}"
     );
     assert!(
-        line_with(&screen, "transmitted d1").contains("glass sphere (inside)"),
+        line_with(&screen, "transmitted d1").contains("glass sphere (ins"),
         "{screen}"
     );
 
@@ -357,7 +357,8 @@ fn light_rays_collapse_stepping_reaches_the_pixel_and_the_explanation_jumps_at_8
     tmux.wait_for("the explanation", |s| {
         s.contains("Explanation · Enter: go to") && s.contains("Findings")
     });
-    tmux.keys(&["Tab", "Tab", "Down", "Down", "Enter"]);
+    // x gave the explanation the keyboard.
+    tmux.keys(&["Down", "Down", "Enter"]);
     let screen = tmux.wait_for("the ray of the third contribution", |s| {
         line_with(s, "▸").contains("7.8% ██ diffuse from sun")
     });
@@ -670,11 +671,11 @@ fn a_new_user_at_80x24_finds_the_glass_sphere_s_transmitted_ray_and_reads_it() {
         s.contains("9 of 13 rays") && line_with(s, "rendered in").contains("(400, 270)")
     });
     assert!(
-        line_with(&screen, "▼ camera").contains("glass sph"),
+        line_with(&screen, "▼ camera").contains("glass s"),
         "the camera ray hits the glass sphere:\n{screen}"
     );
     assert!(
-        screen.contains("what it met"),
+        line_with(&screen, "  ray  ").contains("share"),
         "the tree has a header:\n{screen}"
     );
 
@@ -905,4 +906,233 @@ fn a_query_marks_its_pixels_and_n_goes_to_the_first() {
     tmux.wait_for("the shell after quitting", |s| {
         s.contains("debugger exited with 0")
     });
+}
+
+// Issue 27, "the debugger at 80x24": what a newcomer's trial at the common terminal size found.
+
+/// The `--pixel 400,270` glass-sphere pixel of scenes/whitted.scene in a `width × height`
+/// terminal, its tree shown.
+fn glass_pixel_at(name: &str, width: u16, height: u16) -> Tmux {
+    let command = format!("'{}' debug scenes/whitted.scene --pixel 400,270", whitted());
+    let tmux = Tmux::start(name, &repository(), &command, width, height);
+    tmux.wait_for("the tree of --pixel", |s| {
+        s.contains("9 of 13 rays") && s.contains("rendered in")
+    });
+    tmux
+}
+
+/// The right column of an 80x24 screen when the left one has the focus (the inspector's
+/// and the source pane's text), one string per line, without the borders.
+fn right_column(screen: &str, from: usize) -> Vec<String> {
+    screen
+        .lines()
+        .map(|line| {
+            line.chars()
+                .skip(from)
+                .collect::<String>()
+                .trim_matches(|c: char| "│┃ ".contains(c))
+                .to_string()
+        })
+        .collect()
+}
+
+#[test]
+fn at_80x24_the_unfocused_inspector_shows_values_first_and_whole_source_locations() {
+    let tmux = glass_pixel_at("inspector80", 80, 24);
+    let screen = tmux.wait_for("the inspector", |s| s.contains("Inspector · camera"));
+    // The image has the keyboard: the inspector is the narrow right column (from column 48).
+    let inspector = right_column(&screen, 48);
+    assert!(
+        inspector.iter().any(|l| l == "scenes/whitted.scene:20:1"),
+        "the glass sphere's definition on a line by itself:\n{screen}"
+    );
+    // The value first, whole; its field name after it, on the next line if need be.
+    let pixel = inspector
+        .iter()
+        .position(|l| l.contains("pixel 400,270"))
+        .unwrap_or_else(|| panic!("the pixel's line:\n{screen}"));
+    assert!(
+        inspector[pixel.saturating_sub(1)..=pixel]
+            .iter()
+            .any(|l| l.starts_with("██ 0.189 0.292 0.693")),
+        "the value first, whole:\n{screen}"
+    );
+}
+
+/// The ray tree pane's header and rows as character vectors, cut at the pane's right border.
+fn tree_rows(screen: &str) -> (Vec<char>, Vec<Vec<char>>) {
+    let lines: Vec<&str> = screen.lines().collect();
+    let at = lines
+        .iter()
+        .position(|l| l.contains("  ray  ") && l.contains("share"))
+        .unwrap_or_else(|| panic!("the tree's header:\n{screen}"));
+    let header: Vec<char> = lines[at].chars().collect();
+    let border = header
+        .iter()
+        .skip(1)
+        .position(|c| "│┃".contains(*c))
+        .map_or(header.len(), |p| p + 1);
+    let cut = |line: &str| -> Vec<char> { line.chars().take(border).collect() };
+    let rows = lines[at + 1..]
+        .iter()
+        .take_while(|l| !l.starts_with('└') && !l.starts_with('┗'))
+        .map(|l| cut(l))
+        .filter(|l| l.contains(&'█'))
+        .collect();
+    (cut(lines[at]), rows)
+}
+
+/// The words of `line` from `from` on, with the column each starts at.
+fn words_from(line: &[char], from: usize) -> Vec<(usize, String)> {
+    let mut words = Vec::new();
+    let mut current: Option<(usize, String)> = None;
+    for (i, &c) in line.iter().enumerate().skip(from) {
+        if c == ' ' || "│┃".contains(c) {
+            words.extend(current.take());
+        } else if let Some((_, word)) = &mut current {
+            word.push(c);
+        } else {
+            current = Some((i, c.to_string()));
+        }
+    }
+    words.extend(current);
+    words
+}
+
+/// In every row, the swatch stands under `share` and each number under its `r`, `g` or `b`,
+/// whole (two decimals, not cut), and the depth after the kind is whole too.
+fn assert_tree_columns(screen: &str) {
+    let (header, rows) = tree_rows(screen);
+    let header_text: String = header.iter().collect();
+    let share = header_text
+        .find("share")
+        .map(|byte| header_text[..byte].chars().count())
+        .unwrap_or_else(|| panic!("a share header:\n{screen}"));
+    let channels = words_from(&header, share + 5);
+    assert!(!rows.is_empty(), "{screen}");
+    for row in rows {
+        let text: String = row.iter().collect();
+        let swatch = row.iter().position(|&c| c == '█').unwrap();
+        assert!(
+            (share..share + 5).contains(&swatch) && (share..share + 5).contains(&(swatch + 1)),
+            "the swatch under `share`:\n{header_text}\n{text}\n{screen}"
+        );
+        let under_share: String = row.iter().skip(share).take(5).collect();
+        assert!(
+            under_share.chars().all(|c| c == ' ' || c == '█'),
+            "only the swatch under `share`:\n{header_text}\n{text}\n{screen}"
+        );
+        let numbers = words_from(&row, share + 5);
+        assert_eq!(
+            numbers.len(),
+            channels.len(),
+            "as many numbers as headers:\n{header_text}\n{text}\n{screen}"
+        );
+        for ((at, number), (channel_at, channel)) in numbers.iter().zip(&channels) {
+            let whole = number.split_once('.').is_some_and(|(units, decimals)| {
+                !units.is_empty()
+                    && units.chars().all(|c| c.is_ascii_digit())
+                    && decimals.len() == 2
+                    && decimals.chars().all(|c| c.is_ascii_digit())
+            });
+            assert!(whole, "`{number}` is whole:\n{text}\n{screen}");
+            assert!(
+                (*at..at + number.chars().count()).contains(channel_at),
+                "`{channel}` over `{number}`:\n{header_text}\n{text}\n{screen}"
+            );
+        }
+        let depth_whole = words_from(&row, 0).iter().any(|(_, word)| {
+            word.len() > 1 && word.starts_with('d') && word[1..].chars().all(|c| c.is_ascii_digit())
+        });
+        assert!(depth_whole, "the depth is whole:\n{text}\n{screen}");
+    }
+}
+
+#[test]
+fn the_tree_s_headers_stand_over_their_columns_at_80x24_and_wide() {
+    let tmux = glass_pixel_at("headers80", 80, 24);
+    // Unfocused (swatches only), then focused (with the numbers).
+    assert_tree_columns(&tmux.screen());
+    tmux.keys(&["Tab"]);
+    let screen = tmux.wait_for("the focused tree", |s| s.contains("┏ Ray tree"));
+    assert_tree_columns(&screen);
+    assert!(
+        line_with(&screen, "  ray  ").contains("share    r    g    b"),
+        "the focused tree has room for the numbers:\n{screen}"
+    );
+    drop(tmux);
+    let tmux = glass_pixel_at("headers160", 160, 48);
+    assert_tree_columns(&tmux.screen());
+}
+
+#[test]
+fn deep_rows_keep_their_digits_and_show_fewer_columns() {
+    // A room of mirrors: rays 64 deep.
+    let command = format!(
+        "'{}' debug scenes/ray-explosion.scene --pixel 32,24",
+        whitted()
+    );
+    let tmux = Tmux::start("deep", &repository(), &command, 80, 24);
+    tmux.wait_for("the tree of --pixel", |s| {
+        s.contains("Ray tree") && s.contains("rendered in")
+    });
+    tmux.keys(&["Tab", "End"]);
+    let screen = tmux.wait_for("the deepest rows", |s| {
+        s.contains("┏ Ray tree") && s.contains("Inspector · shadow")
+    });
+    assert_tree_columns(&screen);
+    // Unfocused, the narrow tree keeps its swatches and depths whole too.
+    tmux.keys(&["Tab"]);
+    let screen = tmux.wait_for("the inspector focused", |s| s.contains("┏ Inspector"));
+    assert_tree_columns(&screen);
+}
+
+#[test]
+fn the_query_prompt_opens_empty_recalls_history_and_edits_like_a_shell() {
+    let tmux = glass_pixel_at("prompt80", 80, 24);
+    tmux.keys(&[":"]);
+    tmux.wait_for("the prompt", |s| s.contains(" query: "));
+    tmux.type_text("tir and hit(\"nope\")");
+    tmux.keys(&["Enter"]);
+    tmux.wait_for("the query's error", |s| s.contains("query error at column"));
+    tmux.keys(&[":"]);
+    let screen = tmux.wait_for("the prompt again", |s| s.contains(" query: "));
+    assert!(
+        line_with(&screen, " query: ").starts_with(" query:     Enter runs it"),
+        "the prompt opens empty:\n{screen}"
+    );
+    tmux.keys(&["Up"]);
+    tmux.wait_for("the failed query recalled", |s| {
+        line_with(s, " query: ").contains("query: tir and hit(\"nope\")")
+    });
+    tmux.keys(&["C-w"]);
+    tmux.wait_for("the word before the cursor deleted", |s| {
+        line_with(s, " query: ").starts_with(" query: tir and     Enter")
+    });
+    tmux.keys(&["C-u"]);
+    tmux.wait_for("the line cleared", |s| {
+        line_with(s, " query: ").starts_with(" query:     Enter")
+    });
+    tmux.keys(&["Escape"]);
+    tmux.wait_for("the prompt closed", |s| !s.contains(" query: "));
+}
+
+#[test]
+fn keys_act_on_the_focused_explanation() {
+    let tmux = glass_pixel_at("explainkeys", 80, 24);
+    // From the tree, x opens the explanation: it takes the keyboard, so z zooms it.
+    tmux.keys(&["Tab"]);
+    tmux.wait_for("the focused tree", |s| s.contains("┏ Ray tree"));
+    tmux.keys(&["x"]);
+    let screen = tmux.wait_for("the explanation", |s| s.contains("Findings"));
+    assert!(
+        screen.contains("┏ Explanation"),
+        "the explanation has the keyboard:\n{screen}"
+    );
+    tmux.keys(&["z"]);
+    let screen = tmux.wait_for("the zoomed pane", |s| s.contains("zoomed: z back"));
+    assert!(
+        screen.contains("Explanation of (400, 270)") && !screen.contains("Ray tree"),
+        "the explanation is zoomed, not the tree:\n{screen}"
+    );
 }

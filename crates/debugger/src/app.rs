@@ -19,10 +19,10 @@ use crate::image_view::{ColorDepth, Viewport};
 use crate::layout::{self, Arrangement, Panes};
 use crate::line_input::LineInput;
 use crate::query_job::QueryState;
-use crate::ray_view_state::{BackdropJob, BackdropRendered, RayViewState};
-use crate::search::Search;
+use crate::ray_view::state::{BackdropJob, BackdropRendered, RayViewState};
+use crate::search::state::Search;
 use crate::trace_job::{Explained, TraceFailure, TraceJob, Traced};
-use crate::tree_view::TreeView;
+use crate::tree::state::TreeView;
 use crate::what_if_state::WhatIf;
 
 /// A scene ready to render and trace: the IR (names, spans, sources) and its prepared form.
@@ -750,7 +750,7 @@ mod tests {
         let tree = &app.picked.as_ref().unwrap().tree;
         assert_eq!(
             app.search.as_ref().map(|s| s.matches.clone()),
-            Some(crate::search::matching_rays(tree, "transmitted"))
+            Some(crate::search::state::matching_rays(tree, "transmitted"))
         );
         assert_eq!(
             app.message.as_ref().unwrap().text,

@@ -35,7 +35,7 @@ pub enum Event {
     /// The explanation of a traced pixel's tree, worked out after it on the same worker.
     Explained(crate::trace_job::Explained),
     /// A backdrop of the 3D ray view, rendered off the UI thread (or cancelled).
-    Backdrop(crate::ray_view_state::BackdropRendered),
+    Backdrop(crate::ray_view::state::BackdropRendered),
     /// A what-if re-trace's answer (the popup's `w`).
     WhatIfTraced(crate::what_if_state::WhatIfTraced),
     /// A query's progress or answer (`:`).

@@ -21,8 +21,9 @@ use crate::terminal::{panic_text, take_worker_panic};
 pub struct QueryState {
     /// The prompt on the status line, while typing.
     pub prompt: Option<LineInput>,
-    /// The last query run, to start the next prompt with.
-    pub last_text: String,
+    /// The queries submitted, oldest first (failed ones too, to be fixed): the prompt opens
+    /// empty and ↑↓ bring them back.
+    pub history: Vec<String>,
     pub running: Option<QueryRun>,
     /// The matching pixels of the last finished query.
     pub overlay: Option<QueryOverlay>,
@@ -120,7 +121,6 @@ impl QueryState {
         let query = Query::compile(text, scene).map_err(|e| error_text(&e, text))?;
         self.cancel();
         self.overlay = None;
-        self.last_text = text.to_string();
         self.requests += 1;
         let cancel = Arc::new(AtomicBool::new(false));
         self.running = Some(QueryRun {
@@ -343,7 +343,7 @@ mod tests {
     }
 
     #[test]
-    fn a_bad_query_is_an_error_with_its_column_and_the_prompt_brings_it_back() {
+    fn a_bad_query_is_an_error_with_its_column_and_up_in_the_empty_prompt_brings_it_back() {
         let mut app = app();
         assert!(type_query(&mut app, "tir and hit(\"mirorr sphere\")").is_empty());
         let message = app.message.clone().unwrap();
@@ -354,6 +354,11 @@ mod tests {
         );
         assert!(app.query.running.is_none());
         update(&mut app, Action::QueryPrompt);
+        assert_eq!(app.query.prompt.as_ref().map(LineInput::text), Some(""));
+        update(
+            &mut app,
+            Action::PromptKey(KeyEvent::new(KeyCode::Up, KeyModifiers::NONE)),
+        );
         assert_eq!(
             app.query.prompt.as_ref().map(LineInput::text),
             Some("tir and hit(\"mirorr sphere\")")

@@ -13,7 +13,7 @@
 use whitted_tracer::ray_tree::{RayNode, ShadowOutcome};
 use whitted_tracer::{PixelAccumulator, RayKind, Termination, Vec3A};
 
-use crate::tree_view::{NodeId, TreeView};
+use crate::tree::state::{NodeId, TreeView};
 
 /// Moves the selection to the next (or previous) ray in the tracer's order, opening its
 /// ancestors; whether it moved.

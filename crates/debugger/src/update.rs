@@ -9,11 +9,11 @@ use whitted_ir::Handle;
 
 use crate::action::{Action, Focus};
 use crate::app::{App, Effect, SourceScroll, SourceTarget, View};
-use crate::follow_update;
+use crate::follow::update as follow_update;
 use crate::image_view::Viewport;
 use crate::layout;
 use crate::line_input::{InputOutcome, LineInput};
-use crate::search::Search;
+use crate::search;
 use crate::what_if_state::WhatIf;
 
 /// Applies one action; returns what the event loop must do about it.
@@ -43,7 +43,21 @@ pub fn update(app: &mut App, action: Action) -> Vec<Effect> {
 }
 
 fn apply(app: &mut App, action: Action) -> Vec<Effect> {
-    if app.ray_view.is_some() && ray_view_action(app, action) {
+    // `+ - f` and the pans act on the image from any pane, but not while another pane is
+    // zoomed over it: the change could not be seen.
+    let image_hidden = app.zoomed && app.focus != Focus::Image;
+    let moves_the_image = matches!(
+        action,
+        Action::ZoomIn | Action::ZoomOut | Action::Fit | Action::Pan { .. }
+    );
+    if image_hidden && moves_the_image {
+        app.set_message(
+            "the image is hidden by the zoomed pane: z shows the layout",
+            false,
+        );
+        return Vec::new();
+    }
+    if app.ray_view.is_some() && crate::ray_view::update::action(app, action) {
         return Vec::new();
     }
     match action {
@@ -84,36 +98,30 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
         Action::TreePage(rows) => tree(app, |t| t.page(rows as isize)),
         Action::TreeToggle => tree(app, |t| t.toggle()),
         Action::InspectorScroll(lines) => scroll_inspector(app, lines),
+        // The explanation does not scroll sideways: the hidden inspector must not either.
+        Action::InspectorScrollSideways(_) if app.explain_open => {}
         Action::InspectorScrollSideways(columns) => {
             app.inspector_columns =
                 (i32::from(app.inspector_columns) + columns).clamp(0, 500) as u16;
         }
         Action::ToggleZoom => app.zoomed = !app.zoomed,
-        Action::StartSearch => {
-            if app.picked.is_some() {
-                app.search_prompt = Some(crate::line_input::LineInput::new(""));
-            } else {
-                app.set_message(
-                    "no ray tree to search: move the cursor and press Enter",
-                    false,
-                );
-            }
-        }
+        Action::StartSearch => search::update::start(app),
         // The search prompt, the query prompt and the what-if popup each take every key.
         Action::PromptKey(key) => {
             if app.search_prompt.is_some() {
-                prompt_key(app, key);
+                search::update::prompt_key(app, key);
             } else {
                 return input_key(app, key);
             }
         }
         Action::WhatIf => open_what_if(app),
         Action::QueryPrompt => {
-            app.query.prompt = Some(LineInput::new(&app.query.last_text));
+            // Empty, not the last query: ↑ brings that back when it is wanted.
+            app.query.prompt = Some(LineInput::with_history(&app.query.history));
         }
         Action::NextMatch => step_match(app, false),
         Action::PreviousMatch => step_match(app, true),
-        Action::SearchStep { forward } => search_step(app, forward),
+        Action::SearchStep { forward } => search::update::step(app, forward),
         Action::ToggleOverlay(kind) => {
             app.overlay = if app.overlay == Some(kind) {
                 None
@@ -130,6 +138,9 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
             let state = if app.show_hit_point { "on" } else { "off" };
             app.set_message(format!("hit-point mark {state}"), false);
         }
+        // After a failed reload the errors are in the source pane's place: the keys must
+        // not scroll the hidden source.
+        Action::SourceScroll { .. } | Action::SourceScrollHome if app.errors.is_some() => {}
         Action::SourceScroll { lines, columns } => scroll_source(app, lines, columns),
         Action::SourceScrollHome => {
             app.source_scroll = SourceScroll {
@@ -153,10 +164,10 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
         Action::Export => return export(app),
         Action::ToggleShowAll => follow_update::toggle_show_all(app),
         Action::FollowHeaviest => follow_update::follow_heaviest(app),
-        Action::ToggleExplain => follow_update::toggle_explain(app),
+        Action::ToggleExplain => crate::explain::update::toggle_explain(app),
         Action::Step { forward } => follow_update::step(app, forward),
         Action::RunToEvent { forward } => follow_update::run_to_event(app, forward),
-        Action::ExplainGo => follow_update::go(app),
+        Action::ExplainGo => crate::explain::update::go(app),
         Action::ToggleRayView => {
             app.toggle_ray_view();
             app.focus = Focus::Image;
@@ -168,78 +179,6 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
         Action::Drag { .. } => {}
     }
     Vec::new()
-}
-
-/// How far one arrow press orbits the 3D view; Shift+arrow (a single pixel's move on the
-/// image) turns it by a fine step.
-const ORBIT_STEP_DEGREES: f64 = 5.0;
-const FINE_ORBIT_STEP_DEGREES: f64 = 1.0;
-/// How far a drag across one cell orbits it (a row is twice as tall as a column is wide).
-const DRAG_DEGREES_PER_COLUMN: f64 = 3.0;
-const ZOOM_STEP: f64 = 1.25;
-
-/// In the 3D view, the image's moves steer its camera instead: arrows orbit, +/- and the
-/// wheel zoom, pans pan, 0 resets, and a press and drag in the pane orbits. Whether the
-/// action was taken here.
-fn ray_view_action(app: &mut App, action: Action) -> bool {
-    let area = app.image_area();
-    let Some(view) = app.ray_view.as_mut() else {
-        return false;
-    };
-    let inside = |column: u16, row: u16| {
-        area.is_some_and(|a| a.contains(ratatui::layout::Position::new(column, row)))
-    };
-    if let Action::Click { .. } = action {
-        // Only a press inside the pane starts a drag.
-        view.drag_from = None;
-    }
-    let orbit = &mut view.orbit;
-    match action {
-        Action::MoveCursorByCells { dx, dy } => orbit.orbit(
-            f64::from(dx) * ORBIT_STEP_DEGREES.to_radians(),
-            -f64::from(dy) * ORBIT_STEP_DEGREES.to_radians(),
-        ),
-        Action::MoveCursor { dx, dy } => orbit.orbit(
-            f64::from(dx) * FINE_ORBIT_STEP_DEGREES.to_radians(),
-            -f64::from(dy) * FINE_ORBIT_STEP_DEGREES.to_radians(),
-        ),
-        Action::ZoomIn => orbit.zoom(ZOOM_STEP),
-        Action::ZoomOut => orbit.zoom(1.0 / ZOOM_STEP),
-        Action::Wheel { column, row, lines } if inside(column, row) => {
-            orbit.zoom(if lines < 0 {
-                ZOOM_STEP
-            } else {
-                1.0 / ZOOM_STEP
-            });
-        }
-        Action::Pan { columns, rows } => {
-            // As a fraction of the view's height: a row is two of the backdrop's pixels,
-            // a column one.
-            let half_rows = f64::from(area.map_or(1, |a| a.height.max(1))) * 2.0;
-            orbit.pan(
-                f64::from(columns) / half_rows,
-                -f64::from(rows) * 2.0 / half_rows,
-            );
-        }
-        Action::ResetRayView => orbit.reset(),
-        Action::Click { column, row } if inside(column, row) && !app.help_open => {
-            view.drag_from = Some((column, row));
-            app.focus = Focus::Image;
-        }
-        Action::Drag { column, row } => {
-            // The scene follows the mouse: dragging right turns it right (the camera goes
-            // left), dragging down tips its top towards the viewer (the camera rises).
-            if let Some((from_column, from_row)) = view.drag_from {
-                let dx = f64::from(column) - f64::from(from_column);
-                let dy = f64::from(row) - f64::from(from_row);
-                let step = DRAG_DEGREES_PER_COLUMN.to_radians();
-                orbit.orbit(-dx * step, dy * 2.0 * step);
-                view.drag_from = Some((column, row));
-            }
-        }
-        _ => return false,
-    }
-    true
 }
 
 /// `w`: the what-if popup on the picked pixel, with the material of the selected ray (or,
@@ -288,8 +227,10 @@ fn input_key(app: &mut App, key: KeyEvent) -> Vec<Effect> {
                 app.query.overlay = None;
                 return Vec::new();
             }
-            // Kept even when wrong, so that `:` brings it back to be fixed.
-            app.query.last_text = text.clone();
+            // Kept even when wrong, so that ↑ in the next prompt brings it back to be fixed.
+            if app.query.history.last() != Some(&text) {
+                app.query.history.push(text.clone());
+            }
             let scene = std::sync::Arc::clone(&app.loaded.scene);
             match app.query.start(&text, &app.loaded, &app.options, &scene) {
                 Ok(()) => {
@@ -379,54 +320,6 @@ fn cancel(app: &mut App) {
     } else {
         app.set_message("Esc closes and leaves modes; q quits", false);
     }
-}
-
-/// A key for the `/` prompt: editing keys edit, Enter searches, Esc closes it.
-fn prompt_key(app: &mut App, key: KeyEvent) {
-    let Some(prompt) = &mut app.search_prompt else {
-        return;
-    };
-    match prompt.handle(key) {
-        InputOutcome::Edited | InputOutcome::Ignored => {}
-        InputOutcome::Cancelled => app.search_prompt = None,
-        InputOutcome::Submitted => {
-            let query = prompt.text().trim().to_string();
-            app.search_prompt = None;
-            if query.is_empty() {
-                return;
-            }
-            let Some(picked) = &app.picked else {
-                return;
-            };
-            let search = Search::new(&query, &picked.tree);
-            app.set_message(search.describe(), false);
-            if let Some(id) = search.current_match() {
-                select_ray(app, id);
-                // The match is a tree row: n / N step from there.
-                app.focus = Focus::Tree;
-            }
-            app.search = Some(search);
-        }
-    }
-}
-
-/// `n` / `N`: the next or previous ray matching the last search.
-fn search_step(app: &mut App, forward: bool) {
-    let Some(search) = &mut app.search else {
-        app.set_message("no search yet: / searches the ray tree", false);
-        return;
-    };
-    let target = search.step(forward);
-    let description = search.describe();
-    app.set_message(description, false);
-    if let Some(id) = target {
-        select_ray(app, id);
-    }
-}
-
-/// Selects a ray of the picked tree (opening its ancestors) and shows it.
-fn select_ray(app: &mut App, id: crate::tree_view::NodeId) {
-    tree(app, |t| t.select(id));
 }
 
 /// The image point zooming keeps in place: the centre of the cursor pixel.
@@ -555,26 +448,14 @@ fn wheel(app: &mut App, column: u16, row: u16, lines: i32) {
     }
 }
 
-/// Runs a tree navigation, keeps the selection in view, and resets the inspector's scroll
-/// when another ray is selected.
-fn tree(app: &mut App, navigate: impl FnOnce(&mut crate::tree_view::TreeView)) {
-    let rows = app.tree_rows();
-    let Some(picked) = &mut app.picked else {
-        app.set_message("no ray tree yet: move the cursor and press Enter", false);
-        return;
-    };
-    let before = picked.tree.selected();
-    navigate(&mut picked.tree);
-    picked.tree.keep_selection_in_view(rows);
-    if picked.tree.selected() != before {
-        app.inspector_scroll = 0;
-        app.source_focus = None;
-    }
+/// Runs a tree navigation ([`crate::tree::update::with_tree`]).
+fn tree(app: &mut App, navigate: impl FnOnce(&mut crate::tree::state::TreeView)) {
+    crate::tree::update::with_tree(app, navigate);
 }
 
 fn scroll_inspector(app: &mut App, lines: i32) {
     if app.explain_open {
-        return follow_update::move_explain_selection(app, lines);
+        return crate::explain::update::move_explain_selection(app, lines);
     }
     app.inspector_scroll = if lines == i32::MIN {
         0
@@ -950,6 +831,61 @@ mod tests {
         update(&mut app, Action::ToggleZoom);
         update(&mut app, Action::Cancel);
         assert!(!app.zoomed && !app.should_quit);
+    }
+
+    /// Keys act on the pane that shows: with the explanation (or the errors) in a pane's
+    /// place, the keys of the pane it hides do nothing to it.
+    #[test]
+    fn keys_never_act_on_a_hidden_pane() {
+        let mut app = picked_app();
+        app.focus = Focus::Tree;
+        update(&mut app, Action::ToggleExplain);
+        assert_eq!(
+            app.focus,
+            Focus::Inspector,
+            "x gives the explanation the keyboard"
+        );
+        update(&mut app, Action::ToggleZoom);
+        assert_eq!(app.panes().unwrap().inspector, Rect::new(0, 0, 120, 39));
+        update(&mut app, Action::InspectorScrollSideways(8));
+        assert_eq!(app.inspector_columns, 0);
+        update(&mut app, Action::ToggleExplain);
+        update(&mut app, Action::InspectorScrollSideways(8));
+        assert_eq!(app.inspector_columns, 8);
+
+        // Another pane zoomed over the image: the image's keys leave it alone.
+        app.focus = Focus::Tree;
+        assert!(app.zoomed, "still zoomed from above");
+        let view = app.view;
+        for action in [
+            Action::ZoomIn,
+            Action::Fit,
+            Action::Pan {
+                columns: 4,
+                rows: 0,
+            },
+        ] {
+            update(&mut app, action);
+            assert_eq!(app.view, view, "{action:?}");
+        }
+        assert!(app.message.as_ref().unwrap().text.contains("z shows"));
+        update(&mut app, Action::ToggleZoom);
+        update(&mut app, Action::ZoomIn);
+        assert_ne!(app.view, view, "unzoomed, + zooms the image from the tree");
+
+        app.errors = Some(crate::app::SceneErrors {
+            diagnostics: Vec::new(),
+            sources: whitted_ir::SourceMap::new(),
+        });
+        app.focus = Focus::Source;
+        update(
+            &mut app,
+            Action::SourceScroll {
+                lines: 3,
+                columns: 8,
+            },
+        );
+        assert_eq!((app.source_scroll.lines, app.source_scroll.columns), (0, 0));
     }
 
     fn search(app: &mut App, query: &str) {

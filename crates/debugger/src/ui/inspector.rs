@@ -1,7 +1,10 @@
 //! The inspector pane: every field of the selected ray (docs/ray-tree.md), colours with
 //! swatches beside their numbers, so the pixel's colour can be read off term by term. A
 //! header names the columns; ↑↓ scroll the lines under it and ←→ scroll everything
-//! sideways together, so the columns stay aligned with their header.
+//! sideways together, so the columns stay aligned with their header. In a pane too narrow
+//! for the field names beside the values (unfocused at 80 columns) each line shows its value
+//! first and its field name after, wrapped rather than cut, and source locations stand on
+//! lines of their own.
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -17,12 +20,16 @@ use crate::action::Focus;
 use crate::app::App;
 use crate::hit_point::hit_point_view;
 use crate::image_view::ColorDepth;
-use crate::tree_view::{NodeId, TreeView};
+use crate::tree::state::{NodeId, TreeView};
 
 use super::format::{self, number, swatch, vector};
 use super::pane_block;
 
 const LABEL_WIDTH: usize = 13;
+
+/// Below this inner width the values come first: the field names and a vector beside them
+/// (`direction     (-0.137, -0.143, 0.980)`) need 38 columns.
+const VALUE_FIRST_BELOW: u16 = 40;
 
 pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let focused = app.focus == Focus::Inspector;
@@ -49,9 +56,18 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         node.kind.name(),
         node.depth
     );
-    let lines = Lines::new(app.color_depth).node(app, tree, id, node);
     let mut block = pane_block(Line::from(title), focused);
     let inner = block.inner(pane);
+    if inner.width < VALUE_FIRST_BELOW {
+        let lines = Lines::value_first(app.color_depth)
+            .node(app, tree, id, node)
+            .into_iter()
+            .flat_map(|line| wrap_pieces(line, usize::from(inner.width)))
+            .collect();
+        draw_value_first(block, lines, app.inspector_scroll, pane, buf);
+        return;
+    }
+    let lines = Lines::new(app.color_depth).node(app, tree, id, node);
     if inner.height < 2 {
         block.render(pane, buf);
         return;
@@ -112,6 +128,96 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
         );
 }
 
+/// The narrow inspector: the lines (already wrapped to the pane) under no header, scrolled
+/// by ↑↓ only (nothing is wider than the pane).
+fn draw_value_first(
+    mut block: ratatui::widgets::Block<'static>,
+    lines: Vec<Line<'static>>,
+    scroll: u16,
+    pane: Rect,
+    buf: &mut Buffer,
+) {
+    let inner = block.inner(pane);
+    let hidden = lines.len().saturating_sub(usize::from(inner.height));
+    let scroll = usize::from(scroll).min(hidden);
+    if hidden > 0 {
+        block = block.title_bottom(Line::from(" more: ↑↓ ").right_aligned());
+    }
+    block.render(pane, buf);
+    let shown: Vec<Line<'static>> = lines
+        .into_iter()
+        .skip(scroll)
+        .take(usize::from(inner.height))
+        .collect();
+    Paragraph::new(shown).render(inner, buf);
+}
+
+/// `line` in lines of at most `width` cells, broken between its pieces (its spans: value,
+/// field name, note; a swatch stays with the numbers after it) two spaces apart, and a piece
+/// longer than a line between its words, so that nothing is cut. The lines after the first
+/// are indented, so that a field name on the next line reads as its value's.
+fn wrap_pieces(line: Line<'static>, width: usize) -> Vec<Line<'static>> {
+    const INDENT: &str = "  ";
+    let width = width.max(INDENT.len() + 1);
+    let mut pieces: Vec<Vec<Span<'static>>> = Vec::new();
+    let mut glued = false;
+    for span in line.spans {
+        let swatch = span.content == "██";
+        match pieces.last_mut() {
+            Some(piece) if glued => piece.push(span),
+            _ => pieces.push(vec![span]),
+        }
+        glued = swatch;
+    }
+    let mut lines: Vec<Line<'static>> = Vec::new();
+    let mut current: Vec<Span<'static>> = Vec::new();
+    let mut used = 0;
+    for piece in pieces {
+        let piece_width: usize = piece.iter().map(Span::width).sum();
+        if !current.is_empty() && used + 2 + piece_width <= width {
+            current.push(Span::raw("  "));
+            current.extend(piece);
+            used += 2 + piece_width;
+            continue;
+        }
+        if !current.is_empty() {
+            lines.push(Line::from(std::mem::take(&mut current)));
+        }
+        let indent = if lines.is_empty() { "" } else { INDENT };
+        if indent.len() + piece_width <= width {
+            current = vec![Span::raw(indent)];
+            current.extend(piece);
+            used = indent.len() + piece_width;
+            continue;
+        }
+        // Longer than a line: a text value or a long path, in one style.
+        let style = piece.first().map_or(Style::new(), |span| span.style);
+        let text: String = piece.iter().map(|span| span.content.as_ref()).collect();
+        let first = format::wrap_words(&text, width - indent.len());
+        let rest: String = first[1..].join(" ");
+        lines.push(Line::from(vec![
+            Span::raw(indent),
+            Span::styled(first[0].clone(), style),
+        ]));
+        for row in format::wrap_words(&rest, width - INDENT.len()) {
+            if !row.is_empty() {
+                lines.push(Line::from(vec![
+                    Span::raw(INDENT),
+                    Span::styled(row, style),
+                ]));
+            }
+        }
+        if let Some(last) = lines.pop() {
+            used = last.width();
+            current = last.spans;
+        }
+    }
+    if !current.is_empty() || lines.is_empty() {
+        lines.push(Line::from(current));
+    }
+    lines
+}
+
 /// A line's field name (its first span, when it fills the label column) and the rest.
 /// Section titles have no field name: all of them is the rest.
 fn split_label(line: Line<'static>) -> (Line<'static>, Line<'static>) {
@@ -138,9 +244,11 @@ fn header() -> Line<'static> {
     Line::from(vec![Span::styled(field, style), Span::styled(rest, style)])
 }
 
-/// Builds the inspector's lines: a label column, then values.
+/// Builds the inspector's lines: a label column, then values; or, value first, the value
+/// then its field name (a piece each, for [`wrap_pieces`]).
 struct Lines {
     depth: ColorDepth,
+    value_first: bool,
     out: Vec<Line<'static>>,
 }
 
@@ -156,18 +264,57 @@ impl Lines {
     fn new(depth: ColorDepth) -> Lines {
         Lines {
             depth,
+            value_first: false,
             out: Vec::new(),
         }
     }
 
+    fn value_first(depth: ColorDepth) -> Lines {
+        Lines {
+            value_first: true,
+            ..Lines::new(depth)
+        }
+    }
+
     fn text(&mut self, label: &str, value: impl Into<String>) {
+        if self.value_first {
+            let mut spans = vec![Span::raw(value.into())];
+            if !label.trim().is_empty() {
+                spans.push(Span::styled(label.trim().to_string(), label_style()));
+            }
+            self.out.push(Line::from(spans));
+            return;
+        }
         self.out.push(Line::from(vec![
             Span::styled(format!("{label:<LABEL_WIDTH$} "), label_style()),
             Span::raw(value.into()),
         ]));
     }
 
+    /// Where something is defined: `defined at file:line:col` under its field, or, value
+    /// first, the location alone on its line (wrapped, never cut), so that it can be read
+    /// in a narrow pane.
+    fn location(&mut self, location: &str) {
+        if self.value_first {
+            self.out.push(Line::from(location.to_string()));
+        } else {
+            self.text("", format!("defined at {location}"));
+        }
+    }
+
     fn color(&mut self, label: &str, c: [f32; 3], note: &str) {
+        if self.value_first {
+            let mut spans = vec![
+                swatch(c, self.depth),
+                Span::raw(format!(" {}", format::rgb(c))),
+                Span::styled(label.trim().to_string(), label_style()),
+            ];
+            if !note.is_empty() {
+                spans.push(Span::styled(note.to_string(), label_style()));
+            }
+            self.out.push(Line::from(spans));
+            return;
+        }
         let mut spans = vec![
             Span::styled(format!("{label:<LABEL_WIDTH$} "), label_style()),
             swatch(c, self.depth),
@@ -296,10 +443,10 @@ impl Lines {
             "object",
             format!("{} ({})", hit.object.label, hit.object.kind),
         );
-        self.text("", format!("defined at {}", hit.object.location));
+        self.location(&hit.object.location);
         if hit.leaf.handle != hit.object.handle {
             self.text("leaf", format!("{} ({})", hit.leaf.label, hit.leaf.kind));
-            self.text("", format!("defined at {}", hit.leaf.location));
+            self.location(&hit.leaf.location);
         }
         if !hit.csg_path.is_empty() {
             let path: Vec<String> = hit
@@ -325,7 +472,7 @@ impl Lines {
             );
         }
         self.text("material", hit.material.label.clone());
-        self.text("", format!("defined at {}", hit.material.location));
+        self.location(&hit.material.location);
         if hit.resolved_material.handle != hit.material.handle {
             self.text("pattern →", hit.resolved_material.label.clone());
         }
@@ -344,7 +491,7 @@ impl Lines {
                     other.object.label, other.object.kind
                 ),
             );
-            self.text("", format!("defined at {}", other.object.location));
+            self.location(&other.object.location);
         }
     }
 
@@ -428,13 +575,13 @@ impl Lines {
     }
 
     fn shadow(&mut self, shadow: &ShadowInfo) {
-        self.text(
-            "towards",
-            format!(
-                "{} ({})  {}",
-                shadow.light.label, shadow.light.kind, shadow.light.location
-            ),
-        );
+        let light = format!("{} ({})", shadow.light.label, shadow.light.kind);
+        if self.value_first {
+            self.text("towards", light);
+            self.location(&shadow.light.location);
+        } else {
+            self.text("towards", format!("{light}  {}", shadow.light.location));
+        }
         self.text(
             "max t",
             match shadow.max_t {
@@ -442,15 +589,23 @@ impl Lines {
                 None => "none (directional light)".to_string(),
             },
         );
+        let mut blocker_location = None;
         let result = match shadow.result {
             ShadowOutcome::Unblocked => "reached the light".to_string(),
             ShadowOutcome::Blocked => match &shadow.blocker {
-                Some(blocker) => format!(
-                    "blocked by {} at t {}  {}",
-                    blocker.object.label,
-                    number(blocker.t),
-                    blocker.object.location
-                ),
+                Some(blocker) => {
+                    let blocked = format!(
+                        "blocked by {} at t {}",
+                        blocker.object.label,
+                        number(blocker.t)
+                    );
+                    if self.value_first {
+                        blocker_location = Some(blocker.object.location.as_str());
+                        blocked
+                    } else {
+                        format!("{blocked}  {}", blocker.object.location)
+                    }
+                }
                 None => "blocked".to_string(),
             },
             ShadowOutcome::Filtered => {
@@ -458,6 +613,9 @@ impl Lines {
             }
         };
         self.text("result", result);
+        if let Some(location) = blocker_location {
+            self.location(location);
+        }
         if let Some(transmittance) = shadow.transmittance {
             self.color("transmittance", transmittance, "");
         }
@@ -580,6 +738,46 @@ mod tests {
         );
         assert!(lines[1].contains("faces away: N·L <= 0"), "{text}");
         assert!(lines[2].contains("black light"), "{text}");
+    }
+
+    fn plain(lines: &[Line<'static>]) -> Vec<String> {
+        lines
+            .iter()
+            .map(|line| line.spans.iter().map(|s| s.content.as_ref()).collect())
+            .collect()
+    }
+
+    /// Value first, a line breaks between its value, field name and note, a value longer
+    /// than the pane between its words, and a path longer than the pane inside it: nothing
+    /// is cut, and a swatch stays with its numbers.
+    #[test]
+    fn narrow_lines_wrap_between_pieces_and_never_cut() {
+        let mut lines = Lines::value_first(ColorDepth::TrueColor);
+        lines.color(
+            "pixel 400,270",
+            [0.189, 0.292, 0.693],
+            "its rendered colour",
+        );
+        lines.text("hit at t", "4.406  point (-0.606, 0.971, -2.181)");
+        lines.location("scenes/a-rather-long-folder-name/whitted.scene:20:1");
+        let wrapped: Vec<Line<'static>> = lines
+            .out
+            .into_iter()
+            .flat_map(|line| wrap_pieces(line, 30))
+            .collect();
+        assert_eq!(
+            plain(&wrapped),
+            [
+                "██ 0.189 0.292 0.693",
+                "  pixel 400,270",
+                "  its rendered colour",
+                "4.406 point (-0.606, 0.971,",
+                "  -2.181)  hit at t",
+                "scenes/a-rather-long-folder-na",
+                "  me/whitted.scene:20:1",
+            ]
+        );
+        assert!(wrapped.iter().all(|line| line.width() <= 30));
     }
 
     #[test]

@@ -1,19 +1,17 @@
 //! Drawing: the whole screen as a function of the [`App`] (`impl Widget for &App`). Each pane
-//! has its own module; none of them changes state.
+//! has its own module (the ray tree's, the 3D ray view's and the explanation's are `draw.rs`
+//! in their feature's folder: `tree/`, `ray_view/`, `explain/`); none of them changes state.
 
-mod braille;
+pub(crate) mod braille;
 mod errors_pane;
-mod explain_pane;
 pub mod format;
 mod help;
 mod image_pane;
 mod inspector;
-mod ray_view_pane;
 #[cfg(test)]
 mod snapshot_tests;
 pub(crate) mod source_pane;
 mod status;
-mod tree_pane;
 mod what_if_popup;
 
 use ratatui::buffer::Buffer;
@@ -34,16 +32,16 @@ impl Widget for &App {
         // Zoomed, the panes other than the focused one are empty: not drawn.
         if !panes.image.is_empty() {
             match &self.ray_view {
-                Some(view) => ray_view_pane::draw(self, view, panes.image, buf),
+                Some(view) => crate::ray_view::draw::draw(self, view, panes.image, buf),
                 None => image_pane::draw(self, panes.image, buf),
             }
         }
         if !panes.tree.is_empty() {
-            tree_pane::draw(self, panes.tree, buf);
+            crate::tree::draw::draw(self, panes.tree, buf);
         }
         if !panes.inspector.is_empty() {
             if self.explain_open {
-                explain_pane::draw(self, panes.inspector, buf);
+                crate::explain::draw::draw(self, panes.inspector, buf);
             } else {
                 inspector::draw(self, panes.inspector, buf);
             }
@@ -67,7 +65,7 @@ impl Widget for &App {
 /// A pane's frame and title. The pane with the keyboard has a thick yellow border and its
 /// title in black on yellow, so it stands out even in a 16-colour or monochrome terminal
 /// (the border's shape differs, not only its colour).
-fn pane_block(title: Line<'static>, focused: bool) -> Block<'static> {
+pub(crate) fn pane_block(title: Line<'static>, focused: bool) -> Block<'static> {
     if focused {
         Block::bordered()
             .border_type(BorderType::Thick)

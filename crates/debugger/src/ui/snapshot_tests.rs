@@ -188,7 +188,7 @@ fn explained_glass_pixel(width: u16, height: u16) -> App {
     let mut app = rendered_app(width, height);
     pick_glass_pixel(&mut app);
     update(&mut app, Action::ToggleExplain);
-    app.focus = Focus::Inspector;
+    assert_eq!(app.focus, Focus::Inspector, "x gives it the keyboard");
     update(&mut app, Action::InspectorScroll(1));
     app
 }

@@ -1,95 +1,20 @@
-//! How the keys that follow what matters change the [`App`]: `a` (light rays), `p` (the
-//! heaviest child), `[ ] { }` (stepping in the tracer's order), `x` and, in the explanation,
-//! ↑↓ and Enter. Called from [`crate::update::update`]; the tree logic itself is in
-//! `tree_view.rs`, `follow.rs`, `stepping.rs` and `explain_view.rs`.
+//! How `x` and, in the explanation, ↑↓ and Enter change the [`App`]: the explanation in
+//! the inspector's place, its selected entry, and going to an entry's ray or line. Called
+//! from [`crate::update::update`].
 
 use crate::action::Focus;
 use crate::app::App;
-use crate::explain_view::{self, Jump};
-use crate::follow;
-use crate::stepping;
-use crate::tree_view::TreeView;
+use crate::explain::state::{self as explain_view, Jump};
+use crate::tree::update::with_tree;
 
-/// Runs `change` on the picked tree, keeps the selection in view, and resets what follows
-/// the selected ray (the inspector's scroll, a finding's line) when it moved. What `change`
-/// returns is handed back; `None` with a message when no pixel is picked.
-fn with_tree<T>(app: &mut App, change: impl FnOnce(&mut TreeView) -> T) -> Option<T> {
-    let rows = app.tree_rows();
-    let Some(picked) = &mut app.picked else {
-        app.set_message("no ray tree yet: move the cursor and press Enter", false);
-        return None;
-    };
-    let before = picked.tree.selected();
-    let answer = change(&mut picked.tree);
-    picked.tree.keep_selection_in_view(rows);
-    if picked.tree.selected() != before {
-        app.inspector_scroll = 0;
-        app.source_focus = None;
-    }
-    Some(answer)
-}
-
-pub fn toggle_show_all(app: &mut App) {
-    let Some(hidden) = with_tree(app, |tree| {
-        tree.toggle_show_all();
-        tree.light_count()
-    }) else {
-        return;
-    };
-    if hidden == 0 {
-        app.set_message("no ray here counts for under 1% of the pixel", false);
-    }
-}
-
-pub fn follow_heaviest(app: &mut App) {
-    if with_tree(app, follow::follow_heaviest) == Some(None) {
-        app.set_message("the selected ray has no children to follow", false);
-    }
-}
-
-pub fn step(app: &mut App, forward: bool) {
-    let moved = with_tree(app, |tree| stepping::step(tree, forward));
-    if moved == Some(false) {
-        let end = if forward { "last" } else { "first" };
-        app.set_message(format!("this is the {end} ray the tracer traced"), false);
-    }
-}
-
-pub fn run_to_event(app: &mut App, forward: bool) {
-    let Some(found) = with_tree(app, |tree| {
-        let found = stepping::run_to_event(tree, forward)?;
-        let node = tree.node(found.0)?;
-        Some((found, node.kind.name(), node.depth, tree.len()))
-    }) else {
-        return;
-    };
-    match found {
-        Some(((id, events), kind, depth, rays)) => {
-            let names: Vec<&str> = events.iter().map(|e| e.name()).collect();
-            app.set_message(
-                format!(
-                    "{}: {kind} ray, depth {depth} (ray {} of {rays} in trace order)",
-                    names.join(", "),
-                    id + 1
-                ),
-                false,
-            );
-        }
-        None => {
-            let way = if forward { "after" } else { "before" };
-            app.set_message(
-                format!(
-                    "no event {way} this ray (total internal reflection, max depth, \
-                     weight cut-off, blocked shadow ray, self-hit)"
-                ),
-                false,
-            );
-        }
-    }
-}
-
+/// `x`: the explanation in the inspector's place, with the keyboard (as `v` gives it to the
+/// 3D view), so that the keys that follow (`z`, ↑↓, Enter) act on what was just opened and
+/// not on the pane that had the focus before; `x` again brings the inspector back.
 pub fn toggle_explain(app: &mut App) {
     app.explain_open = !app.explain_open;
+    if app.explain_open {
+        app.focus = Focus::Inspector;
+    }
     if app.explain_open && app.picked.is_none() {
         app.set_message("pick a pixel (Enter) to explain it", false);
     }
@@ -225,7 +150,7 @@ mod tests {
         let mut app = picked_app();
         update(&mut app, Action::ToggleExplain);
         assert!(app.explain_open);
-        app.focus = Focus::Inspector;
+        assert_eq!(app.focus, Focus::Inspector, "x gives it the keyboard");
         let picked = app.picked.as_ref().unwrap();
         let explanation = picked.explanation.ready().unwrap().clone();
         // The second contribution (the first is usually the camera ray's own light).
@@ -263,41 +188,5 @@ mod tests {
             app.explain_selected,
             explanation.contributions.len() + explanation.findings.len() - 1
         );
-    }
-
-    #[test]
-    fn follow_keys_without_a_tree_say_how_to_get_one() {
-        let mut app = App::new(
-            "scenes/whitted.scene".into(),
-            LoadedScene::new(whitted_scene()),
-            Rect::new(0, 0, 120, 40),
-            "/tmp/out".into(),
-        );
-        for action in [
-            Action::ToggleShowAll,
-            Action::FollowHeaviest,
-            Action::Step { forward: true },
-            Action::RunToEvent { forward: false },
-        ] {
-            update(&mut app, action);
-            assert!(app.message.as_ref().unwrap().text.contains("Enter"));
-        }
-    }
-
-    #[test]
-    fn run_to_event_says_what_it_found() {
-        let mut app = picked_app();
-        update(&mut app, Action::RunToEvent { forward: true });
-        let text = &app.message.as_ref().unwrap().text;
-        assert!(text.contains("in trace order"), "{text}");
-        assert_ne!(app.picked.as_ref().unwrap().tree.selected(), 0);
-        update(&mut app, Action::RunToEvent { forward: false });
-        update(&mut app, Action::RunToEvent { forward: false });
-        assert!(app
-            .message
-            .as_ref()
-            .unwrap()
-            .text
-            .contains("no event before"));
     }
 }

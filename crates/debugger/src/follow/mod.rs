@@ -1,7 +1,10 @@
 //! `p`: following the path that matters down the picked pixel's tree, one heaviest child at
-//! a time.
+//! a time. What all the keys that follow what matters (`a`, `p`, `[ ] { }`, `x`) do to the
+//! [`App`](crate::app::App) is in [`update`].
 
-use crate::tree_view::{NodeId, TreeView};
+pub(crate) mod update;
+
+use crate::tree::state::{NodeId, TreeView};
 
 /// The child of `id` that brings the most to the pixel ([`TreeView::contribution`], summed
 /// over the channels); the first of equals. `None` for a ray without children.

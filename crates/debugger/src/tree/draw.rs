@@ -14,10 +14,10 @@ use crate::action::Focus;
 use crate::app::App;
 use crate::image_view::ColorDepth;
 use crate::stepping;
-use crate::tree_view::{NodeId, TreeView};
+use crate::tree::state::{NodeId, TreeView};
 
-use super::format::{self, swatch};
-use super::pane_block;
+use crate::ui::format::{self, swatch};
+use crate::ui::pane_block;
 
 pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let focused = app.focus == Focus::Tree;
@@ -45,16 +45,19 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     if area.is_empty() {
         return;
     }
-    header_line(usize::from(area.width)).render(Rect { height: 1, ..area }, buf);
+    let width = usize::from(area.width);
     let visible = tree.visible();
-    let rows = visible
+    let shown: Vec<NodeId> = visible
         .iter()
+        .copied()
         .skip(tree.scroll())
-        .take(usize::from(area.height - 1));
+        .take(usize::from(area.height - 1))
+        .collect();
+    let columns = Columns::fit(tree, &shown, width);
+    header_line(&columns, width).render(Rect { height: 1, ..area }, buf);
     let matches = app.search.as_ref().map_or(&[][..], |s| &s.matches[..]);
-    let numbers = shows_numbers(usize::from(area.width));
-    for (row, &id) in rows.enumerate() {
-        let line = row_line(app, tree, id, usize::from(area.width), numbers);
+    for (row, &id) in shown.iter().enumerate() {
+        let line = row_line(app, tree, id, width, &columns);
         let selected = id == tree.selected();
         let style = match (selected, focused) {
             (true, true) => Style::new().add_modifier(Modifier::REVERSED),
@@ -69,33 +72,132 @@ pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     }
 }
 
-/// The width of the numbers after a row's swatch: ` 0.19 0.29 0.69`.
-const NUMBERS_WIDTH: usize = 15;
+/// The kind column: as wide as the longest kind, `transmitted`.
+const KIND_WIDTH: usize = 11;
 
-/// The width of a camera ray's head (marker, kind, depth): `▼ camera      d0 `.
-const HEAD_WIDTH: usize = 2 + 11 + 4;
+/// The share column: its header, over a swatch as wide.
+const SHARE: &str = "share";
+const SHARE_WIDTH: usize = SHARE.len();
 
-/// Whether a pane `width` columns wide shows the numbers after the swatches: when a camera
-/// ray's row keeps 8 columns for what it met. The choice is the same for every row, so that
-/// the numbers stay under their header (deeper rows cut what they met first).
-fn shows_numbers(width: usize) -> bool {
-    width >= HEAD_WIDTH + 8 + 3 + NUMBERS_WIDTH
+/// What a row keeps for what it met at the least (a character and `…`) before a column on
+/// its right goes.
+const MIN_MET: usize = 2;
+
+const CHANNELS: [&str; 3] = ["r", "g", "b"];
+
+/// The columns of the rows on screen, fitted to the pane. A number is never cut: a column
+/// that does not fit on every row goes, b first, then g, r and last the swatch; and rows
+/// deeper than the pane can indent are drawn at the deepest indentation that still leaves
+/// their depth and swatch whole (the depth column says how deep they are).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Columns {
+    /// The widest depth (`d12`) on screen: depths are padded to it.
+    depth_width: usize,
+    /// The deepest indentation, in levels.
+    max_level: usize,
+    share: bool,
+    /// How many of r, g and b show.
+    channels: usize,
+    /// The widest number on screen (`0.19`, `12.50`): numbers are right-aligned in it.
+    number_width: usize,
 }
 
-/// The column header: the ray's kind and depth, what it met, and its share of the pixel
-/// (over the swatch and, when they show, r g b over the numbers). In a narrow pane "what it
-/// met" is cut, never the share's header.
-fn header_line(width: usize) -> Line<'static> {
-    // Over a camera ray's head (marker, kind, depth "d0"): the kind and "d" for depth.
-    let head = format!("  {:<11} {:<3}", "ray", "d");
-    let right = if shows_numbers(width) {
-        "share r    g    b"
-    } else {
-        "share"
-    };
-    let left_width = width.saturating_sub(right.len() + 1);
+impl Columns {
+    fn fit(tree: &TreeView, shown: &[NodeId], width: usize) -> Columns {
+        let depth_width = shown
+            .iter()
+            .filter_map(|&id| tree.node(id))
+            .map(|node| format!("d{}", node.depth).len())
+            .max()
+            .unwrap_or(2);
+        let number_width = shown
+            .iter()
+            .flat_map(|&id| tree.contribution(id))
+            .map(|value| channel(value).chars().count())
+            .max()
+            .unwrap_or(4);
+        let shallowest = head_width(0, depth_width);
+        let share = shallowest + MIN_MET + 1 + SHARE_WIDTH <= width;
+        let tail = if share { 1 + SHARE_WIDTH } else { 0 };
+        let max_level = width.saturating_sub(shallowest + MIN_MET + tail) / 2;
+        let deepest = shown
+            .iter()
+            .map(|&id| tree.level(id).min(max_level))
+            .max()
+            .unwrap_or(0);
+        let room = width.saturating_sub(head_width(deepest, depth_width) + MIN_MET + tail);
+        let channels = if share {
+            (room / (1 + number_width)).min(CHANNELS.len())
+        } else {
+            0
+        };
+        Columns {
+            depth_width,
+            max_level,
+            share,
+            channels,
+            number_width,
+        }
+    }
+
+    /// The width of everything right of what the ray met.
+    fn tail(&self) -> usize {
+        if self.share {
+            1 + SHARE_WIDTH + self.channels * (1 + self.number_width)
+        } else {
+            0
+        }
+    }
+
+    /// The share column and the numbers: ` share    r    g    b` over ` █████ 0.19 0.29 0.69`.
+    fn tail_spans(&self, contribution: [f32; 3], depth: ColorDepth) -> Vec<Span<'static>> {
+        if !self.share {
+            return Vec::new();
+        }
+        // The swatch fills the column under its header, so that no cell is wasted.
+        let mut spans = vec![
+            Span::raw(" "),
+            Span::styled(
+                "█".repeat(SHARE_WIDTH),
+                Style::new().fg(format::terminal_color(contribution, depth)),
+            ),
+        ];
+        for value in contribution.into_iter().take(self.channels) {
+            let width = self.number_width;
+            spans.push(Span::raw(format!(" {:>width$}", channel(value))));
+        }
+        spans
+    }
+}
+
+/// A colour channel in the tree: two decimals.
+fn channel(value: f32) -> String {
+    format!("{value:.2}")
+}
+
+/// The width of a row's head at an indentation `level`: indentation, marker, kind, depth.
+fn head_width(level: usize, depth_width: usize) -> usize {
+    2 * level + 2 + KIND_WIDTH + 1 + depth_width + 1
+}
+
+/// The column header, each name over its column: over the head of a camera ray (marker,
+/// kind, depth) the kind and `d` for depth, then what it met, and right of it the share over
+/// the swatches and r g b over their numbers, as many as the rows show. In a narrow pane
+/// "what it met" is cut, never the share's header.
+fn header_line(columns: &Columns, width: usize) -> Line<'static> {
+    let depth_width = columns.depth_width;
+    let head = format!("  {:<KIND_WIDTH$} {:<depth_width$} ", "ray", "d");
+    let mut right = String::new();
+    if columns.share {
+        right.push_str(&format!(" {SHARE}"));
+        for name in CHANNELS.iter().take(columns.channels) {
+            let number_width = columns.number_width;
+            right.push_str(&format!(" {name:>number_width$}"));
+        }
+    }
+    let left_width = width.saturating_sub(right.chars().count());
     let left = format::truncate(&format!("{head}what it met"), left_width);
-    let text = format::truncate(&format!("{left:<left_width$} {right}"), width);
+    let text = format::truncate(&format!("{left:<left_width$}{right}"), width);
     Line::from(Span::styled(
         text,
         Style::new()
@@ -104,31 +206,31 @@ fn header_line(width: usize) -> Line<'static> {
     ))
 }
 
-/// One ray's row, fitted to `width` columns: the label is cut first, the numbers only
-/// when the pane is very narrow.
+/// One ray's row, fitted to `width` columns: what it met is cut, never a number.
 fn row_line(
     app: &App,
     tree: &TreeView,
     id: NodeId,
     width: usize,
-    show_numbers: bool,
+    columns: &Columns,
 ) -> Line<'static> {
     let Some(node) = tree.node(id) else {
         return Line::default();
     };
-    let indent = "  ".repeat(tree.level(id));
+    let level = tree.level(id).min(columns.max_level);
+    let indent = "  ".repeat(level);
     let marker = match (tree.has_children(id), tree.is_open(id)) {
         (false, _) => "  ",
         (true, true) => "▼ ",
         (true, false) => "▶ ",
     };
-    let head = format!("{indent}{marker}{:<11} d{} ", node.kind.name(), node.depth);
-    let contribution = tree.contribution(id);
-    let [r, g, b] = contribution;
-    let numbers = format!(" {r:.2} {g:.2} {b:.2}");
-    let head_width = head.chars().count();
-    let tail = 3 + if show_numbers { numbers.len() } else { 0 };
-    let label_width = width.saturating_sub(head_width + tail);
+    let depth_width = columns.depth_width;
+    let head = format!(
+        "{indent}{marker}{:<KIND_WIDTH$} {:<depth_width$} ",
+        node.kind.name(),
+        format!("d{}", node.depth)
+    );
+    let label_width = width.saturating_sub(head_width(level, depth_width) + columns.tail());
     let mut description = describe(node);
     if node.kind == RayKind::Camera && tree.tree().samples.len() > 1 {
         if let Some(sample) = tree.sample(id) {
@@ -145,15 +247,8 @@ fn row_line(
         RayKind::Transmitted => Color::LightGreen,
         RayKind::Shadow => Color::Gray,
     });
-    let mut spans = vec![
-        Span::styled(head, kind_style),
-        Span::raw(label),
-        Span::raw(" "),
-        swatch(contribution, app.color_depth),
-    ];
-    if show_numbers {
-        spans.push(Span::raw(numbers));
-    }
+    let mut spans = vec![Span::styled(head, kind_style), Span::raw(label)];
+    spans.extend(columns.tail_spans(tree.contribution(id), app.color_depth));
     Line::from(spans)
 }
 

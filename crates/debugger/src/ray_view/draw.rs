@@ -12,11 +12,11 @@ use whitted_tracer::display::linear_to_srgb8_rgb;
 
 use crate::app::{App, Picked};
 use crate::image_view::ColorDepth;
-use crate::ray_view::{segments, SegmentKind, ViewProjection};
-use crate::ray_view_state::{Backdrop, RayViewState};
+use crate::ray_view::geometry::{segments, SegmentKind, ViewProjection};
+use crate::ray_view::state::{Backdrop, RayViewState};
 
-use super::braille::BrailleCanvas;
-use super::pane_block;
+use crate::ui::braille::BrailleCanvas;
+use crate::ui::pane_block;
 
 const CAMERA: [u8; 3] = [255, 255, 255];
 const REFLECTED: [u8; 3] = [0, 230, 255];

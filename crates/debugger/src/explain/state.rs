@@ -7,7 +7,7 @@ use whitted_explain::{Contribution, Explanation, Finding, Term};
 use whitted_ir::{SourceMap, Span};
 use whitted_tracer::RayKind;
 
-use crate::tree_view::{NodeId, TreeView};
+use crate::tree::state::{NodeId, TreeView};
 
 /// One selectable line of the pane.
 #[derive(Clone, Copy, Debug, PartialEq)]

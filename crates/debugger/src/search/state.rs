@@ -4,7 +4,7 @@
 
 use whitted_tracer::ray_tree::RayNode;
 
-use crate::tree_view::{NodeId, TreeView};
+use crate::tree::state::{NodeId, TreeView};
 
 /// A submitted search: the query, its matches in pre-order, and the one shown.
 #[derive(Clone, Debug, PartialEq, Eq)]

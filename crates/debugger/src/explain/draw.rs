@@ -1,7 +1,7 @@
 //! The explanation pane (`x`, in the inspector's place): why the picked pixel has its
 //! colour, from the explain library: each main contribution with its share and swatch, then
 //! each finding with its `file:line:col` and message. The selected entry is highlighted;
-//! Enter goes to its ray or line (`follow_update.rs`).
+//! Enter goes to its ray or line (`update.rs`).
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
@@ -13,11 +13,11 @@ use whitted_explain::{describe_term, Explanation};
 
 use crate::action::Focus;
 use crate::app::{App, ExplanationState};
-use crate::explain_view::{entries, Entry};
+use crate::explain::state::{entries, Entry};
 use crate::image_view::ColorDepth;
 
-use super::format::{self, swatch, wrap_words};
-use super::pane_block;
+use crate::ui::format::{self, swatch, wrap_words};
+use crate::ui::pane_block;
 
 pub fn draw(app: &App, pane: Rect, buf: &mut Buffer) {
     let focused = app.focus == Focus::Inspector;

@@ -14,7 +14,7 @@ use whitted_tracer::{render_from, PreparedScene, RenderObserver, RenderOptions, 
 
 use crate::app::LoadedScene;
 use crate::event::Event;
-use crate::orbit::OrbitCamera;
+use crate::ray_view::orbit::OrbitCamera;
 
 /// What a backdrop shows: the scene, the camera and the size in pixels. A backdrop is
 /// current when its key matches the view's.

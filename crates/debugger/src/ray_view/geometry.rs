@@ -9,7 +9,7 @@ use whitted_ir::{Camera, DVec3, Projection};
 use whitted_tracer::ray_tree::{RayTree, ShadowOutcome};
 use whitted_tracer::RayKind;
 
-use crate::tree_view::NodeId;
+use crate::tree::state::NodeId;
 
 /// What a segment is, for its colour.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -26,7 +26,7 @@ pub enum SegmentKind {
 /// One recorded ray as a line in the world.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Segment {
-    /// The node of the tree this is (numbered like [`crate::tree_view::TreeView`]).
+    /// The node of the tree this is (numbered like [`crate::tree::state::TreeView`]).
     pub node: NodeId,
     pub kind: SegmentKind,
     pub from: DVec3,
@@ -240,7 +240,7 @@ pub fn clip_to_rect(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::orbit::OrbitCamera;
+    use crate::ray_view::orbit::OrbitCamera;
 
     fn camera() -> Camera {
         Camera {
