@@ -23,7 +23,7 @@ use crate::ray_view::state::{BackdropJob, BackdropRendered, RayViewState};
 use crate::search::state::Search;
 use crate::trace_job::{Explained, TraceFailure, TraceJob, Traced};
 use crate::tree::state::TreeView;
-use crate::what_if_state::WhatIf;
+use crate::what_if::state::WhatIf;
 
 /// A scene ready to render and trace: the IR (names, spans, sources) and its prepared form.
 #[derive(Clone)]

@@ -37,7 +37,7 @@ pub enum Event {
     /// A backdrop of the 3D ray view, rendered off the UI thread (or cancelled).
     Backdrop(crate::ray_view::state::BackdropRendered),
     /// A what-if re-trace's answer (the popup's `w`).
-    WhatIfTraced(crate::what_if_state::WhatIfTraced),
+    WhatIfTraced(crate::what_if::state::WhatIfTraced),
     /// A query's progress or answer (`:`).
     Query(crate::query_job::QueryNews),
     /// A watched scene file changed on disk.

@@ -35,8 +35,6 @@ pub mod ui;
 pub mod update;
 mod watch;
 pub mod what_if;
-pub mod what_if_state;
-pub mod write_back;
 
 #[cfg(test)]
 mod test_provenance_scene;

@@ -14,7 +14,7 @@ use crate::image_view::Viewport;
 use crate::layout;
 use crate::line_input::{InputOutcome, LineInput};
 use crate::search;
-use crate::what_if_state::WhatIf;
+use crate::what_if::state::WhatIf;
 
 /// Applies one action; returns what the event loop must do about it.
 pub fn update(app: &mut App, action: Action) -> Vec<Effect> {

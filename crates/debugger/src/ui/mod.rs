@@ -12,7 +12,6 @@ mod inspector;
 mod snapshot_tests;
 pub(crate) mod source_pane;
 mod status;
-mod what_if_popup;
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::{Alignment, Rect};
@@ -54,7 +53,7 @@ impl Widget for &App {
         }
         status::draw(self, panes.status, buf);
         if let Some(what_if) = &self.what_if {
-            what_if_popup::draw(what_if, self.color_depth, area, buf);
+            crate::what_if::draw::draw(what_if, self.color_depth, area, buf);
         }
         if self.help_open {
             help::draw(area, self.help_scroll, buf);

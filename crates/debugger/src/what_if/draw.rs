@@ -10,16 +10,16 @@ use ratatui::widgets::{Block, Clear, Paragraph, Widget};
 use whitted_explain::diff::{Change, RayChange};
 
 use crate::image_view::ColorDepth;
-use crate::what_if_state::WhatIf;
+use crate::what_if::state::WhatIf;
 
-use super::format::{number, rgb, swatch, wrap_words};
+use crate::ui::format::{number, rgb, swatch, wrap_words};
 
 const KEY_STYLE: Style = Style::new().fg(Color::Yellow);
 
 pub fn draw(what_if: &WhatIf, depth: ColorDepth, area: Rect, buf: &mut Buffer) {
     let width = area.width.saturating_sub(4).min(100);
     let height = area.height.saturating_sub(2);
-    let popup = super::format::centered(area, width, height);
+    let popup = crate::ui::format::centered(area, width, height);
     Clear.render(popup, buf);
     let (x, y) = what_if.pixel;
     let block = Block::bordered()
@@ -40,7 +40,7 @@ pub fn draw(what_if: &WhatIf, depth: ColorDepth, area: Rect, buf: &mut Buffer) {
         );
     let inner = block.inner(popup);
     block.render(popup, buf);
-    let inner = super::format::left_padded(inner);
+    let inner = crate::ui::format::left_padded(inner);
     let lines = lines(what_if, depth, inner.width, usize::from(inner.height));
     Paragraph::new(lines).render(inner, buf);
 }
