@@ -3,8 +3,8 @@
 //! strings fool), a default is added to its block or a new `settings` block, and the edited
 //! text compiles to the changed value (the oracle: the compiler, not the edit's own idea).
 
-use whitted_debugger::what_if::Param;
 use whitted_debugger::what_if::write_back::{write_back, WriteBack};
+use whitted_debugger::what_if::Param;
 use whitted_ir::properties::{material_color, IOR};
 use whitted_ir::setting_rows::{MAX_DEPTH, MIN_WEIGHT};
 use whitted_ir::{Color, Handle, Material, Scene};

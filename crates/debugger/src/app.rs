@@ -15,7 +15,7 @@ use whitted_tracer::{PixelStats, PreparedScene, RenderOptions, RenderStats, Tile
 use crate::action::Focus;
 use crate::framebuffer::Framebuffer;
 use crate::heat_map::{HeatMap, HeatMapKind};
-use crate::image_view::{ColorDepth, Viewport};
+use crate::image::{ColorDepth, Viewport};
 use crate::layout::{self, Arrangement, Panes};
 use crate::line_input::LineInput;
 use crate::query_job::QueryState;

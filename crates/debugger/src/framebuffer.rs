@@ -7,7 +7,7 @@
 use whitted_tracer::display::linear_to_srgb8_rgb;
 use whitted_tracer::TileResult;
 
-use crate::image_view::PixelSource;
+use crate::image::PixelSource;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Framebuffer {

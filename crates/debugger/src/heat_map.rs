@@ -4,7 +4,7 @@
 use whitted_tracer::display::heat_color;
 use whitted_tracer::PixelStats;
 
-use crate::image_view::PixelSource;
+use crate::image::PixelSource;
 
 /// Which statistic an overlay shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

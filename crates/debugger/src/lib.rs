@@ -15,7 +15,7 @@ pub mod follow;
 pub mod framebuffer;
 pub mod heat_map;
 pub mod hit_point;
-pub mod image_view;
+pub mod image;
 pub mod layout;
 pub mod line_input;
 pub mod palette;

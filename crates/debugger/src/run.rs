@@ -15,7 +15,7 @@ use ratatui::layout::Rect;
 use crate::action::{action_for_key, action_for_mouse, Action};
 use crate::app::{App, Effect, LoadedScene};
 use crate::event::Event;
-use crate::image_view::ColorDepth;
+use crate::image::ColorDepth;
 use crate::reload::Reloader;
 use crate::render_job::RenderJob;
 use crate::session::Session;

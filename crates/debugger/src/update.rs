@@ -10,7 +10,7 @@ use whitted_ir::Handle;
 use crate::action::{Action, Focus};
 use crate::app::{App, Effect, SourceScroll, SourceTarget, View};
 use crate::follow::update as follow_update;
-use crate::image_view::Viewport;
+use crate::image::Viewport;
 use crate::layout;
 use crate::line_input::{InputOutcome, LineInput};
 use crate::search;

@@ -14,7 +14,7 @@ use whitted_explain::{describe_term, Explanation};
 use crate::action::Focus;
 use crate::app::{App, ExplanationState};
 use crate::explain::state::{entries, Entry};
-use crate::image_view::ColorDepth;
+use crate::image::ColorDepth;
 
 use crate::ui::format::{self, swatch, wrap_words};
 use crate::ui::pane_block;

@@ -11,7 +11,7 @@ use whitted_ir::LightKind;
 use whitted_tracer::display::linear_to_srgb8_rgb;
 
 use crate::app::{App, Picked};
-use crate::image_view::ColorDepth;
+use crate::image::ColorDepth;
 use crate::ray_view::geometry::{segments, SegmentKind, ViewProjection};
 use crate::ray_view::state::{Backdrop, RayViewState};
 

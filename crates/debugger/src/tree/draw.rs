@@ -12,7 +12,7 @@ use whitted_tracer::{RayKind, Termination};
 
 use crate::action::Focus;
 use crate::app::App;
-use crate::image_view::ColorDepth;
+use crate::image::ColorDepth;
 use crate::stepping;
 use crate::tree::state::{NodeId, TreeView};
 

@@ -4,7 +4,7 @@
 use ratatui::style::{Color, Style};
 use ratatui::text::Span;
 
-use crate::image_view::ColorDepth;
+use crate::image::ColorDepth;
 use whitted_tracer::display::linear_to_srgb8_rgb;
 
 /// A number with three decimals; very large or small magnitudes in scientific notation so

@@ -19,7 +19,7 @@ use whitted_tracer::{RayKind, Termination};
 use crate::action::Focus;
 use crate::app::App;
 use crate::hit_point::hit_point_view;
-use crate::image_view::ColorDepth;
+use crate::image::ColorDepth;
 use crate::tree::state::{NodeId, TreeView};
 
 use super::format::{self, number, swatch, vector};

@@ -6,12 +6,12 @@ pub(crate) mod braille;
 mod errors_pane;
 pub mod format;
 mod help;
-mod image_pane;
+
 mod inspector;
 #[cfg(test)]
 mod snapshot_tests;
 pub(crate) mod source_pane;
-mod status;
+pub(crate) mod status;
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::{Alignment, Rect};
@@ -32,7 +32,7 @@ impl Widget for &App {
         if !panes.image.is_empty() {
             match &self.ray_view {
                 Some(view) => crate::ray_view::draw::draw(self, view, panes.image, buf),
-                None => image_pane::draw(self, panes.image, buf),
+                None => crate::image::draw::draw(self, panes.image, buf),
             }
         }
         if !panes.tree.is_empty() {

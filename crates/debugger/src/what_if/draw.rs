@@ -9,7 +9,7 @@ use ratatui::text::{Line, Span};
 use ratatui::widgets::{Block, Clear, Paragraph, Widget};
 use whitted_explain::diff::{Change, RayChange};
 
-use crate::image_view::ColorDepth;
+use crate::image::ColorDepth;
 use crate::what_if::state::WhatIf;
 
 use crate::ui::format::{number, rgb, swatch, wrap_words};

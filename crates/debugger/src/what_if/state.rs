@@ -20,8 +20,8 @@ use crate::event::Event;
 use crate::line_input::{InputOutcome, LineInput};
 use crate::terminal::{panic_text, take_worker_panic};
 use crate::trace_job::{TraceFailure, TraceJob, Traced};
-use crate::what_if::{params, value_text, Owner, Param, Value};
 use crate::what_if::write_back::{write_back, WriteBack};
+use crate::what_if::{params, value_text, Owner, Param, Value};
 
 /// The popup, open on one picked pixel.
 pub struct WhatIf {

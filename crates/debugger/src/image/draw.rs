@@ -9,12 +9,12 @@ use ratatui::widgets::Widget;
 
 use crate::app::{App, RenderState, View};
 use crate::hit_point::{hit_point_view, HitPointView};
-use crate::image_view::{draw_image, PixelSource, Viewport};
+use crate::image::{draw_image, PixelSource, Viewport};
 use crate::layout::inner;
 
-use super::pane_block;
-use super::status::QUERY_COLOR;
 use crate::query_job::QueryOverlay;
+use crate::ui::pane_block;
+use crate::ui::status::QUERY_COLOR;
 
 const CURSOR_COLOR: Color = Color::Rgb(255, 0, 255);
 const HIT_POINT_COLOR: Color = Color::Rgb(0, 255, 128);
