@@ -242,6 +242,8 @@ pub struct DebugArgs {
     /// A pixel to trace at start: X,Y counted from the top-left corner (0,0).
     #[arg(long, value_name = "X,Y", value_parser = parse_pixel, allow_hyphen_values = true)]
     pub pixel: Option<[u32; 2]>,
+    #[command(flatten)]
+    pub overrides: RenderOverrides,
 }
 
 fn parse_pixel(text: &str) -> Result<[u32; 2], String> {

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use whitted_debugger::{Compiled, DebugError, Recompile, Session};
 use whitted_ir::SourceMap;
 
-use crate::cli::{DebugArgs, SceneArgs};
+use crate::cli::{DebugArgs, RenderOverrides, SceneArgs};
 use crate::scene_input::load_scene;
 use crate::Failure;
 
@@ -15,8 +15,10 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
     // The first compile prints its diagnostics like every other command; a scene with
     // errors stops here, before the terminal is taken over.
     let loaded = load_scene(&args.scene, false)?;
+    // At the size and depth of the render it follows (`--width`, `--max-depth`, ...), so
+    // that a pixel a lint or `render` names is the same pixel here.
+    let (loaded, _) = crate::setting_flags::apply_render_flags(loaded, &args.overrides)?;
     let settings = &loaded.scene.settings;
-    crate::render_cmd::check_image_size(settings.width, settings.height)?;
     if let Some([x, y]) = args.pixel {
         if x >= settings.width || y >= settings.height {
             return Err(crate::request::pixel_outside(
@@ -32,7 +34,8 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
         Some(loaded.scene.scene()),
     );
     let scene_args = args.scene.clone();
-    let recompile: Recompile = Box::new(move || compile(&scene_args));
+    let overrides = args.overrides.clone();
+    let recompile: Recompile = Box::new(move || compile(&scene_args, &overrides));
     let session = Session {
         scene_name: args.scene.scene.display().to_string(),
         scene: loaded.scene,
@@ -60,8 +63,21 @@ fn export_dir(scene: &Path) -> PathBuf {
 
 /// Compiles the scene again (with the front end its content calls for, and the same `-D`
 /// and `--set` as the first compile), silently: the debugger shows the diagnostics itself.
-fn compile(args: &SceneArgs) -> Compiled {
-    let compilation = crate::front_end::compile(args, &whitted_mit6837::CourseOptions::default());
+fn compile(args: &SceneArgs, overrides: &RenderOverrides) -> Compiled {
+    let mut compilation =
+        crate::front_end::compile(args, &whitted_mit6837::CourseOptions::default());
+    if let Some(scene) = compilation.scene.take() {
+        match crate::setting_flags::apply_to_scene(scene, overrides) {
+            Ok(scene) => compilation.scene = Some(scene),
+            Err(failure) => compilation.diagnostics.push(whitted_ir::Diagnostic::new(
+                whitted_ir::Severity::Error,
+                failure
+                    .message()
+                    .unwrap_or("the command line's settings do not fit"),
+                None,
+            )),
+        }
+    }
     let watch = watch_list(
         &args.scene,
         &compilation.sources,

@@ -129,8 +129,8 @@ pub fn compile(args: &SceneArgs, course: &CourseOptions) -> Compiled {
             compiled.sources = scene.sources.clone();
             compiled.scene = Some(scene);
         }
-        Err((scene, diagnostics)) => {
-            compiled.sources = scene.sources;
+        Err((sources, diagnostics)) => {
+            compiled.sources = sources;
             compiled.diagnostics.extend(diagnostics);
         }
     }

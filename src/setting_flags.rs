@@ -9,7 +9,8 @@
 
 use whitted_ir::setting_rows::{self, SettingRow, SettingValue};
 use whitted_ir::{
-    BlockKind, Diagnostic, Scene, SourceFile, Span, ValidScene, WrittenBlock, WrittenProperty,
+    BlockKind, Diagnostic, Scene, SourceFile, SourceMap, Span, ValidScene, WrittenBlock,
+    WrittenProperty,
 };
 use whitted_tracer::RenderOptions;
 
@@ -32,7 +33,28 @@ pub fn apply_render_flags(
     loaded: Loaded,
     overrides: &RenderOverrides,
 ) -> Result<(Loaded, RenderOptions), Failure> {
-    let settings = &loaded.scene.settings;
+    let Loaded {
+        scene,
+        warnings,
+        warned_at,
+    } = loaded;
+    let scene = apply_to_scene(scene, overrides)?;
+    let options = RenderOptions::from_settings(&scene.settings);
+    let loaded = Loaded {
+        scene,
+        warnings,
+        warned_at,
+    };
+    Ok((loaded, options))
+}
+
+/// Applies the render flags to `scene`'s settings (the debugger does it again at each
+/// reload, so that the scene keeps the size it was opened at).
+pub fn apply_to_scene(
+    scene: ValidScene,
+    overrides: &RenderOverrides,
+) -> Result<ValidScene, Failure> {
+    let settings = &scene.settings;
     let (width, height) = image_size(
         (settings.width, settings.height),
         overrides.width,
@@ -75,25 +97,12 @@ pub fn apply_render_flags(
             });
         }
     }
-    let loaded = if assignments.is_empty() {
-        loaded
-    } else {
-        let Loaded {
-            scene,
-            warnings,
-            warned_at,
-        } = loaded;
-        let scene = assign(scene.into_inner(), assignments).map_err(|message| {
-            Failure::Usage(format!("the command line's settings do not fit: {message}"))
-        })?;
-        Loaded {
-            scene,
-            warnings,
-            warned_at,
-        }
-    };
-    let options = RenderOptions::from_settings(&loaded.scene.settings);
-    Ok((loaded, options))
+    if assignments.is_empty() {
+        return Ok(scene);
+    }
+    assign(scene.into_inner(), assignments).map_err(|message| {
+        Failure::Usage(format!("the command line's settings do not fit: {message}"))
+    })
 }
 
 /// Writes `assignments` into the scene's settings and its table of written settings, then
@@ -151,11 +160,11 @@ fn record(scene: &mut Scene, name: &'static str, flag: Span, value: Span) {
 /// `--set NAME=VALUE` for a 6.837 scene: each read by its row's plain-value reader (a
 /// number, a word, a grey or `rgb(r, g, b)`) and applied to the scene's settings. Returns
 /// the diagnostics, located in the `--set` pseudo-files (which `load_scene` turns into a
-/// command-line error); the scene is unchanged when there are any.
+/// command-line error), with the sources they point into.
 pub fn apply_course_sets(
     scene: ValidScene,
     sets: &[(String, String)],
-) -> Result<ValidScene, (Scene, Vec<Diagnostic>)> {
+) -> Result<ValidScene, (SourceMap, Vec<Diagnostic>)> {
     let mut scene = scene.into_inner();
     let mut diagnostics = Vec::new();
     let mut settings = scene.settings.clone();
@@ -193,7 +202,7 @@ pub fn apply_course_sets(
         }
     }
     if !diagnostics.is_empty() {
-        return Err((scene, diagnostics));
+        return Err((scene.sources, diagnostics));
     }
     scene.settings = settings;
     for (name, name_span, value_span) in recorded {
@@ -212,7 +221,7 @@ pub fn apply_course_sets(
     }
     whitted_ir::validate(scene).map_err(|invalid| {
         let invalid = *invalid;
-        (invalid.scene, invalid.diagnostics)
+        (invalid.scene.sources, invalid.diagnostics)
     })
 }
 

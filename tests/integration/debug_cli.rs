@@ -40,6 +40,19 @@ fn a_pixel_outside_the_image_is_an_error() {
     );
 }
 
+/// `debug` takes the render's size flags, so a pixel named for a render at `--width 100`
+/// (by a lint, or `render`'s report) is the same pixel in the debugger.
+#[test]
+fn the_debugger_opens_at_the_size_the_flags_give() {
+    let output = debug(&["scenes/whitted.scene", "--width", "100", "--pixel", "150,10"]);
+    assert_eq!(output.status.code(), Some(2));
+    assert!(
+        stderr(&output).contains("`--pixel 150,10` is outside the 100x75 image"),
+        "{}",
+        stderr(&output)
+    );
+}
+
 #[test]
 fn a_scene_with_errors_prints_them_and_never_starts() {
     let dir = tempfile::tempdir().expect("a temporary directory");
