@@ -285,3 +285,70 @@ fn every_course_scene_checks() {
     }
     assert!(count >= 6, "{count} scenes");
 }
+
+/// The course adds `reflectiveColor·trace + transparentColor·trace` as given: a thin mirror
+/// that is also 95% transparent (ior 1), black itself, over a grey background of 0.2, is
+/// `0.5·0.2 + 0.95·0.2 = 0.29` in linear light: 73.95 → 74 of 255 in the course's linear
+/// 8-bit image. whitted's own language would scale 0.5 and 0.95 down to add up to 1 (0.2,
+/// 51 of 255). `whitted mit6837` says so once, as a warning.
+#[test]
+fn reflective_and_transparent_are_added_as_given() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let scene = dir.path().join("bright.txt");
+    std::fs::write(
+        &scene,
+        "OrthographicCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 size 2 }\n\
+         Background { color 0.2 0.2 0.2 ambientLight 0 0 0 }\n\
+         Materials { numMaterials 1\n\
+           PhongMaterial { diffuseColor 0 0 0 reflectiveColor 0.5 0.5 0.5\n\
+             transparentColor 0.95 0.95 0.95 indexOfRefraction 1 } }\n\
+         Group { numObjects 1 MaterialIndex 0 Triangle { vertex0 -5 -5 0 vertex1 5 -5 0 vertex2 0 5 0 } }\n",
+    )
+    .expect("writable");
+    let image = path_in(dir.path(), "bright.tga");
+    let output = whitted(&[
+        "mit6837",
+        "-input",
+        &scene.to_string_lossy(),
+        "-size",
+        "4",
+        "4",
+        "-bounces",
+        "1",
+        "-output",
+        &image,
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let (width, _, rgb) = read_tga(&image);
+    assert_eq!(pixel(&rgb, width, 2, 2), [74, 74, 74]);
+    let said = stderr(&output);
+    assert_eq!(said.matches("more than 1").count(), 1, "{said}");
+    assert!(said.contains("as given"), "{said}");
+
+    // The same material in whitted's language, where the default scales it down.
+    let own = dir.path().join("bright.scene");
+    std::fs::write(
+        &own,
+        "settings { width 4 height 4 max_depth 1 background 0.2 ambient 0 }\n\
+         camera orthographic { eye <0, 0, 10> look_at <0, 0, 0> height 2 }\n\
+         material m { diffuse 0 reflective 0.5 transmissive 0.95 ior 1 }\n\
+         triangle { vertices <-5, -5, 0>, <5, -5, 0>, <0, 5, 0> material m }\n",
+    )
+    .expect("writable");
+    let trace = |extra: &[&str]| {
+        let mut args = vec![
+            "trace",
+            own.to_str().expect("UTF-8"),
+            "--pixel",
+            "2,2",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let output = whitted(&args);
+        assert!(output.status.success(), "{}", stderr(&output));
+        let tree: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+        tree["color"][0].as_f64().expect("a colour")
+    };
+    assert!((trace(&[]) - 0.2).abs() < 1e-6);
+    assert!((trace(&["--set", "energy_clamp=off"]) - 0.29).abs() < 1e-6);
+}

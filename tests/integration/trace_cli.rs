@@ -48,7 +48,7 @@ fn trace_json(args: &[&str]) -> Value {
 #[test]
 fn json_matches_the_documented_schema_on_varied_scenes() {
     let schema = schema();
-    let cases: [&[&str]; 7] = [
+    let cases: [&[&str]; 8] = [
         &["scenes/whitted.scene", "--pixel", "400,270"],
         // A spot cone that misses (`outside_cone` with its `cone`), and the ray budget.
         &[
@@ -77,6 +77,8 @@ fn json_matches_the_documented_schema_on_varied_scenes() {
             "--height",
             "36",
         ],
+        // A 6.837 scene: the course's model, `energy_clamp` off in the tree's model.
+        &["scenes/mit6837/glass-gem.txt", "--pixel", "100,100"],
         &[
             "scenes/transparent-shadows.scene",
             "--pixel",

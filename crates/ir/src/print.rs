@@ -21,7 +21,7 @@ pub fn print(scene: &Scene) -> String {
     );
     let _ = writeln!(
         out,
-        "  background {}, ambient {}, epsilon {}, shadows {}{}{}{}{}",
+        "  background {}, ambient {}, epsilon {}, shadows {}{}{}{}{}{}",
         color(&s.background),
         color(&s.ambient),
         s.epsilon.map_or("auto".to_string(), |e| e.to_string()),
@@ -41,6 +41,11 @@ pub fn print(scene: &Scene) -> String {
             ""
         } else {
             ", attenuation unclamped"
+        },
+        if s.energy_clamp {
+            ""
+        } else {
+            ", reflective + transmissive unclamped"
         },
         match s.sampling {
             crate::scene::Sampling::Jittered => "",

@@ -105,6 +105,10 @@ pub struct Settings {
     /// Whether point and spot lights' distance attenuation is clamped at 1, so that a light
     /// never gets brighter than its colour close up (MIT 6.837 does not clamp).
     pub attenuation_clamp: bool,
+    /// Whether a surface's reflected and transmitted coefficients are scaled down to add up
+    /// to at most 1 (so that no bounce returns more light than arrives). MIT 6.837 adds
+    /// `reflective·trace + transparent·trace` as given.
+    pub energy_clamp: bool,
 }
 
 impl Default for Settings {
@@ -123,6 +127,7 @@ impl Default for Settings {
             highlight: Highlight::Phong,
             shade_back: true,
             attenuation_clamp: true,
+            energy_clamp: true,
         }
     }
 }

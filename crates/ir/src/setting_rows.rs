@@ -258,6 +258,15 @@ pub const ATTENUATION_CLAMP: SettingRow = SettingRow {
     set: |s, v| s.attenuation_clamp = word(v) != "off",
 };
 
+pub const ENERGY_CLAMP: SettingRow = SettingRow {
+    name: "energy_clamp",
+    kind: SettingKind::Word(ON_OFF),
+    default: "on",
+    doc: "whether a surface's reflective and transmissive weights are scaled down to add up to at most 1",
+    get: |s| Some(on_off(s.energy_clamp)),
+    set: |s, v| s.energy_clamp = word(v) != "off",
+};
+
 /// Every setting, in the order the docs list them.
 pub const SETTINGS: &[SettingRow] = &[
     WIDTH,
@@ -273,6 +282,7 @@ pub const SETTINGS: &[SettingRow] = &[
     HIGHLIGHT,
     SHADE_BACK,
     ATTENUATION_CLAMP,
+    ENERGY_CLAMP,
 ];
 
 /// The row of the setting called `name`.

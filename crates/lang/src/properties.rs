@@ -239,6 +239,9 @@ properties! {
     AttenuationClamp "attenuation_clamp" {
         Settings => setting_kind(&S::ATTENUATION_CLAMP), S::ATTENUATION_CLAMP.default, S::ATTENUATION_CLAMP.doc;
     }
+    EnergyClamp "energy_clamp" {
+        Settings => setting_kind(&S::ENERGY_CLAMP), S::ENERGY_CLAMP.default, S::ENERGY_CLAMP.doc;
+    }
     Position "position" {
         Light(POSITIONED) => Vector, "", "where the light is";
     }

@@ -85,6 +85,7 @@ pub fn convert(
     let ambient = ambient.or((scene.lights.is_empty()).then_some(Color::WHITE));
     scene.settings = settings(options, background, ambient);
     scene.format = SceneFormat::Mit6837;
+    warnings.extend(energy_note(&scene));
     let sources = scene.sources.clone();
     match whitted_ir::validate(scene) {
         Ok(valid) => Conversion {
@@ -132,7 +133,44 @@ fn settings(
         highlight: Highlight::Blinn,
         shade_back: options.shade_back,
         attenuation_clamp: false,
+        // The course adds `reflectiveColor·trace + transparentColor·trace` as given.
+        energy_clamp: false,
     }
+}
+
+/// The note, once per scene, that a material's reflective and transparent colours add up to
+/// more than 1 and are used as given (the course's model; whitted's own language scales them
+/// down), so that a bright result is not a surprise.
+fn energy_note(scene: &whitted_ir::Scene) -> Option<Diagnostic> {
+    let mut over = scene.materials.iter_with_spans().filter(|(_, m, _)| {
+        let (kr, kt) = (m.reflective, m.transmissive);
+        [kr.r + kt.r, kr.g + kt.g, kr.b + kt.b]
+            .iter()
+            .any(|sum| *sum > 1.0 + 1e-9)
+    });
+    let (_, first, span) = over.next()?;
+    let others = over.count();
+    let (kr, kt) = (first.reflective, first.transmissive);
+    let more = match others {
+        0 => String::new(),
+        1 => " (and 1 other material)".to_string(),
+        n => format!(" (and {n} other materials)"),
+    };
+    Some(
+        Diagnostic::warning(
+            format!(
+                "this material's reflectiveColor + transparentColor is more than 1{more}: the                  course adds reflective·trace + transparent·trace as given, so it returns                  more light than arrives"
+            ),
+            span,
+        )
+        .with_label(format!(
+            "reflective {} {} {} + transparent {} {} {}",
+            kr.r, kr.g, kr.b, kt.r, kt.g, kt.b
+        ))
+        .with_hint(
+            "this is the course's model (docs/courses.md, \"Reflection and refraction\");              a scene in whitted's language scales the two down to add up to 1 unless it sets              `energy_clamp off`",
+        ),
+    )
 }
 
 /// The file's text, or an error at its first byte that is not UTF-8 (or past the size

@@ -444,6 +444,7 @@ impl<'a> Tracer<'a> {
             n,
             (self.ior(outer), self.ior(inner)),
             solid && front_face,
+            self.scene.settings.energy_clamp,
         );
         let mut outcome = Outcome::default();
         let carried = if in_air {
@@ -1094,11 +1095,12 @@ pub fn split_weights(
         (true, true) => (1.0, m.ior),
         (true, false) => (m.ior, 1.0),
     };
-    split_at(m, d, n, ior, solid && front_face)
+    split_at(m, d, n, ior, solid && front_face, true)
 }
 
 /// [`split_weights`] between the media on either side: `ior` is (before, beyond) the
-/// surface, and `entering` whether the ray enters a solid there (for the record).
+/// surface, and `entering` whether the ray enters a solid there (for the record);
+/// `energy_clamp` is the scene's setting (off: `kr` and `kt` as given, as MIT 6.837 adds them).
 #[inline(always)]
 pub fn split_at(
     m: &PreparedMaterial,
@@ -1106,6 +1108,7 @@ pub fn split_at(
     n: Vec3A,
     ior: (f32, f32),
     entering: bool,
+    energy_clamp: bool,
 ) -> Split {
     let cos_incidence = (-d).dot(n).clamp(0.0, 1.0);
     let mut split = Split {
@@ -1158,7 +1161,9 @@ pub fn split_at(
             split.refracted = Some(direction);
         }
     }
-    conserve_energy(&mut split);
+    if energy_clamp {
+        conserve_energy(&mut split);
+    }
     split
 }
 

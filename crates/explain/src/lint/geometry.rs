@@ -179,10 +179,16 @@ pub(super) fn material_gain(scene: &Scene, lints: &mut Vec<Lint>) {
             continue;
         }
         let name = material_name(scene, handle);
+        let consequence = if scene.settings.energy_clamp {
+            "so the tracer scales both down to sum to 1"
+        } else {
+            "and with `energy_clamp off` both are used as given: every bounce returns more \
+             light than arrives"
+        };
         let diagnostic = Diagnostic::warning(
             format!(
                 "{name} reflects and transmits more light than it receives: reflective + \
-                 transmissive is {} (more than 1), so the tracer scales both down to sum to 1",
+                 transmissive is {} (more than 1), {consequence}",
                 color_sum(material.reflective, material.transmissive)
             ),
             span,

@@ -49,6 +49,14 @@ pub struct ShadingModel {
     pub shade_back: bool,
     /// Whether point and spot lights' attenuation is clamped at 1.
     pub attenuation_clamp: bool,
+    /// Whether a surface's `kr + kt` is scaled down to at most 1; written only when off, so
+    /// that trees of the default model read as they did before the switch existed.
+    #[serde(skip_serializing_if = "is_on")]
+    pub energy_clamp: bool,
+}
+
+fn is_on(switch: &bool) -> bool {
+    *switch
 }
 
 impl ShadingModel {
@@ -58,6 +66,7 @@ impl ShadingModel {
             highlight: settings.highlight,
             shade_back: settings.shade_back,
             attenuation_clamp: settings.attenuation_clamp,
+            energy_clamp: settings.energy_clamp,
         }
     }
 }

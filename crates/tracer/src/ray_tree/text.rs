@@ -54,6 +54,9 @@ pub fn format_text(tree: &RayTree, options: TextOptions) -> String {
     if !model.attenuation_clamp {
         switches.push("attenuation not clamped at 1");
     }
+    if !model.energy_clamp {
+        switches.push("reflective + transmissive as given (energy_clamp off)");
+    }
     if !switches.is_empty() {
         let _ = writeln!(out, "model: {}", switches.join(", "));
     }
