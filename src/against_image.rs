@@ -158,10 +158,9 @@ pub fn against_image(args: &DiffArgs, student_path: &Path) -> Result<(), Failure
         return write_json_stdout(&document);
     }
     let mut out = format!(
-        "student: {}\nreference: whitted's render of {} ({})\n",
+        "student: {}\nreference: {}\n",
         student_path.display(),
-        args.scene.scene.display(),
-        describe_switches(&loaded.scene.settings, course)
+        describe_reference(&args.scene.scene, &loaded.scene.settings, course)
     );
     if regions.is_empty() {
         out.push_str(&format!(
@@ -170,6 +169,9 @@ pub fn against_image(args: &DiffArgs, student_path: &Path) -> Result<(), Failure
             space.name()
         ));
         return write_stdout(&out);
+    }
+    if course {
+        out.push_str(COURSE_SWITCHES);
     }
     out.push_str(&format!(
         "{differing} of {total} pixels differ by more than {} (8-bit {} steps), in {} region{}\n",
@@ -223,14 +225,21 @@ pub fn against_image(args: &DiffArgs, student_path: &Path) -> Result<(), Failure
     write_stdout(&out)
 }
 
-/// The switches the reference was rendered with: for a 6.837 scene as the course's flags
-/// (the teacher checks them against the assignment's command line), with the `--set`s that
-/// give them.
-fn describe_switches(settings: &Settings, course: bool) -> String {
-    let size = format!("{}x{}", settings.width, settings.height);
+/// How the course's switches are given to `diff`, for a teacher whose reference differs
+/// from the assignment's command line.
+const COURSE_SWITCHES: &str = "(the course's switches, as --set: -shadows shadows=opaque, \
+-transparent_shadows shadows=filtered, -shade_back shade_back=on, -bounces N max_depth=N, \
+-weight W min_weight=W)\n";
+
+/// What the reference is: for a 6.837 scene the course's command line that makes the same
+/// image (the teacher checks it against the assignment's), else the main settings.
+fn describe_reference(scene: &Path, settings: &Settings, course: bool) -> String {
     if !course {
         return format!(
-            "{size}, shadows {}, max_depth {}",
+            "whitted's render of {} at {}x{}, shadows {}, max_depth {}",
+            scene.display(),
+            settings.width,
+            settings.height,
             shadow_word(settings.shadows),
             settings.max_depth
         );
@@ -251,7 +260,9 @@ fn describe_switches(settings: &Settings, course: bool) -> String {
         flags.push(format!("-weight {}", settings.min_weight));
     }
     format!(
-        "as `whitted mit6837 {}`; other switches: --set shadows=opaque, --set max_depth=N, ... (docs/courses.md)",
+        "whitted's render of {}, as `whitted mit6837 -input {} {}` makes it",
+        scene.display(),
+        scene.display(),
         flags.join(" ")
     )
 }

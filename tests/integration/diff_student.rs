@@ -87,7 +87,7 @@ fn the_courses_own_images_match_the_reference_in_every_pixel() {
         );
         // The switches are shown as the course's command line, for the teacher to check.
         assert!(
-            text.contains("-size 200 200 -shadows -bounces 4 -weight 0.01"),
+            text.contains("-size 200 200 -shadows -bounces 4 -weight 0.01` makes it"),
             "{text}"
         );
         args.push("--json");

@@ -27,8 +27,9 @@ use whitted_tracer::{PreparedScene, RenderOptions};
 pub enum Behaviour {
     /// Shadow rays as this mode casts them (`none`: no shadow rays at all).
     Shadows { mode: whitted_ir::ShadowMode },
-    /// Reflected and refracted rays followed to this depth (the camera ray is depth 0).
-    Depth { max_depth: u32 },
+    /// Reflected and refracted rays followed to `max_depth` (the camera ray is depth 0);
+    /// every depth from `lowest` to `max_depth` gives the pixel the same colour.
+    Depth { max_depth: u32, lowest: u32 },
     /// No ambient term.
     NoAmbient,
     /// Highlights by this model.
@@ -119,7 +120,17 @@ pub fn read_student_pixel(
         });
     // A behaviour explains the pixel when it takes away most of the difference: half is
     // not enough (two mistakes at once would each look half right).
-    let explains = best.filter(|(_, _, left)| u32::from(*left) * 3 <= u32::from(now));
+    let mut explains = best.filter(|(_, _, left)| u32::from(*left) * 3 <= u32::from(now));
+    // Depths that give this pixel the same colour cannot be told apart here: say all.
+    if let Some((Behaviour::Depth { max_depth, lowest }, bytes, _)) = &mut explains {
+        for (behaviour, color) in &candidates {
+            if let Behaviour::Depth { max_depth: d, .. } = behaviour {
+                if *d < *lowest && *d < *max_depth && encode(*color) == *bytes {
+                    *lowest = *d;
+                }
+            }
+        }
+    }
     // Where the reference's camera rays all leave the scene, a student's pixel that is not
     // the background hit something: no traced behaviour gives that colour.
     let missing = explains.is_none() && tree.samples.iter().all(|s| s.root.hit.is_none());

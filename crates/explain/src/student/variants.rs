@@ -121,7 +121,10 @@ impl Behaviours {
                     ..*reference.options
                 };
                 out.push((
-                    Behaviour::Depth { max_depth },
+                    Behaviour::Depth {
+                        max_depth,
+                        lowest: max_depth,
+                    },
                     pixel_color(reference.prepared, &options, x, y),
                 ));
             }
@@ -162,7 +165,10 @@ impl Behaviours {
                     ..*reference.options
                 };
                 out.push((
-                    Behaviour::Depth { max_depth },
+                    Behaviour::Depth {
+                        max_depth,
+                        lowest: max_depth,
+                    },
                     pixel_color(reference.prepared, &options, x, y),
                 ));
             }

@@ -8,9 +8,7 @@ use whitted_tracer::ray_tree::{trace_pixel, RayNode, RayTree, SampleChoice, Visi
 use whitted_tracer::RayKind;
 
 use super::{Behaviour, Behaviours};
-use crate::contributions::{decompose, describe_path};
 use crate::findings::{walk, weight_of};
-use crate::text::describe_term;
 
 /// A reading in words.
 pub(super) struct Worded {
@@ -50,7 +48,7 @@ pub(super) fn word(
         {
             Some(shadow) => worded(
                 format!(
-                    "the reference is in the shadow of {} (light {}); the student cast no shadow ray there, or ignored what it hit",
+                    "the reference is in the shadow of {} ({}); the student cast no shadow ray there, or ignored what it hit",
                     shadow.blocker, shadow.light
                 ),
                 "for each light, cast a shadow ray from the hit point towards the light and leave the light out when an object is hit before it (the course's -shadows)",
@@ -71,7 +69,7 @@ pub(super) fn word(
                 .and_then(|t| heaviest_shadow(&t, Visibility::Blocked).or_else(|| heaviest_shadow(&t, Visibility::Filtered)));
             let what = blocker.as_ref().map_or_else(
                 || "the student's pixel is darkened as if by shadow rays".to_string(),
-                |b| format!("the student's tracer put {seen_text} in the shadow of {} (light {})", b.blocker, b.light),
+                |b| format!("the student's tracer put {seen_text} in the shadow of {} ({})", b.blocker, b.light),
             );
             worded(
                 format!("the reference casts no shadow rays (the command line asks for none); {what}"),
@@ -83,8 +81,8 @@ pub(super) fn word(
             let shadow = heaviest_shadow(tree, Visibility::Filtered);
             worded(
                 format!(
-                    "in the reference, light{} reaches {seen_text} through {}, tinted by its transparent colour; the student's shadow ray stopped there",
-                    shadow.as_ref().map_or(String::new(), |s| format!(" {}", s.light)),
+                    "in the reference, {} reaches {seen_text} through {}, tinted by its transparent colour; the student's shadow ray stopped there",
+                    shadow.as_ref().map_or("the light".to_string(), |s| s.light.clone()),
                     shadow.as_ref().map_or("a transparent object".to_string(), |s| s.blocker.clone()),
                 ),
                 "let shadow rays pass through transparent objects, multiplying the light by each one's transparent colour (the course's -transparent_shadows)",
@@ -95,15 +93,20 @@ pub(super) fn word(
             let shadow = heaviest_shadow(tree, Visibility::Blocked);
             worded(
                 format!(
-                    "in the reference, {} blocks the light{} completely; the student's shadow ray let light through it",
+                    "in the reference, {} blocks {} completely; the student's shadow ray let light through it",
                     shadow.as_ref().map_or("an object".to_string(), |s| s.blocker.clone()),
-                    shadow.as_ref().map_or(String::new(), |s| format!(" {}", s.light)),
+                    shadow.as_ref().map_or("the light".to_string(), |s| s.light.clone()),
                 ),
                 "stop a shadow ray at the first object it hits, transparent or not, unless transparent shadows are asked for (the course's -transparent_shadows)",
                 shadow.and_then(|s| s.location).or(seen_location),
             )
         }
-        Some(Behaviour::Depth { max_depth }) if max_depth < tree.max_depth => {
+        Some(Behaviour::Depth { max_depth, lowest }) if max_depth < tree.max_depth => {
+            let stopped = if lowest < max_depth {
+                format!("at a depth from {lowest} to {max_depth} (they give this pixel the same colour)")
+            } else {
+                format!("at depth {max_depth}")
+            };
             let cut = heaviest_at_depth(tree, max_depth + 1);
             let what = cut.as_ref().map_or_else(
                 || format!("rays of depth {}", max_depth + 1),
@@ -111,23 +114,23 @@ pub(super) fn word(
             );
             worded(
                 format!(
-                    "the reference follows {what} (depth {}), which brings light; the student's tracer stopped recursing at depth {max_depth}",
+                    "the reference follows {what} (depth {}), which brings light; the student's tracer stopped recursing {stopped}",
                     max_depth + 1
                 ),
                 &format!(
-                    "trace reflected and refracted rays recursively until depth {} (the course's -bounces {}; the camera ray is depth 0)",
+                    "trace reflected and refracted rays recursively until depth {} (max_depth {}, the course's -bounces; the camera ray is depth 0)",
                     tree.max_depth, tree.max_depth
                 ),
                 cut.and_then(|c| c.location).or(seen_location),
             )
         }
-        Some(Behaviour::Depth { max_depth }) => worded(
+        Some(Behaviour::Depth { max_depth, .. }) => worded(
             format!(
                 "the student's pixel has light of rays deeper than the reference's limit of {} (it matches a trace to depth {max_depth})",
                 tree.max_depth
             ),
             &format!(
-                "stop spawning reflected and refracted rays past depth {} (the course's -bounces {}; the camera ray is depth 0)",
+                "stop spawning reflected and refracted rays past depth {} (max_depth {}, the course's -bounces; the camera ray is depth 0)",
                 tree.max_depth, tree.max_depth
             ),
             seen_location,
@@ -144,7 +147,7 @@ pub(super) fn word(
             worded(
                 format!(
                     "the reference has a specular highlight{}; the student's pixel has none",
-                    highlight.as_ref().map_or(String::new(), |h| format!(" of light {} on {}", h.light, h.blocker))
+                    highlight.as_ref().map_or(String::new(), |h| format!(" of {} on {}", h.light, h.blocker))
                 ),
                 &format!(
                     "add each light's specular term, specular colour times ({})^exponent, where the light reaches the point",
@@ -195,25 +198,14 @@ pub(super) fn word(
             "check the camera ray through this pixel, the intersection tests (a hit behind the eye, t below the minimum) and the background colour",
             None,
         ),
-        None => {
-            let main = decompose(tree).into_iter().next().map(|c| {
-                let path = describe_path(&c.path);
-                let share = c.share.map_or(String::new(), |s| format!("{:.0}% ", s * 100.0));
-                if path.is_empty() {
-                    format!("{share}{}", describe_term(&c))
-                } else {
-                    format!("{share}{path}: {}", describe_term(&c))
-                }
-            });
-            worded(
-                format!(
-                    "no single difference of tracer behaviour that whitted tries (shadows, depth, ambient, highlights, back faces, total internal reflection, a missed hit) explains it; the reference's main light is {}",
-                    main.unwrap_or_else(|| "none".into())
-                ),
-                "compare the student's terms with the reference's ray by ray (whitted trace at this pixel, with the same switches)",
-                seen_location,
-            )
-        }
+        None => Worded {
+            message: "no single difference of tracer behaviour that whitted tries (shadows, depth, ambient, highlights, back faces, total internal reflection, a missed hit) explains it".into(),
+            tracer: format!(
+                "compare its terms with the reference's ray by ray: whitted trace SCENE --pixel {},{} with the same switches",
+                tree.pixel[0], tree.pixel[1]
+            ),
+            location: seen_location,
+        },
     }
 }
 
@@ -242,12 +234,12 @@ fn heaviest_shadow(tree: &RayTree, visibility: Visibility) -> Option<Shadow> {
             let shadow = match blocker {
                 Some(b) => Shadow {
                     blocker: format!("{} at {}", b.object.label, b.object.location),
-                    light: light.light.label.clone(),
+                    light: light_name(&light.light.label),
                     location: Some(b.object.location.clone()),
                 },
                 None => Shadow {
                     blocker: "an object".into(),
-                    light: light.light.label.clone(),
+                    light: light_name(&light.light.label),
                     location: Some(light.light.location.clone()),
                 },
             };
@@ -275,7 +267,7 @@ fn heaviest_specular(tree: &RayTree) -> Option<Shadow> {
                 strength,
                 Shadow {
                     blocker: format!("{} at {}", hit.object.label, hit.object.location),
-                    light: light.light.label.clone(),
+                    light: light_name(&light.light.label),
                     location: Some(hit.object.location.clone()),
                 },
             ));
@@ -345,4 +337,13 @@ fn tir_object(tree: &RayTree) -> Option<(String, String)> {
         }
     });
     best.map(|(_, o)| o)
+}
+
+/// A light's label as a noun: `light #0` as it is, a named light `warm` as `light warm`.
+fn light_name(label: &str) -> String {
+    if label.starts_with("light") {
+        label.to_string()
+    } else {
+        format!("light {label}")
+    }
 }
