@@ -36,39 +36,36 @@ impl Behaviours {
     /// they are made once for every region of an image.
     pub fn new(scene: &Scene) -> Behaviours {
         let settings = &scene.settings;
-        let mut changes: Vec<(Behaviour, Box<dyn Fn(&mut Scene)>)> = Vec::new();
-        for mode in [ShadowMode::None, ShadowMode::Opaque, ShadowMode::Filtered] {
-            if mode != settings.shadows {
-                changes.push((
-                    Behaviour::Shadows { mode },
-                    Box::new(move |s: &mut Scene| s.settings.shadows = mode),
-                ));
-            }
-        }
+        let mut changes: Vec<Behaviour> =
+            [ShadowMode::None, ShadowMode::Opaque, ShadowMode::Filtered]
+                .into_iter()
+                .filter(|&mode| mode != settings.shadows)
+                .map(|mode| Behaviour::Shadows { mode })
+                .collect();
         if settings.ambient != Color::BLACK {
-            changes.push((
-                Behaviour::NoAmbient,
-                Box::new(|s: &mut Scene| s.settings.ambient = Color::BLACK),
-            ));
+            changes.push(Behaviour::NoAmbient);
         }
-        let other = match settings.highlight {
-            Highlight::Phong => Highlight::Blinn,
-            Highlight::Blinn => Highlight::Phong,
-        };
-        changes.push((
-            Behaviour::Highlight { model: other },
-            Box::new(move |s: &mut Scene| s.settings.highlight = other),
-        ));
-        let on = !settings.shade_back;
-        changes.push((
-            Behaviour::ShadeBack { on },
-            Box::new(move |s: &mut Scene| s.settings.shade_back = on),
-        ));
+        changes.push(Behaviour::Highlight {
+            model: match settings.highlight {
+                Highlight::Phong => Highlight::Blinn,
+                Highlight::Blinn => Highlight::Phong,
+            },
+        });
+        changes.push(Behaviour::ShadeBack {
+            on: !settings.shade_back,
+        });
         let variants = changes
             .into_iter()
-            .filter_map(|(behaviour, change)| {
+            .filter_map(|behaviour| {
                 let mut copy = scene.clone();
-                change(&mut copy);
+                let settings = &mut copy.settings;
+                match behaviour {
+                    Behaviour::Shadows { mode } => settings.shadows = mode,
+                    Behaviour::NoAmbient => settings.ambient = Color::BLACK,
+                    Behaviour::Highlight { model } => settings.highlight = model,
+                    Behaviour::ShadeBack { on } => settings.shade_back = on,
+                    _ => return None,
+                }
                 // A setting changed to another valid value leaves the scene valid; should
                 // it not, that behaviour is simply not tried.
                 let scene = validate(copy).ok()?;
@@ -229,13 +226,10 @@ fn sum_over(
 /// A hit's specular terms, weighted by the ray's path weight and the hit's absorption.
 fn specular_light(node: &RayNode) -> Option<[f32; 3]> {
     let (local, hit) = (node.local.as_ref()?, node.hit.as_ref()?);
-    let mut sum = [0.0f32; 3];
-    for light in &local.lights {
-        for c in 0..3 {
-            sum[c] += light.specular[c] * node.weight[c] * hit.absorption[c];
-        }
-    }
-    Some(sum)
+    Some(std::array::from_fn(|c| {
+        let specular: f32 = local.lights.iter().map(|l| l.specular[c]).sum();
+        specular * node.weight[c] * hit.absorption[c]
+    }))
 }
 
 /// The whole light a totally internally reflected ray brings.
