@@ -95,12 +95,18 @@ pub fn against_image(args: &DiffArgs, student_path: &Path) -> Result<(), Failure
     if let Some(other) = other_space {
         if other * 4 <= differing && differing - other >= (total / 100).max(1) {
             eprintln!(
-                "warning: {} looks like {} 8-bit values: {other} pixels differ compared as {}, {differing} as {} (the default for {}); add --{} to compare as {}",
+                "warning: {} looks like {} 8-bit values: {other} pixels differ compared as {}, {differing} as {} ({}); add --{} to compare as {}",
                 student_path.display(),
                 space.other().name(),
                 space.other().name(),
                 space.name(),
-                if course { "a 6.837 scene" } else { "a scene in whitted's language" },
+                if args.linear || args.srgb {
+                    "as asked"
+                } else if course {
+                    "the default for a 6.837 scene"
+                } else {
+                    "the default for a scene in whitted's language"
+                },
                 space.other().name(),
                 space.other().name(),
             );
