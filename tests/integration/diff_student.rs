@@ -1,8 +1,9 @@
 //! `whitted diff SCENE --against-image STUDENT` as a teacher uses it (issue 28, part 3):
 //! whitted's own images in every format it writes (the course's 8-bit linear TGA and PNG,
 //! `render`'s sRGB PNG, TGA and PPM, and EXR) match the reference in 0 pixels, an image in
-//! the other space draws a warning, and a student's image made without shadow rays is read
-//! from the student's side, naming the missing shadow ray and what blocks the light.
+//! the other space draws a warning, a student's image made without shadow rays is read from
+//! the student's side, naming the missing shadow ray and what blocks the light, and images
+//! made with recursion stopped early, no specular term or lit back faces are read as such.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -237,4 +238,109 @@ fn assert_shadow_reading(text: &str) {
     );
     assert!(!text.contains("fix:"), "{text}");
     assert!(!text.contains("whitted #"), "{text}");
+}
+
+/// The first region's reading of a course-format student image made by `course_flags`
+/// (a student's tracer with that behaviour), against the reference made with `sets`.
+fn course_reading(scene: &str, student_scene: &str, course_flags: &[&str], sets: &[&str]) -> Value {
+    let dir = tempfile::tempdir().unwrap();
+    let student = path(dir.path(), "student.tga");
+    let mut args = vec![
+        "mit6837",
+        "-input",
+        student_scene,
+        "-size",
+        "120",
+        "120",
+        "-output",
+        &student,
+    ];
+    args.extend(course_flags);
+    ok(&args);
+    let mut args = vec![
+        "diff",
+        scene,
+        "--against-image",
+        &student,
+        "--width",
+        "120",
+        "--height",
+        "120",
+        "--json",
+    ];
+    args.extend(sets);
+    let report: Value = serde_json::from_str(&ok(&args)).unwrap();
+    assert_eq!(report["space"], "linear");
+    report["regions"][0]["reading"].clone()
+}
+
+/// The other main mistakes, each made by a real trace with that behaviour: recursion that
+/// stops early, no specular term (the scene without its specular colours), back faces lit
+/// without `-shade_back`; each read as that behaviour, exactly (0 steps left).
+#[test]
+fn depth_specular_and_back_face_mistakes_are_read_as_such() {
+    let scene = "scenes/mit6837/reflect-refract.txt";
+    let reading = course_reading(
+        scene,
+        scene,
+        &["-shadows", "-bounces", "1"],
+        &["--set", "shadows=opaque", "--set", "max_depth=4"],
+    );
+    assert_eq!(reading["behaviour"]["kind"], "depth", "{reading:#}");
+    assert_eq!(reading["direction"], "darker");
+    assert!(
+        reading["behaviour"]["lowest"].as_u64().unwrap() <= 1,
+        "{reading:#}"
+    );
+    assert!(
+        reading["message"]
+            .as_str()
+            .unwrap()
+            .contains("the student's tracer stopped recursing"),
+        "{reading:#}"
+    );
+    assert!(reading["tracer"]
+        .as_str()
+        .unwrap()
+        .contains("until depth 4"));
+    assert_eq!(reading["remaining_difference"], 0);
+
+    let scene = "scenes/mit6837/lights-perspective.txt";
+    let dir = tempfile::tempdir().unwrap();
+    let flat = dir.path().join("flat.txt");
+    let text = std::fs::read_to_string(scene).unwrap();
+    let without: String = text
+        .lines()
+        .filter(|l| !l.contains("specularColor") && !l.contains("exponent"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(&flat, without).unwrap();
+    let reading = course_reading(
+        scene,
+        flat.to_str().unwrap(),
+        &["-shadows"],
+        &["--set", "shadows=opaque"],
+    );
+    assert_eq!(reading["behaviour"]["kind"], "no_specular", "{reading:#}");
+    assert!(
+        reading["message"]
+            .as_str()
+            .unwrap()
+            .contains("the reference has a specular highlight of light #0 on sphere"),
+        "{reading:#}"
+    );
+    assert!(reading["location"].as_str().unwrap().starts_with(scene));
+
+    let scene = "scenes/mit6837/back-faces.txt";
+    let reading = course_reading(scene, scene, &["-shade_back"], &[]);
+    assert_eq!(reading["behaviour"]["kind"], "shade_back", "{reading:#}");
+    assert_eq!(reading["behaviour"]["on"], true);
+    assert_eq!(reading["direction"], "brighter");
+    assert!(
+        reading["message"]
+            .as_str()
+            .unwrap()
+            .contains("the student's tracer lit it"),
+        "{reading:#}"
+    );
 }
