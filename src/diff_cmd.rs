@@ -21,6 +21,11 @@ pub fn diff(args: &DiffArgs) -> Result<(), Failure> {
         }
         return crate::against_image::against_image(args, student);
     }
+    if args.linear || args.srgb {
+        return Err(Failure::Usage(
+            "--linear and --srgb say how a student's image is compared: use them with --against-image".into(),
+        ));
+    }
     let Some(pixel) = args.pixel else {
         return Err(Failure::Usage(
             "which pixel? add --pixel X,Y (or compare whole images with --against-image STUDENT.png)"
