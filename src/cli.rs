@@ -180,10 +180,19 @@ pub struct DiffArgs {
     /// max_depth=8 (repeatable).
     #[arg(long = "against-set", value_name = "NAME=VALUE", value_parser = parse_setting)]
     pub against_set: Vec<(String, String)>,
-    /// Compare whitted's render with this image (same size, 8-bit sRGB PNG as `render`
-    /// writes): list the regions that differ and explain a pixel of each.
-    #[arg(long = "against-image", value_name = "REF.png")]
+    /// Compare a student's image (PNG, TGA, PPM or EXR, the scene's size) with whitted's
+    /// render, the reference: list the regions that differ and read a pixel of each from
+    /// the student's side.
+    #[arg(long = "against-image", value_name = "STUDENT.tga")]
     pub against_image: Option<PathBuf>,
+    /// With --against-image: compare in 8-bit linear values (colour times 255), as the MIT
+    /// 6.837 course wrote images (the default for a 6.837 scene).
+    #[arg(long, conflicts_with = "srgb")]
+    pub linear: bool,
+    /// With --against-image: compare in 8-bit sRGB, as `whitted render` writes PNG, TGA and
+    /// PPM (the default for a scene in whitted's language).
+    #[arg(long)]
+    pub srgb: bool,
     /// With --against-image: the largest difference (in 8-bit steps, any channel) that
     /// still counts as equal.
     #[arg(long, default_value_t = 8)]

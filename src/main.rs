@@ -5,6 +5,7 @@
 // A program, not a library: it prints its results and sets its exit status.
 #![allow(clippy::print_stdout, clippy::print_stderr, clippy::exit)]
 
+mod against_image;
 mod allocator;
 mod cli;
 mod cpu_time;
@@ -22,6 +23,7 @@ mod request;
 mod scene_input;
 mod setting_flags;
 mod stats_image;
+mod student_image;
 mod trace_cmd;
 
 use std::io::Write;

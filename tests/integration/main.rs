@@ -8,6 +8,7 @@ mod conventions;
 mod debug_cli;
 mod debug_tmux;
 mod diff;
+mod diff_student;
 mod exit_codes;
 mod explain;
 mod extremes;

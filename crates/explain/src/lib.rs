@@ -21,6 +21,7 @@ mod numbers;
 pub mod probe;
 pub mod query;
 pub mod regions;
+pub mod student;
 mod text;
 
 pub use json::{ExplanationDocument, EXPLAIN_JSON_VERSION};

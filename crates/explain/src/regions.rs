@@ -1,9 +1,14 @@
-//! Where two images differ (`whitted diff SCENE --against-image REF.png`): pixels whose
-//! 8-bit sRGB values differ by more than a tolerance in some channel, grouped into
-//! connected regions (8-neighbours), each with its bounding box and a sample pixel, the
-//! one that differs most, for whitted to explain.
+//! Where two images differ (`whitted diff SCENE --against-image STUDENT.tga`): pixels whose
+//! 8-bit values differ by more than a tolerance in some channel, grouped into connected
+//! regions (8-neighbours), each with its bounding box and a sample pixel, the one that
+//! differs most, for whitted to read from the student's side (`student`).
 
 use serde::Serialize;
+
+/// The version of `diff --against-image --json` (docs/diff.md): 2 named the sides
+/// `student` and `reference` (1 had `whitted` and `reference`, the student's image) and
+/// added the space and each region's `reading`.
+pub const IMAGE_DIFF_JSON_VERSION: u32 = 2;
 
 /// A connected set of differing pixels.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
