@@ -154,6 +154,8 @@ fn options() -> CompileOptions {
     CompileOptions {
         defines: Vec::new(),
         settings: Vec::new(),
+        // The editor's index is built for every fuzzed text too: it must not panic either.
+        index: true,
         limits: Limits {
             max_objects: 5_000,
             max_evaluation_steps: 20_000,
