@@ -44,7 +44,13 @@ fn a_pixel_outside_the_image_is_an_error() {
 /// (by a lint, or `render`'s report) is the same pixel in the debugger.
 #[test]
 fn the_debugger_opens_at_the_size_the_flags_give() {
-    let output = debug(&["scenes/whitted.scene", "--width", "100", "--pixel", "150,10"]);
+    let output = debug(&[
+        "scenes/whitted.scene",
+        "--width",
+        "100",
+        "--pixel",
+        "150,10",
+    ]);
     assert_eq!(output.status.code(), Some(2));
     assert!(
         stderr(&output).contains("`--pixel 150,10` is outside the 100x75 image"),

@@ -6,8 +6,8 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use lsp_types::{
-    Diagnostic as LspDiagnostic, DiagnosticRelatedInformation, DiagnosticSeverity, Location,
-    Range, Url,
+    Diagnostic as LspDiagnostic, DiagnosticRelatedInformation, DiagnosticSeverity, Location, Range,
+    Url,
 };
 use whitted_ir::{Diagnostic, FileId, Severity, SourceMap, Span};
 use whitted_lang::editor::Index;

@@ -2,9 +2,7 @@
 //! (those it does not have yet, transforms always), a material's name after `material`, a
 //! property's words (`shadows` → `opaque`, `filtered`, `none`).
 
-use lsp_types::{
-    CompletionItem, CompletionItemKind, Documentation, MarkupContent, MarkupKind,
-};
+use lsp_types::{CompletionItem, CompletionItemKind, Documentation, MarkupContent, MarkupKind};
 use whitted_lang::editor::cursor::{self, Place};
 use whitted_lang::editor::SymbolKind;
 

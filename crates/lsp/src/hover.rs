@@ -8,7 +8,8 @@ use whitted_lang::editor::{cursor, BlockKind, PropertyDoc};
 use crate::documents::Document;
 
 pub fn hover(document: &Document, offset: usize) -> Option<Hover> {
-    let (block, property, span) = from_index(document, offset).or_else(|| from_text(document, offset))?;
+    let (block, property, span) =
+        from_index(document, offset).or_else(|| from_text(document, offset))?;
     Some(Hover {
         contents: HoverContents::Markup(MarkupContent {
             kind: MarkupKind::Markdown,
@@ -23,7 +24,10 @@ pub fn hover(document: &Document, offset: usize) -> Option<Hover> {
 
 /// The hover text: the doc line, what it takes and its default, and the block it is in.
 pub fn describe(block: BlockKind, property: &PropertyDoc) -> String {
-    let mut text = format!("**{}**: {}\n\n{}", property.name, property.doc, property.kind);
+    let mut text = format!(
+        "**{}**: {}\n\n{}",
+        property.name, property.doc, property.kind
+    );
     if !property.default.is_empty() {
         text.push_str(&format!("; default `{}`", property.default));
     }
@@ -52,11 +56,19 @@ fn from_index(document: &Document, offset: usize) -> Option<Found> {
 fn from_text(document: &Document, offset: usize) -> Option<Found> {
     let text = &document.text;
     let is_word = |c: char| c.is_ascii_alphanumeric() || c == '_';
-    let start = text.get(..offset)?.rfind(|c| !is_word(c)).map_or(0, |i| i + 1);
-    let end = text.get(offset..)?.find(|c| !is_word(c)).map_or(text.len(), |i| offset + i);
+    let start = text
+        .get(..offset)?
+        .rfind(|c| !is_word(c))
+        .map_or(0, |i| i + 1);
+    let end = text
+        .get(offset..)?
+        .find(|c| !is_word(c))
+        .map_or(text.len(), |i| offset + i);
     let word = text.get(start..end).filter(|w| !w.is_empty())?;
     match cursor::place_at(text, end).place {
-        cursor::Place::PropertyName { block, .. } => Some((block, block.property(word)?, start..end)),
+        cursor::Place::PropertyName { block, .. } => {
+            Some((block, block.property(word)?, start..end))
+        }
         _ => None,
     }
 }

@@ -59,10 +59,9 @@ pub fn serve(connection: &Connection, files: Box<dyn Files>) -> Result<(), Strin
                 Message::Response(_) => {}
             }
         }
-        let published = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            server.analyze_changed()
-        }))
-        .unwrap_or_default();
+        let published =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| server.analyze_changed()))
+                .unwrap_or_default();
         for notification in published {
             send(connection, Message::Notification(notification))?;
         }

@@ -132,7 +132,11 @@ impl Server {
             if !own {
                 others.push(file.clone());
             }
-            out.push(publish(file.clone(), diagnostics.clone(), own.then_some(version)));
+            out.push(publish(
+                file.clone(),
+                diagnostics.clone(),
+                own.then_some(version),
+            ));
         }
         for gone in self.published.remove(uri).unwrap_or_default() {
             if !others.contains(&gone) {
@@ -158,7 +162,9 @@ impl Server {
         let result = match method {
             HoverRequest::METHOD => self
                 .at::<lsp_types::HoverParams>(params, |p| p.text_document_position_params)
-                .map(|found| found.and_then(|(document, _, offset)| crate::hover::hover(document, offset)))
+                .map(|found| {
+                    found.and_then(|(document, _, offset)| crate::hover::hover(document, offset))
+                })
                 .and_then(to_value),
             Completion::METHOD => self
                 .at::<lsp_types::CompletionParams>(params, |p| p.text_document_position)
@@ -169,9 +175,7 @@ impl Server {
                 })
                 .and_then(to_value),
             GotoDefinition::METHOD => self
-                .at::<lsp_types::GotoDefinitionParams>(params, |p| {
-                    p.text_document_position_params
-                })
+                .at::<lsp_types::GotoDefinitionParams>(params, |p| p.text_document_position_params)
                 .map(|found| {
                     found.and_then(|(document, uri, offset)| {
                         crate::navigation::definition(uri, document, offset)
@@ -181,9 +185,11 @@ impl Server {
                 .and_then(to_value),
             DocumentSymbolRequest::METHOD => {
                 match parse::<lsp_types::DocumentSymbolParams>(params) {
-                    Some(p) => to_value(self.documents.get(&p.text_document.uri).map(|d| {
-                        DocumentSymbolResponse::Nested(crate::navigation::symbols(d))
-                    })),
+                    Some(p) => to_value(
+                        self.documents
+                            .get(&p.text_document.uri)
+                            .map(|d| DocumentSymbolResponse::Nested(crate::navigation::symbols(d))),
+                    ),
                     None => Err(invalid_params()),
                 }
             }

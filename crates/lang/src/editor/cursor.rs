@@ -195,7 +195,10 @@ impl Reader<'_> {
         }
         let statement = start..open;
         let keyword = |w: &str| statement.clone().any(|i| self.word(i) == Some(w));
-        if ["fn", "for", "while", "if", "else"].into_iter().any(keyword) {
+        if ["fn", "for", "while", "if", "else"]
+            .into_iter()
+            .any(keyword)
+        {
             return Some(BlockKind(Context::Statements {
                 top_level: false,
                 in_function: keyword("fn"),
@@ -244,7 +247,9 @@ pub fn place_at(text: &str, offset: usize) -> Cursor {
         place: Place::Other,
         word_start,
     };
-    if quiet.iter().any(|&(s, e)| s <= offset && offset <= e && s < e)
+    if quiet
+        .iter()
+        .any(|&(s, e)| s <= offset && offset <= e && s < e)
         || quiet.iter().any(|&(s, e)| s == e && s == offset)
     {
         return other(offset);
@@ -257,7 +262,10 @@ pub fn place_at(text: &str, offset: usize) -> Cursor {
         .position(|t| t.class == Class::Word && t.start < offset && offset <= t.end);
     let before = typed.unwrap_or_else(|| tokens.partition_point(|t| t.end <= offset));
     let word_start = typed.map_or(offset, |i| tokens[i].start);
-    if tokens.get(before).is_some_and(|t| t.start < offset && typed.is_none()) {
+    if tokens
+        .get(before)
+        .is_some_and(|t| t.start < offset && typed.is_none())
+    {
         // Inside a number or a token that is no word.
         return other(offset);
     }

@@ -55,7 +55,9 @@ impl Walker<'_> {
         for item in &block.items {
             if let ItemKind::Property(property) = &item.kind {
                 if let Some(prop) = property.prop {
-                    self.blocks[at].properties.push((prop.name(), property.name.span));
+                    self.blocks[at]
+                        .properties
+                        .push((prop.name(), property.name.span));
                 }
             }
             self.item(item, symbols);
@@ -91,7 +93,12 @@ impl Walker<'_> {
                     let mut children = Vec::new();
                     self.statements(&function.body, &mut children);
                     let name = self.interner.name(function.name.sym).to_string();
-                    symbols.push(symbol(SymbolKind::Function, name, function.name.span, children));
+                    symbols.push(symbol(
+                        SymbolKind::Function,
+                        name,
+                        function.name.span,
+                        children,
+                    ));
                 }
             }
             ItemKind::For { body, .. } | ItemKind::While { body, .. } => {
@@ -114,10 +121,19 @@ impl Walker<'_> {
                     item.span.start as usize,
                     item.span.start as usize + "settings".len(),
                 );
-                symbols.push(symbol(SymbolKind::Settings, "settings".into(), keyword, Vec::new()));
+                symbols.push(symbol(
+                    SymbolKind::Settings,
+                    "settings".into(),
+                    keyword,
+                    Vec::new(),
+                ));
             }
             ItemKind::Camera { kind, tag, body } => {
-                self.properties(body, tag.map_or(Context::Unknown, Context::Camera), &mut Vec::new());
+                self.properties(
+                    body,
+                    tag.map_or(Context::Unknown, Context::Camera),
+                    &mut Vec::new(),
+                );
                 let name = format!("camera {}", self.interner.name(kind.sym));
                 symbols.push(symbol(SymbolKind::Camera, name, kind.span, Vec::new()));
             }
@@ -127,7 +143,11 @@ impl Walker<'_> {
                 name,
                 body,
             } => {
-                self.properties(body, tag.map_or(Context::Unknown, Context::Light), &mut Vec::new());
+                self.properties(
+                    body,
+                    tag.map_or(Context::Unknown, Context::Light),
+                    &mut Vec::new(),
+                );
                 let mut text = format!("light {}", self.interner.name(kind.sym));
                 if let Some(name) = name {
                     text.push_str(&format!(" \"{}\"", name.value));
@@ -146,7 +166,11 @@ impl Walker<'_> {
                 body,
             } => {
                 let mut children = Vec::new();
-                self.properties(body, tag.map_or(Context::Unknown, Context::Object), &mut children);
+                self.properties(
+                    body,
+                    tag.map_or(Context::Unknown, Context::Object),
+                    &mut children,
+                );
                 let mut text = self.interner.name(kind.sym).to_string();
                 if let Some(name) = name {
                     text.push_str(&format!(" \"{}\"", name.value));

@@ -131,7 +131,7 @@ fn describe_kind(kind: Kind) -> String {
         Kind::Points(n) => format!("{n} vectors, separated by commas"),
         Kind::Numbers(n) => format!("{n} numbers, as numbers and vectors"),
         Kind::Transform => "a transform".to_string(),
-        Kind::ShapeParameter => "a shape parameter".to_string(),
+        Kind::ShapeParameter => "a value the shape checks with its other parameters".to_string(),
         Kind::Text => "a string".to_string(),
         Kind::Bool => "`true` or `false`".to_string(),
     }
@@ -144,8 +144,12 @@ pub(crate) fn block_named(words: &[&str]) -> Option<BlockKind> {
     let context = match words {
         ["settings", ..] => Context::Settings,
         ["material", ..] => Context::Material,
-        ["camera", kind, ..] => Context::Camera(CameraTag::ALL.into_iter().find(|t| t.name() == *kind)?),
-        ["light", kind, ..] => Context::Light(LightTag::ALL.into_iter().find(|t| t.name() == *kind)?),
+        ["camera", kind, ..] => {
+            Context::Camera(CameraTag::ALL.into_iter().find(|t| t.name() == *kind)?)
+        }
+        ["light", kind, ..] => {
+            Context::Light(LightTag::ALL.into_iter().find(|t| t.name() == *kind)?)
+        }
         [kind, ..] => Context::Object(ObjectTag::from_name(kind)?),
         [] => return None,
     };
