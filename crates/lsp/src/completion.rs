@@ -31,7 +31,7 @@ pub fn complete(document: &Document, offset: usize) -> Vec<CompletionItem> {
                 }
             })
             .collect(),
-        Place::Value { property, .. } if property.is_material => materials(document),
+        Place::Value { property, .. } if property.is_material => materials(document, None),
         Place::Value { property, .. } => property
             .words
             .unwrap_or(&[])
@@ -43,14 +43,15 @@ pub fn complete(document: &Document, offset: usize) -> Vec<CompletionItem> {
                 ..CompletionItem::default()
             })
             .collect(),
-        Place::ParentMaterial => materials(document),
+        Place::ParentMaterial { child } => materials(document, child.as_deref()),
         Place::Other => Vec::new(),
     }
 }
 
 /// The materials the text defines (read from the text, so that one typed a moment ago is
-/// offered), then those its imports define (from the last analysis).
-fn materials(document: &Document) -> Vec<CompletionItem> {
+/// offered), then those its imports define (from the last analysis); never `except`, the
+/// material being defined.
+fn materials(document: &Document, except: Option<&str>) -> Vec<CompletionItem> {
     let mut names = cursor::material_names(&document.text);
     if let Some(index) = document.analysis.as_ref().and_then(|a| a.index.as_ref()) {
         for symbol in &index.symbols {
@@ -64,6 +65,7 @@ fn materials(document: &Document) -> Vec<CompletionItem> {
     }
     names
         .into_iter()
+        .filter(|name| Some(name.as_str()) != except)
         .map(|name| CompletionItem {
             label: name,
             kind: Some(CompletionItemKind::VALUE),

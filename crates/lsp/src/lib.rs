@@ -29,3 +29,6 @@ pub trait Files {
         path.to_path_buf()
     }
 }
+
+#[cfg(test)]
+mod tests;

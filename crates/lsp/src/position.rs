@@ -74,15 +74,16 @@ fn saturate(n: usize) -> u32 {
 mod tests {
     use super::*;
 
-    /// `é` is two bytes and one UTF-16 unit; `😀` is four bytes and two units.
+    /// `é` is two bytes and one UTF-16 unit; `😀` is four bytes and two units: `x` is byte 11
+    /// of its line, character 6 and unit 7.
     const TEXT: &str = "a\n// é😀 x\nradius 1\r\nlast";
 
     #[test]
     fn columns_count_utf16_units() {
         let index = LineIndex::new(TEXT);
         let x = TEXT.find('x').unwrap();
-        assert_eq!(index.position(TEXT, x), Position::new(1, 6));
-        assert_eq!(index.offset(TEXT, Position::new(1, 6)), x);
+        assert_eq!(index.position(TEXT, x), Position::new(1, 7));
+        assert_eq!(index.offset(TEXT, Position::new(1, 7)), x);
         let smiley = TEXT.find('😀').unwrap();
         assert_eq!(index.position(TEXT, smiley), Position::new(1, 4));
         // Inside the surrogate pair: the character's start.

@@ -78,6 +78,8 @@ impl Server {
                             document.apply(change);
                         }
                         document.version = p.text_document.version;
+                        // A new version gets its diagnostics, even when nothing changed.
+                        document.analysis = None;
                     }
                 }
             }

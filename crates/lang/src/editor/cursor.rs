@@ -20,8 +20,9 @@ pub enum Place {
         block: BlockKind,
         property: PropertyDoc,
     },
-    /// A material's name after `:` (`material tinted : glass`).
-    ParentMaterial,
+    /// A material's name after `:` (`material tinted : glass`); `child` is the material
+    /// being defined, which cannot be its own parent.
+    ParentMaterial { child: Option<String> },
     /// Anywhere else: statements, inside an expression, a comment or a string.
     Other,
 }
@@ -299,14 +300,19 @@ pub fn place_at(text: &str, offset: usize) -> Cursor {
     };
     let previous = before.checked_sub(1).filter(|&i| Some(i) != frame.open);
     if let Some(previous) = previous {
-        if reader.punct(previous) == Some(b':')
-            && (reader.word(previous.wrapping_sub(1)) == Some("material")
-                || reader.word(previous.wrapping_sub(2)) == Some("material"))
-        {
-            return Cursor {
-                place: Place::ParentMaterial,
-                word_start,
+        let word = |back: usize| previous.checked_sub(back).and_then(|i| reader.word(i));
+        if reader.punct(previous) == Some(b':') {
+            let child = match (word(2), word(1)) {
+                (Some("material"), Some(child)) => Some(Some(child.to_string())),
+                (_, Some("material")) => Some(None),
+                _ => None,
             };
+            if let Some(child) = child {
+                return Cursor {
+                    place: Place::ParentMaterial { child },
+                    word_start,
+                };
+            }
         }
     }
     if block.is_statements() {
