@@ -4,7 +4,7 @@
 //! after `shutdown` and `exit`. The Content-Length framing is written here by hand: it is the
 //! protocol, not the server under test.
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
