@@ -60,7 +60,7 @@ pub fn analyze(uri: &Url, document: &Document, mut overlay: Overlay<'_>) -> Anal
             compilation.diagnostics,
         )
     };
-    let diagnostics = convert_all(uri, &sources, &diagnostics);
+    let diagnostics = convert_all(Locator::new(uri, &sources, &document.lines), &diagnostics);
     Analysis {
         sources,
         index,
@@ -76,11 +76,13 @@ pub struct Locator<'a> {
 }
 
 impl<'a> Locator<'a> {
-    pub fn new(root: &'a Url, sources: &'a SourceMap) -> Self {
+    /// `root_lines` is the document's line index, already made (file 0 is the document's
+    /// text), so that a big document is not indexed again for each answer.
+    pub fn new(root: &'a Url, sources: &'a SourceMap, root_lines: &LineIndex) -> Self {
         Locator {
             root,
             sources,
-            lines: HashMap::new(),
+            lines: HashMap::from([(FileId(0), root_lines.clone())]),
         }
     }
 
@@ -106,11 +108,10 @@ impl<'a> Locator<'a> {
 }
 
 fn convert_all(
-    root: &Url,
-    sources: &SourceMap,
+    mut locator: Locator<'_>,
     diagnostics: &[Diagnostic],
 ) -> Vec<(Url, Vec<LspDiagnostic>)> {
-    let mut locator = Locator::new(root, sources);
+    let root = locator.root;
     let mut by_file: Vec<(Url, Vec<LspDiagnostic>)> = vec![(root.clone(), Vec::new())];
     for diagnostic in diagnostics {
         // A diagnostic without a place (or in a file that is not one) is shown at the

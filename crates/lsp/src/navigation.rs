@@ -13,7 +13,7 @@ pub fn definition(uri: &Url, document: &Document, offset: usize) -> Option<Locat
     let (_, to) = index.links.iter().find(|(from, _)| {
         from.file.0 == 0 && (from.start as usize) <= offset && offset <= from.end as usize
     })?;
-    Locator::new(uri, &analysis.sources).location(*to)
+    Locator::new(uri, &analysis.sources, &document.lines).location(*to)
 }
 
 pub fn symbols(document: &Document) -> Vec<DocumentSymbol> {
