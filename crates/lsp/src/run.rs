@@ -13,7 +13,7 @@ pub fn serve(connection: &Connection, files: Box<dyn Files>) -> Result<(), Strin
     let capabilities = serde_json::to_value(capabilities()).map_err(|e| e.to_string())?;
     connection
         .initialize(capabilities)
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| format!("no `initialize` request from the client ({e})"))?;
     let mut server = Server::new(files);
     while let Ok(first) = connection.receiver.recv() {
         // Everything already waiting is read before any analysis, so that a burst of edits

@@ -202,6 +202,68 @@ fn hover_reads_the_words_when_the_text_does_not_parse() {
     assert!(value.ends_with("(in a material)"), "{value}");
 }
 
+#[test]
+fn hover_on_a_setting_reads_the_ir_settings_table() {
+    let text = "settings { max_depth 4 }\n";
+    let mut server = Server::new(Box::new(Memory::default()));
+    open(&mut server, "a.scene", text);
+    let hover = request(
+        &mut server,
+        "textDocument/hover",
+        position_params("a.scene", text, 12),
+    );
+    let row = whitted_ir::setting_rows::SETTINGS
+        .iter()
+        .find(|row| row.name == "max_depth")
+        .expect("a row");
+    let value = hover["contents"]["value"].as_str().expect("markdown");
+    assert!(
+        value.starts_with(&format!("**max_depth**: {}\n\n", row.doc)),
+        "{value}"
+    );
+    assert!(
+        value.contains(&format!("default `{}`", row.default)),
+        "{value}"
+    );
+}
+
+/// Where go to definition lands from the name at `|` (the marker removed): the range's
+/// start, as (line, character).
+fn definition(marked: &str) -> Option<(u64, u64)> {
+    let offset = marked.find('|').expect("a cursor");
+    let text = marked.replacen('|', "", 1);
+    let mut server = Server::new(Box::new(Memory::default()));
+    open(&mut server, "a.scene", &text);
+    let found = request(
+        &mut server,
+        "textDocument/definition",
+        position_params("a.scene", &text, offset),
+    );
+    let start = &found.get("range")?["start"];
+    Some((start["line"].as_u64()?, start["character"].as_u64()?))
+}
+
+#[test]
+fn definitions_of_lets_functions_parameters_and_materials() {
+    let text = "const n = 3;\nmaterial red { }\nfn ring(k) { for i in 0..k { sphere { center <i, 0, 0> material red } } }\n";
+    assert_eq!(definition(&format!("{text}ring(|n)")), Some((0, 6)));
+    assert_eq!(definition(&format!("{text}r|ing(n)")), Some((2, 3)));
+    let inside = text.replace("0..k", "0..|k");
+    assert_eq!(definition(&format!("{inside}ring(n)")), Some((2, 8)));
+    let material = text.replace("material red }", "material r|ed }");
+    assert_eq!(definition(&format!("{material}ring(n)")), Some((1, 9)));
+    let loop_variable = text.replace("<i,", "<|i,");
+    assert_eq!(
+        definition(&format!("{loop_variable}ring(n)")),
+        Some((2, 17))
+    );
+    // A number is no name.
+    assert_eq!(
+        definition(&format!("{text}ring(n) sphere {{ radius |1 }}")),
+        None
+    );
+}
+
 /// The diagnostics published for `name` among `published`.
 fn published_for(published: &[Notification], name: &str) -> Option<Vec<Value>> {
     published
