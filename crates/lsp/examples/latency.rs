@@ -19,12 +19,35 @@ impl Files for NoFiles {
     }
 }
 
+struct NoImports;
+
+impl whitted_lang::SourceLoader for NoImports {
+    fn load(&mut self, _: &std::path::Path) -> std::io::Result<Vec<u8>> {
+        Err(std::io::ErrorKind::NotFound.into())
+    }
+}
+
 fn main() {
     let statements: usize = std::env::args()
         .nth(1)
         .and_then(|n| n.parse().ok())
         .unwrap_or(100_000);
     let text = scene(statements);
+    // What the editor's index adds to a compile: the same text with and without it.
+    for index in [false, true] {
+        let options = whitted_lang::CompileOptions {
+            index,
+            ..Default::default()
+        };
+        let started = Instant::now();
+        let compilation =
+            whitted_lang::compile_source("big.scene", &text, &mut NoImports, &options);
+        println!(
+            "compile with index {index}: {:.0} ms ({} diagnostics)",
+            ms(started),
+            compilation.diagnostics.len()
+        );
+    }
     let uri = "file:///big.scene";
     let mut server = Server::new(Box::new(NoFiles));
     let started = Instant::now();
