@@ -29,9 +29,13 @@ impl LineIndex {
         while !text.is_char_boundary(offset) {
             offset -= 1;
         }
-        let line = self.starts.partition_point(|&start| start <= offset) - 1;
-        let start = self.starts[line];
-        let column = text[start..offset].encode_utf16().count();
+        let line = self.starts.partition_point(|&start| start <= offset).max(1) - 1;
+        // An index made for another text would put `start` anywhere: count nothing then
+        // rather than slice outside a character.
+        let start = self.starts.get(line).copied().unwrap_or(0).min(offset);
+        let column = text
+            .get(start..offset)
+            .map_or(0, |s| s.encode_utf16().count());
         Position::new(saturate(line), saturate(column))
     }
 
@@ -53,7 +57,9 @@ impl LineIndex {
             .starts
             .get(position.line as usize + 1)
             .map_or(text.len(), |next| next - 1);
-        let line = &text[start..end];
+        let Some(line) = text.get(start..end.max(start)) else {
+            return text.len();
+        };
         let line = line.strip_suffix('\r').unwrap_or(line);
         let mut units = 0usize;
         for (at, c) in line.char_indices() {

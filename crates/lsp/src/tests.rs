@@ -430,8 +430,14 @@ fn random_edits_and_requests_never_fail() {
         if rng.below(4) == 0 {
             server.analyze_changed();
         }
+        let lines = LineIndex::new(&text);
         for _ in 0..3 {
-            let position = at(&mut rng, &text);
+            let offset = rng.below(text.len() + 1);
+            let mut position = lines.position(&text, offset);
+            if rng.below(10) == 0 {
+                position =
+                    Position::new(position.line + rng.below(3) as u32, rng.below(200) as u32);
+            }
             let method = [
                 "textDocument/hover",
                 "textDocument/completion",
