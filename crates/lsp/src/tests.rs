@@ -392,6 +392,7 @@ fn random_edits_and_requests_never_fail() {
     open(&mut server, "a.scene", START);
     let mut text = START.to_string();
     let mut rng = Rng(29);
+    let mut answered: HashMap<&str, usize> = HashMap::new();
     for version in 2..600 {
         let lines = LineIndex::new(&text);
         let at = |rng: &mut Rng, text: &str| {
@@ -427,6 +428,16 @@ fn random_edits_and_requests_never_fail() {
             json!({"textDocument": {"uri": uri("a.scene"), "version": version},
                    "contentChanges": [{"range": {"start": start, "end": end}, "text": piece}]}),
         );
+        if rng.below(8) == 0 {
+            // Back to the scene that compiles, so that the syntax tree's answers (hover,
+            // definitions, the outline) are asked at random places too.
+            text = START.to_string();
+            server.notify(
+                "textDocument/didChange",
+                json!({"textDocument": {"uri": uri("a.scene"), "version": version},
+                       "contentChanges": [{"text": START}]}),
+            );
+        }
         if rng.below(4) == 0 {
             server.analyze_changed();
         }
@@ -446,12 +457,20 @@ fn random_edits_and_requests_never_fail() {
             ][rng.below(4)];
             let params = json!({"textDocument": {"uri": uri("a.scene")}, "position": position});
             let (result, _) = server.request(method, params);
+            if result
+                .as_ref()
+                .is_ok_and(|v| !v.is_null() && *v != json!([]))
+            {
+                *answered.entry(method).or_insert(0) += 1;
+            }
             assert!(
                 result.is_ok(),
                 "{method} at {position:?} after edit {version} of {text:?}"
             );
         }
     }
+    // Every kind of request was asked where it has an answer, some of the time.
+    assert_eq!(answered.len(), 4, "{answered:?}");
     // The server's text is the text the edits make.
     server.notify(
         "textDocument/didChange",
