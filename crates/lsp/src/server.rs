@@ -68,7 +68,8 @@ impl Server {
                     let mut document =
                         Document::new(&uri, p.text_document.text, p.text_document.version);
                     document.identity = document.path.as_deref().map(|p| self.files.identify(p));
-                    self.documents.insert(uri, document);
+                    self.documents.insert(uri.clone(), document);
+                    self.importers_changed(&uri);
                 }
             }
             DidChangeTextDocument::METHOD => {
@@ -81,6 +82,7 @@ impl Server {
                         // A new version gets its diagnostics, even when nothing changed.
                         document.analysis = None;
                     }
+                    self.importers_changed(&p.text_document.uri);
                 }
             }
             DidCloseTextDocument::METHOD => {
@@ -99,6 +101,27 @@ impl Server {
             _ => {}
         }
         Vec::new()
+    }
+
+    /// Marks for analysis the open documents whose last compile read the document `uri`
+    /// (they import it), so that their diagnostics follow its unsaved text.
+    fn importers_changed(&mut self, uri: &Url) {
+        let Some(path) = self.documents.get(uri).and_then(|d| d.path.clone()) else {
+            return;
+        };
+        let path = path.to_string_lossy();
+        for (other, document) in &mut self.documents {
+            let imports = document.analysis.as_ref().is_some_and(|analysis| {
+                analysis
+                    .sources
+                    .files()
+                    .skip(1)
+                    .any(|(_, file)| file.path == path)
+            });
+            if other != uri && imports {
+                document.analysis = None;
+            }
+        }
     }
 
     /// Analyses every document changed since its last analysis and returns the
@@ -131,6 +154,11 @@ impl Server {
         let mut others = Vec::new();
         for (file, diagnostics) in &analysis.diagnostics {
             let own = file == uri;
+            if !own && self.documents.contains_key(file) {
+                // An open file's diagnostics are its own compile's: an importer's view of
+                // it (where its materials are used, say) would flicker with them.
+                continue;
+            }
             if !own {
                 others.push(file.clone());
             }
@@ -141,7 +169,7 @@ impl Server {
             ));
         }
         for gone in self.published.remove(uri).unwrap_or_default() {
-            if !others.contains(&gone) {
+            if !others.contains(&gone) && !self.documents.contains_key(&gone) {
                 out.push(publish(gone, Vec::new(), None));
             }
         }

@@ -279,35 +279,61 @@ fn published_for(published: &[Notification], name: &str) -> Option<Vec<Value>> {
 }
 
 #[test]
-fn an_open_import_is_read_instead_of_the_disk_and_gets_its_diagnostics() {
+fn an_open_import_is_read_instead_of_the_disk() {
     let mut disk = Memory::default();
     disk.0.insert(
         PathBuf::from("/project/lib.scene"),
         b"material chrome { reflective 0.8 }\n".to_vec(),
     );
     let mut server = Server::new(Box::new(disk));
-    let main = "import \"lib.scene\"\nsphere { material chrome }\n";
+    // main.scene uses `steel`, which only the editor's unsaved lib.scene defines.
+    let main = "import \"lib.scene\"\nsphere { material steel }\n";
     let published = open(&mut server, "main.scene", main);
-    assert_eq!(published_for(&published, "main.scene"), Some(Vec::new()));
-    // The editor's unsaved lib.scene has a typo: main's compile reads it and reports it
-    // in lib.scene, at its place there.
-    open(
+    let errors = published_for(&published, "main.scene").expect("main's diagnostics");
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert!(errors[0]["message"]
+        .as_str()
+        .is_some_and(|m| m.starts_with("unknown name `steel`")));
+    // Nothing to say about lib.scene from main's compile (an unused material of an
+    // import is no warning).
+    assert_eq!(published_for(&published, "lib.scene"), None);
+
+    // Opening lib.scene recompiles main, which now reads the editor's text.
+    let published = open(
         &mut server,
         "lib.scene",
-        "material chrome { reflectiv 0.8 }\n",
+        "material steel { reflective 0.8 }\n",
     );
+    assert_eq!(published_for(&published, "main.scene"), Some(Vec::new()));
+    // lib.scene's diagnostics are its own compile's (where `steel` is unused), however
+    // many times main is compiled after.
+    let own = published_for(&published, "lib.scene").expect("lib's diagnostics");
+    assert_eq!(own.len(), 1, "{own:?}");
+    assert_eq!(own[0]["severity"], json!(2));
     server.notify(
         "textDocument/didChange",
         json!({"textDocument": {"uri": uri("main.scene"), "version": 2},
                "contentChanges": [{"text": main}]}),
     );
     let published = server.analyze_changed();
+    assert_eq!(published_for(&published, "main.scene"), Some(Vec::new()));
+    assert_eq!(published_for(&published, "lib.scene"), None);
+
+    // An error typed into lib.scene is reported there, at its place, and main (which
+    // imports it) is compiled again.
+    server.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": uri("lib.scene"), "version": 2},
+               "contentChanges": [{"text": "material steel { reflectiv 0.8 }\n"}]}),
+    );
+    let published = server.analyze_changed();
     let in_lib = published_for(&published, "lib.scene").expect("lib.scene's diagnostics");
     assert_eq!(in_lib.len(), 1, "{in_lib:?}");
     assert_eq!(
         in_lib[0]["range"],
-        json!({"start": {"line": 0, "character": 18}, "end": {"line": 0, "character": 27}})
+        json!({"start": {"line": 0, "character": 17}, "end": {"line": 0, "character": 26}})
     );
+    assert!(published_for(&published, "main.scene").is_some());
 }
 
 #[test]
