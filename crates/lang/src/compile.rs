@@ -319,7 +319,7 @@ impl Loading<'_> {
     }
 
     fn import(&mut self, importer: &Path, name: &str, span: Span) -> Option<FileIndex> {
-        let target = normalize(&importer.parent().unwrap_or(Path::new("")).join(name));
+        let target = crate::editor::import_target(importer, name);
         let identity = self.loader.identify(&target);
         if let Some(position) = self.stack.iter().position(|(id, _)| *id == identity) {
             let chain: Vec<String> = self.stack[position..]

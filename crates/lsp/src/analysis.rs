@@ -60,7 +60,8 @@ pub fn analyze(uri: &Url, document: &Document, mut overlay: Overlay<'_>) -> Anal
             compilation.diagnostics,
         )
     };
-    let diagnostics = convert_all(Locator::new(uri, &sources, &document.lines), &diagnostics);
+    let mut diagnostics = convert_all(Locator::new(uri, &sources, &document.lines), &diagnostics);
+    summarize_imports(uri, document, &name, &mut diagnostics);
     Analysis {
         sources,
         index,
@@ -161,4 +162,52 @@ fn message(diagnostic: &Diagnostic) -> String {
         text.push_str(&format!("\nhelp: {hint}"));
     }
     text
+}
+
+/// An error in a file the document imports is reported in that file; the document gets one
+/// error on its `import` line too, saying so and pointing there, so that a user looking at
+/// the document sees why it does not compile.
+fn summarize_imports(
+    root: &Url,
+    document: &Document,
+    name: &str,
+    by_file: &mut [(Url, Vec<LspDiagnostic>)],
+) {
+    let imports = whitted_lang::editor::cursor::imports(&document.text);
+    let mut summaries = Vec::new();
+    for (file, diagnostics) in by_file.iter().filter(|(file, _)| file != root) {
+        let errors: Vec<&LspDiagnostic> = diagnostics
+            .iter()
+            .filter(|d| d.severity == Some(DiagnosticSeverity::ERROR))
+            .collect();
+        let Some(first) = errors.first() else {
+            continue;
+        };
+        let statement = imports.iter().find(|(written, _)| {
+            let target = whitted_lang::editor::import_target(Path::new(name), written);
+            Url::from_file_path(target).is_ok_and(|target| target == *file)
+        });
+        let Some((written, span)) = statement else {
+            continue;
+        };
+        let count = match errors.len() {
+            1 => "an error".to_string(),
+            n => format!("{n} errors"),
+        };
+        let headline = first.message.lines().next().unwrap_or_default();
+        summaries.push(LspDiagnostic {
+            range: document.lines.range(&document.text, span.clone()),
+            severity: Some(DiagnosticSeverity::ERROR),
+            source: Some("whitted".to_string()),
+            message: format!("`{written}` has {count}: {headline}"),
+            related_information: Some(vec![DiagnosticRelatedInformation {
+                location: Location::new(file.clone(), first.range),
+                message: first.message.clone(),
+            }]),
+            ..LspDiagnostic::default()
+        });
+    }
+    if let Some((_, own)) = by_file.iter_mut().find(|(file, _)| file == root) {
+        own.extend(summaries);
+    }
 }

@@ -333,7 +333,21 @@ fn an_open_import_is_read_instead_of_the_disk() {
         in_lib[0]["range"],
         json!({"start": {"line": 0, "character": 17}, "end": {"line": 0, "character": 26}})
     );
-    assert!(published_for(&published, "main.scene").is_some());
+    // main.scene says so on its import line, pointing at the error.
+    let in_main = published_for(&published, "main.scene").expect("main's diagnostics");
+    assert_eq!(in_main.len(), 1, "{in_main:?}");
+    assert_eq!(
+        in_main[0]["range"],
+        json!({"start": {"line": 0, "character": 0}, "end": {"line": 0, "character": 18}})
+    );
+    let message = in_main[0]["message"].as_str().expect("a message");
+    assert!(
+        message.starts_with("`lib.scene` has an error: "),
+        "{message}"
+    );
+    let related = &in_main[0]["relatedInformation"][0]["location"];
+    assert_eq!(related["uri"], json!(uri("lib.scene")));
+    assert_eq!(related["range"], in_lib[0]["range"]);
 }
 
 #[test]

@@ -395,3 +395,25 @@ pub fn material_names(text: &str) -> Vec<String> {
     }
     names
 }
+
+/// The `import "path"` statements of `text`: each path as written, with the byte range of
+/// the whole statement.
+pub fn imports(text: &str) -> Vec<(String, std::ops::Range<usize>)> {
+    let reader = Reader {
+        text,
+        tokens: tokens(text).0,
+    };
+    let mut found = Vec::new();
+    for index in 0..reader.tokens.len() {
+        let (Some("import"), Some(path)) = (reader.word(index), reader.tokens.get(index + 1))
+        else {
+            continue;
+        };
+        let closed = path.end >= path.start + 2 && text.as_bytes()[path.end - 1] == b'"';
+        if path.class == Class::Text && closed {
+            let written = &text[path.start + 1..path.end - 1];
+            found.push((written.to_string(), reader.tokens[index].start..path.end));
+        }
+    }
+    found
+}

@@ -137,6 +137,13 @@ fn describe_kind(kind: Kind) -> String {
     }
 }
 
+/// The file an `import "name"` in the file at `importer` reads: the path the compiler asks
+/// its loader for (and names the file by in its source map).
+pub fn import_target(importer: &std::path::Path, name: &str) -> std::path::PathBuf {
+    let folder = importer.parent().unwrap_or(std::path::Path::new(""));
+    crate::compile::normalize(&folder.join(name))
+}
+
 /// The block kind opened by a statement whose first words are `words` (`sphere`,
 /// `light spot`, `camera perspective`, `settings`, `material`), if it is one that takes
 /// properties.
