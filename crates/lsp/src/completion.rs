@@ -1,6 +1,7 @@
 //! Completion that knows where it is (`whitted_lang::editor::cursor`): a block's properties
 //! (those it does not have yet, transforms always), a material's name after `material`, a
-//! property's words (`shadows` → `opaque`, `filtered`, `none`).
+//! property's words (`shadows` → `opaque`, `filtered`, `none`), and at the start of a
+//! statement the keywords and object kinds that may start one there.
 
 use lsp_types::{CompletionItem, CompletionItemKind, Documentation, MarkupContent, MarkupKind};
 use whitted_lang::editor::cursor::{self, Place};
@@ -44,6 +45,15 @@ pub fn complete(document: &Document, offset: usize) -> Vec<CompletionItem> {
             })
             .collect(),
         Place::ParentMaterial { child } => materials(document, child.as_deref()),
+        Place::Statement { statements } => statements
+            .into_iter()
+            .map(|(word, what)| CompletionItem {
+                label: word.to_string(),
+                kind: Some(CompletionItemKind::KEYWORD),
+                detail: Some(what.to_string()),
+                ..CompletionItem::default()
+            })
+            .collect(),
         Place::Other => Vec::new(),
     }
 }

@@ -159,6 +159,20 @@ fn values_offer_materials_and_words() {
 }
 
 #[test]
+fn a_statement_starts_with_a_keyword_or_an_object_kind() {
+    let top = completions("sphere { } |");
+    assert_eq!(top[..4], ["import", "settings", "camera", "light"]);
+    assert!(has(&top, "sphere") && has(&top, "group") && !has(&top, "return"));
+    assert_eq!(completions("|"), top);
+    assert_eq!(completions("let n = 3; |"), top);
+    let in_function = completions("fn f() { | }");
+    assert!(has(&in_function, "return") && has(&in_function, "sphere"));
+    assert!(!has(&in_function, "settings") && !has(&in_function, "import"));
+    let in_loop = completions("for i in 0..3 { | }");
+    assert!(!has(&in_loop, "return") && !has(&in_loop, "camera") && has(&in_loop, "box"));
+}
+
+#[test]
 fn half_typed_text_still_knows_its_block() {
     let labels = completions("camera perspective { eye <0, 0, -5> }\nsphere { rad|");
     assert!(has(&labels, "radius"), "{labels:?}");
@@ -172,14 +186,13 @@ fn half_typed_text_still_knows_its_block() {
 #[test]
 fn nothing_is_offered_where_no_property_goes() {
     for text in [
-        "|",
-        "sphere { } |",
         "sphere { center <0, | }",
         "// sphere { |",
         "sphere \"a | b\" { }",
         "sphere { radius 1 + | }",
-        "fn f() { | }",
         "blob { | }",
+        "let x = |",
+        "for i in 0..| { }",
     ] {
         assert_eq!(completions(text), Vec::<String>::new(), "{text}");
     }

@@ -20,6 +20,11 @@ pub enum Place {
         block: BlockKind,
         property: PropertyDoc,
     },
+    /// The start of a statement in a file, a function or a loop: `statements` lists what
+    /// may start one there.
+    Statement {
+        statements: Vec<(&'static str, &'static str)>,
+    },
     /// A material's name after `:` (`material tinted : glass`); `child` is the material
     /// being defined, which cannot be its own parent.
     ParentMaterial { child: Option<String> },
@@ -315,8 +320,21 @@ pub fn place_at(text: &str, offset: usize) -> Cursor {
             }
         }
     }
-    if block.is_statements() {
-        return other(word_start);
+    if let BlockKind(Context::Statements {
+        top_level,
+        in_function,
+    }) = block
+    {
+        let at_start = previous.is_none_or(|i| matches!(reader.punct(i), Some(b'}' | b';')));
+        if !at_start {
+            return other(word_start);
+        }
+        return Cursor {
+            place: Place::Statement {
+                statements: super::statement_words(top_level, in_function),
+            },
+            word_start,
+        };
     }
     match previous.map(|i| (tokens[i].class, reader.word(i))) {
         Some((Class::Word, Some(name))) => {

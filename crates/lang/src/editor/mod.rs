@@ -144,6 +144,41 @@ pub fn import_target(importer: &std::path::Path, name: &str) -> std::path::PathB
     crate::compile::normalize(&folder.join(name))
 }
 
+/// What may start a statement in a block of statements, each with a few words on it: the
+/// keywords (those only a file's top level or a function takes, there only), then every kind
+/// of object.
+pub(crate) fn statement_words(
+    top_level: bool,
+    in_function: bool,
+) -> Vec<(&'static str, &'static str)> {
+    let mut words = Vec::new();
+    if top_level {
+        words.extend([
+            (
+                "import",
+                "read another scene file's definitions and objects",
+            ),
+            ("settings", "the render's settings"),
+            ("camera", "the camera: `camera perspective { ... }`"),
+        ]);
+    }
+    words.extend([
+        ("light", "a light: `light point { ... }`"),
+        ("material", "a named material: `material glass { ... }`"),
+        ("let", "a binding that may change: `let n = 3;`"),
+        ("const", "a constant (`-D` may replace it): `const n = 3;`"),
+        ("fn", "a function: `fn ring(n) { ... }`"),
+        ("for", "a loop: `for i in 0..n { ... }`"),
+        ("while", "a loop while a condition holds"),
+        ("if", "a condition: `if x > 0 { ... } else { ... }`"),
+    ]);
+    if in_function {
+        words.push(("return", "the function's value"));
+    }
+    words.extend(ObjectTag::ALL.iter().map(|tag| (tag.name(), "an object")));
+    words
+}
+
 /// The block kind opened by a statement whose first words are `words` (`sphere`,
 /// `light spot`, `camera perspective`, `settings`, `material`), if it is one that takes
 /// properties.
