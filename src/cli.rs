@@ -41,6 +41,9 @@ pub enum Command {
     /// whitted mit6837 -input scene.txt -size 200 200 -output out.tga [-shadows] ...
     #[command(disable_help_flag = true)]
     Mit6837(Mit6837Args),
+    /// Run the language server on stdin and stdout, for editors (docs/editors.md):
+    /// diagnostics, hover, completion, go to definition and the outline.
+    Lsp,
 }
 
 /// Everything after `whitted mit6837`, read by the course's own flag rules

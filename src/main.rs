@@ -16,6 +16,7 @@ mod failure;
 mod front_end;
 mod image_output;
 mod interrupt;
+mod lsp_cmd;
 mod mit6837_cmd;
 mod query_cmd;
 mod render_cmd;
@@ -72,6 +73,7 @@ fn main() -> ExitCode {
         Command::Explain(args) => explain_cmd::explain_pixel(&args),
         Command::Debug(args) => debug_cmd::debug(&args),
         Command::Mit6837(args) => mit6837_cmd::mit6837(&args.args),
+        Command::Lsp => lsp_cmd::lsp(),
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -223,6 +223,10 @@ fn rows(dir: &Path) -> Vec<Row> {
             "no-such.scene",
         ),
         row(&["query", ok, "nonsense(("], 2, "query"),
+        // The language server takes no arguments, and a client that goes away without
+        // `exit` (here stdin is empty) is a failure: the protocol's exit code 1.
+        row(&["lsp", ok], 2, "unexpected argument"),
+        row(&["lsp"], 1, "language server"),
         // The 6.837 command line.
         row(
             &[

@@ -16,6 +16,7 @@ mod front_end_oracles;
 mod guards;
 mod json_schema;
 mod lint;
+mod lsp;
 mod mit6837;
 mod provenance;
 mod query;

@@ -21,6 +21,7 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
             "whitted-bvh",
             "whitted-tracer",
             "whitted-debugger",
+            "whitted-lsp",
             "pest",
         ],
     ),
@@ -31,6 +32,7 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
             "whitted-bvh",
             "whitted-tracer",
             "whitted-debugger",
+            "whitted-lsp",
             "pest",
             "ratatui",
         ],
@@ -42,6 +44,7 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
             "whitted-bvh",
             "whitted-tracer",
             "whitted-debugger",
+            "whitted-lsp",
             "ratatui",
         ],
     ),
@@ -54,6 +57,7 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
             "whitted-tracer",
             "whitted-explain",
             "whitted-debugger",
+            "whitted-lsp",
             "pest",
             "ratatui",
         ],
@@ -65,6 +69,7 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
             "whitted-mit6837",
             "whitted-debugger",
             "whitted-explain",
+            "whitted-lsp",
             "pest",
             "pest_derive",
             "ratatui",
@@ -78,6 +83,7 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
             "whitted-lang",
             "whitted-mit6837",
             "whitted-debugger",
+            "whitted-lsp",
             "pest",
             "pest_derive",
             "ratatui",
@@ -85,7 +91,25 @@ const FORBIDDEN: &[(&str, &[&str])] = &[
     ),
     (
         "whitted-debugger",
-        &["whitted-lang", "whitted-mit6837", "pest", "pest_derive"],
+        &[
+            "whitted-lang",
+            "whitted-mit6837",
+            "whitted-lsp",
+            "pest",
+            "pest_derive",
+        ],
+    ),
+    // The language server answers from the compiler's own tables and diagnostics; it never
+    // renders, and no library depends on it (only the binary, for `whitted lsp`).
+    (
+        "whitted-lsp",
+        &[
+            "whitted-bvh",
+            "whitted-tracer",
+            "whitted-explain",
+            "whitted-debugger",
+            "ratatui",
+        ],
     ),
 ];
 
@@ -98,6 +122,8 @@ const REQUIRED: &[(&str, &str)] = &[
     ("whitted-debugger", "whitted-tracer"),
     ("whitted-debugger", "whitted-explain"),
     ("whitted-explain", "whitted-tracer"),
+    ("whitted-lsp", "whitted-lang"),
+    ("whitted-lsp", "whitted-mit6837"),
     // The debugger explains the picked pixel (`x`) with the explain library.
     ("whitted-debugger", "whitted-explain"),
 ];

@@ -46,6 +46,7 @@ pub fn compile_file(
             Err(error) => Compilation {
                 sources: SourceMap::new(),
                 scene: None,
+                index: None,
                 work: WorkCounts::default(),
                 diagnostics: vec![Diagnostic::new(
                     Severity::Error,
@@ -156,6 +157,7 @@ where
                 return Compilation {
                     sources: SourceMap::new(),
                     scene: None,
+                    index: None,
                     work: WorkCounts::default(),
                     diagnostics: vec![Diagnostic::new(
                         Severity::Error,
@@ -180,6 +182,7 @@ where
             Ok(None) => Compilation {
                 sources: SourceMap::new(),
                 scene: None,
+                index: None,
                 work: WorkCounts::default(),
                 diagnostics: vec![Diagnostic::new(
                     Severity::Error,
@@ -316,7 +319,7 @@ impl Loading<'_> {
     }
 
     fn import(&mut self, importer: &Path, name: &str, span: Span) -> Option<FileIndex> {
-        let target = normalize(&importer.parent().unwrap_or(Path::new("")).join(name));
+        let target = crate::editor::import_target(importer, name);
         let identity = self.loader.identify(&target);
         if let Some(position) = self.stack.iter().position(|(id, _)| *id == identity) {
             let chain: Vec<String> = self.stack[position..]
@@ -518,11 +521,65 @@ fn compile_root(
         }
         let define_errors = std::mem::take(&mut resolver.diagnostics);
         diagnostics.extend(define_errors);
-        let resolver = Resolver::new(&interner, program.files.len(), &defines);
+        let mut resolver = Resolver::new(&interner, program.files.len(), &defines);
+        resolver.record_links = options.index;
         resolver.resolve_program(&mut program)
     };
     diagnostics.extend(resolve_diagnostics);
     work.name_probes = resolution.name_probes;
+    // An editor's questions are about the text as written, so the index is read off the
+    // resolved tree before evaluation consumes it.
+    let index = options
+        .index
+        .then(|| crate::editor::index::build(&program, &interner, &resolution));
+    let mut compilation = evaluate_and_validate(
+        EvaluationInput {
+            program,
+            interner,
+            resolution,
+            defines,
+            overrides,
+            sources,
+            diagnostics,
+            work,
+        },
+        loader,
+        limits,
+        max_evaluation_depth,
+    );
+    compilation.index = index;
+    compilation
+}
+
+/// What resolution leaves for evaluation.
+struct EvaluationInput {
+    program: Program,
+    interner: Interner,
+    resolution: crate::resolve::Resolution,
+    defines: Vec<Define>,
+    overrides: Vec<SettingOverride>,
+    sources: SourceMap,
+    diagnostics: Vec<Diagnostic>,
+    work: WorkCounts,
+}
+
+/// Evaluation, mesh files and validation: the phases after resolution.
+fn evaluate_and_validate(
+    input: EvaluationInput,
+    loader: &mut dyn SourceLoader,
+    limits: &Limits,
+    max_evaluation_depth: usize,
+) -> Compilation {
+    let EvaluationInput {
+        mut program,
+        interner,
+        resolution,
+        defines,
+        overrides,
+        sources,
+        mut diagnostics,
+        work,
+    } = input;
     // Evaluation runs even after resolution errors (unresolved names evaluate quietly to
     // nothing), so that one run reports every error it can find.
 
@@ -746,6 +803,7 @@ fn finish(
     Compilation {
         sources,
         scene,
+        index: None,
         diagnostics,
         work,
     }

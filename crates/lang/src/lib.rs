@@ -14,6 +14,7 @@ mod ast_dump;
 mod builtins;
 mod compile;
 mod diagnostic_text;
+pub mod editor;
 mod eval;
 mod hints;
 mod intern;
@@ -106,6 +107,9 @@ pub struct CompileOptions {
     /// rows of the property table (NAME, VALUE source text).
     pub settings: Vec<(String, String)>,
     pub limits: Limits,
+    /// Keep an [`editor::Index`] of the text (properties by block, names to definitions,
+    /// symbols) in [`Compilation::index`], for a language server.
+    pub index: bool,
 }
 
 #[derive(Debug)]
@@ -115,6 +119,9 @@ pub struct Compilation {
     pub sources: SourceMap,
     /// Some only when there are no errors (validation by whitted_ir::validate passed too).
     pub scene: Option<whitted_ir::ValidScene>,
+    /// What an editor asks about the text, when [`CompileOptions::index`] asked for it and
+    /// every file parsed (with names resolved as far as they could be).
+    pub index: Option<editor::Index>,
     /// Errors, warnings and notes, in source order within each phase.
     pub diagnostics: Vec<Diagnostic>,
     /// How much work the compilation did, counted deterministically.

@@ -487,6 +487,11 @@ pub fn accepted_named(cx: Context, name: &str) -> Option<Prop> {
         .map(|row| row.prop)
 }
 
+/// Whether `row` is the property's row for the block `cx`.
+pub fn row_accepts(row: &Row, cx: Context) -> bool {
+    row.block.accepts(cx)
+}
+
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Pass {
     Own,

@@ -84,6 +84,10 @@ pub struct Resolution {
     /// Definitions examined while defining and looking up names: a deterministic measure of
     /// the resolver's work, which must grow linearly with the number of names.
     pub name_probes: u64,
+    /// Each name that resolved to a definition in the scene, with where that definition
+    /// is: (use, definition). Kept only when [`Resolver::record_links`] is set (an editor
+    /// asks for it; a render does not pay for a million of them).
+    pub links: Vec<(Span, Span)>,
 }
 
 pub struct Resolver<'a> {
@@ -110,6 +114,8 @@ pub struct Resolver<'a> {
     /// Each property name's row in each kind of block, once looked up: a script's million
     /// statements ask the table about the same few names over and over.
     property_rows: HashMap<(Sym, Context), Option<Prop>, foldhash::fast::FixedState>,
+    /// Whether to keep [`Resolution::links`].
+    pub record_links: bool,
 }
 
 impl<'a> Resolver<'a> {
@@ -130,11 +136,20 @@ impl<'a> Resolver<'a> {
             in_progress: vec![false; file_count],
             name_probes: Cell::new(0),
             property_rows: HashMap::default(),
+            record_links: false,
         }
     }
 
     fn name(&self, sym: Sym) -> &'a str {
         self.interner.name(sym)
+    }
+
+    /// Remembers that the name at `use_span` means the definition `def` (for editors).
+    fn link(&mut self, use_span: Span, def: DefId) {
+        if self.record_links {
+            let to = self.definitions[def].span;
+            self.resolution.links.push((use_span, to));
+        }
     }
 
     fn error(&mut self, diagnostic: Diagnostic) {

@@ -19,11 +19,103 @@ impl Files for NoFiles {
     }
 }
 
+struct NoImports;
+
+impl whitted_lang::SourceLoader for NoImports {
+    fn load(&mut self, _: &std::path::Path) -> std::io::Result<Vec<u8>> {
+        Err(std::io::ErrorKind::NotFound.into())
+    }
+}
+
 fn main() {
     let statements: usize = std::env::args()
         .nth(1)
         .and_then(|n| n.parse().ok())
         .unwrap_or(100_000);
+    let text = scene(statements);
+    // What the editor's index adds to a compile: the same text with and without it.
+    for index in [false, true] {
+        let options = whitted_lang::CompileOptions {
+            index,
+            ..Default::default()
+        };
+        let started = Instant::now();
+        let compilation =
+            whitted_lang::compile_source("big.scene", &text, &mut NoImports, &options);
+        println!(
+            "compile with index {index}: {:.0} ms ({} diagnostics)",
+            ms(started),
+            compilation.diagnostics.len()
+        );
+    }
+    let uri = "file:///big.scene";
+    let mut server = Server::new(Box::new(NoFiles));
+    let started = Instant::now();
+    server.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": uri, "languageId": "whitted", "version": 1, "text": text}}),
+    );
+    server.analyze_changed();
+    println!(
+        "{statements} statements, {} bytes: open to diagnostics {:.0} ms",
+        text.len(),
+        ms(started)
+    );
+    let lines = LineIndex::new(&text);
+    // `radius 0.05` → `radius 0.06` on the last line, then back.
+    let digit = text.rfind("0.05").expect("a radius") + 3;
+    let at = lines.position(&text, digit);
+    let after = lines.position(&text, digit + 1);
+    for (version, new) in [(2, "6"), (3, "5")] {
+        let started = Instant::now();
+        server.notify(
+            "textDocument/didChange",
+            json!({"textDocument": {"uri": uri, "version": version},
+                   "contentChanges": [{"range": {"start": at, "end": after}, "text": new}]}),
+        );
+        let published = server.analyze_changed();
+        println!(
+            "didChange to diagnostics: {:.0} ms ({} notification)",
+            ms(started),
+            published.len()
+        );
+    }
+    let on_radius = text.rfind("radius").expect("radius");
+    let on_red = text.rfind("red }").expect("red");
+    for (what, method, offset) in [
+        (
+            "hover on the last `radius`",
+            "textDocument/hover",
+            on_radius,
+        ),
+        (
+            "completion in the last sphere",
+            "textDocument/completion",
+            on_radius - 1,
+        ),
+        (
+            "definition of the last `red`",
+            "textDocument/definition",
+            on_red,
+        ),
+    ] {
+        let position = lines.position(&text, offset);
+        let started = Instant::now();
+        let (result, _) = server.request(
+            method,
+            json!({"textDocument": {"uri": uri}, "position": position}),
+        );
+        println!(
+            "{what}: {:.1} ms (answered: {})",
+            ms(started),
+            result.is_ok_and(|v| !v.is_null())
+        );
+    }
+}
+
+/// The bench's literal spheres: a header, then one `sphere` statement a line at coordinates
+/// from a fixed LCG.
+fn scene(statements: usize) -> String {
     let mut text = String::from(
         "camera perspective { eye <0, 5, -60> look_at <0, 0, 0> fov 60 }\n\
          light point { position <10, 40, -30> color <1, 1, 1> }\n\
@@ -43,58 +135,7 @@ fn main() {
             "sphere {{ center <{x:.3}, {y:.3}, {z:.3}> radius 0.05 material red }}"
         );
     }
-    let uri = "file:///big.scene";
-    let mut server = Server::new(Box::new(NoFiles));
-    let started = Instant::now();
-    server.notify(
-        "textDocument/didOpen",
-        json!({"textDocument": {"uri": uri, "languageId": "whitted", "version": 1, "text": text}}),
-    );
-    server.analyze_changed();
-    println!(
-        "{statements} statements, {} bytes: open to diagnostics {:.0} ms",
-        text.len(),
-        ms(started)
-    );
-    let lines = LineIndex::new(&text);
-    let last = lines.position(&text, text.len() - 2);
-    // `radius 0.05` → `radius 0.06` on the last line, then back.
-    let radius = text.rfind("0.05").expect("a radius") + 3;
-    let at = lines.position(&text, radius);
-    for (version, digit) in [(2, "6"), (3, "5")] {
-        let started = Instant::now();
-        server.notify(
-            "textDocument/didChange",
-            json!({"textDocument": {"uri": uri, "version": version},
-                   "contentChanges": [{"range": {"start": at, "end": {"line": at.line, "character": at.character + 1}}, "text": digit}]}),
-        );
-        let published = server.analyze_changed();
-        println!(
-            "didChange to diagnostics: {:.0} ms ({} notification)",
-            ms(started),
-            published.len()
-        );
-    }
-    let on_radius = text.rfind("radius").expect("radius");
-    let on_red = text.rfind("red }").expect("red");
-    for (what, method, offset) in [
-        ("hover on the last `radius`", "textDocument/hover", on_radius),
-        ("completion in the last sphere", "textDocument/completion", on_radius - 1),
-        ("definition of the last `red`", "textDocument/definition", on_red),
-    ] {
-        let position = lines.position(&text, offset);
-        let started = Instant::now();
-        let (result, _) = server.request(
-            method,
-            json!({"textDocument": {"uri": uri}, "position": position}),
-        );
-        println!(
-            "{what}: {:.1} ms (answered: {})",
-            ms(started),
-            result.is_ok_and(|v| !v.is_null())
-        );
-    }
-    let _ = last;
+    text
 }
 
 fn ms(since: Instant) -> f64 {

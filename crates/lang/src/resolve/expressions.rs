@@ -27,6 +27,7 @@ impl Resolver<'_> {
             };
             if name.res != Res::Error {
                 self.note_use(def);
+                self.link(name.ident.span, def);
             }
             return;
         }
@@ -69,6 +70,7 @@ impl Resolver<'_> {
             match definition.function {
                 Some(id) => {
                     self.note_use(def);
+                    self.link(call.callee.span, def);
                     call.target = CallTarget::User(id);
                     let expected = program.functions.get(id).map_or(0, |f| f.params.len());
                     if expected != given {

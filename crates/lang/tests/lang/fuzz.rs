@@ -154,6 +154,8 @@ fn options() -> CompileOptions {
     CompileOptions {
         defines: Vec::new(),
         settings: Vec::new(),
+        // The editor's index is built for every fuzzed text too: it must not panic either.
+        index: true,
         limits: Limits {
             max_objects: 5_000,
             max_evaluation_steps: 20_000,
@@ -213,6 +215,31 @@ fn check_outcome(input: &str) -> Result<(), TestCaseError> {
     }
     // Rendering must cope with every span, too.
     let _ = render_diagnostics(&compilation.sources, &compilation.diagnostics, false);
+    // So must an editor's questions: the index's spans are in their files, and the cursor
+    // reader answers at every character of the text (a few, for a long one).
+    if let Some(index) = &compilation.index {
+        let spans = index
+            .blocks
+            .iter()
+            .map(|b| b.span)
+            .chain(index.links.iter().flat_map(|(from, to)| [*from, *to]));
+        for span in spans {
+            let len = compilation
+                .sources
+                .get(span.file)
+                .map_or(0, |f| f.text.len());
+            prop_assert!(
+                span.start <= span.end && span.end as usize <= len,
+                "{span:?}"
+            );
+        }
+    }
+    let step = (input.len() / 64).max(1);
+    for offset in (0..=input.len()).step_by(step) {
+        let _ = whitted_lang::editor::cursor::place_at(input, offset);
+    }
+    let _ = whitted_lang::editor::cursor::material_names(input);
+    let _ = whitted_lang::editor::cursor::imports(input);
     Ok(())
 }
 

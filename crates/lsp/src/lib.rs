@@ -1,0 +1,34 @@
+//! whitted-lsp: the language server behind `whitted lsp`: diagnostics from the compiler
+//! (the scene language, and 6.837 `.txt` scenes), hover and completion from the property
+//! table, go to definition and the outline from the resolver.
+//!
+//! The crate speaks the protocol over an lsp-server `Connection` the binary makes on stdio
+//! (`run.rs`); what each message does is [`Server`] (`server.rs`), which tests drive
+//! in-process. It reads no files itself: imports and meshes come from the editor's open
+//! documents first, then through [`Files`], which the binary implements.
+
+mod analysis;
+mod completion;
+mod documents;
+mod hover;
+mod loader;
+mod navigation;
+pub mod position;
+mod run;
+mod server;
+
+pub use run::serve;
+pub use server::{capabilities, Server};
+
+/// The files the server may read: imports and mesh files that are not open in the editor.
+pub trait Files {
+    fn read(&mut self, path: &std::path::Path) -> std::io::Result<Vec<u8>>;
+
+    /// What makes two paths the same file (see `whitted_lang::SourceLoader::identify`).
+    fn identify(&mut self, path: &std::path::Path) -> std::path::PathBuf {
+        path.to_path_buf()
+    }
+}
+
+#[cfg(test)]
+mod tests;

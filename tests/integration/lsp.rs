@@ -1,0 +1,266 @@
+//! `whitted lsp` as an editor runs it: the real binary over stdio, one whole session with
+//! exact answers (diagnostics appearing at their range and going away, hover, completion in a
+//! material block, go to definition here and into an import, the outline), and exit status 0
+//! after `shutdown` and `exit`. The Content-Length framing is written here by hand: it is the
+//! protocol, not the server under test.
+
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use lsp_types::Url;
+use serde_json::{json, Value};
+
+/// Far longer than any answer takes; a server that hangs fails the test instead of hanging it.
+const PATIENCE: Duration = Duration::from_secs(60);
+
+struct Session {
+    child: std::process::Child,
+    stdin: std::process::ChildStdin,
+    incoming: mpsc::Receiver<Value>,
+    next_id: i64,
+}
+
+impl Session {
+    fn start() -> Session {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_whitted"))
+            .arg("lsp")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .expect("whitted lsp starts");
+        let stdin = child.stdin.take().expect("stdin");
+        let stdout = child.stdout.take().expect("stdout");
+        let (sender, incoming) = mpsc::channel();
+        std::thread::spawn(move || {
+            let mut reader = BufReader::new(stdout);
+            while let Some(message) = read_message(&mut reader) {
+                if sender.send(message).is_err() {
+                    break;
+                }
+            }
+        });
+        Session {
+            child,
+            stdin,
+            incoming,
+            next_id: 0,
+        }
+    }
+
+    fn send(&mut self, message: Value) {
+        let body = message.to_string();
+        write!(self.stdin, "Content-Length: {}\r\n\r\n{body}", body.len()).expect("write");
+        self.stdin.flush().expect("flush");
+    }
+
+    fn notify(&mut self, method: &str, params: Value) {
+        self.send(json!({"jsonrpc": "2.0", "method": method, "params": params}));
+    }
+
+    /// Sends a request and returns its result, skipping notifications on the way.
+    fn request(&mut self, method: &str, params: Value) -> Value {
+        self.next_id += 1;
+        let id = self.next_id;
+        self.send(json!({"jsonrpc": "2.0", "id": id, "method": method, "params": params}));
+        loop {
+            let message = self.receive();
+            if message["id"] == json!(id) {
+                assert!(message.get("error").is_none(), "{method}: {message}");
+                return message["result"].clone();
+            }
+        }
+    }
+
+    fn receive(&mut self) -> Value {
+        self.incoming
+            .recv_timeout(PATIENCE)
+            .expect("the server answers within the time")
+    }
+
+    /// The next diagnostics published for `uri`.
+    fn diagnostics(&mut self, uri: &Url) -> Value {
+        loop {
+            let message = self.receive();
+            if message["method"] == "textDocument/publishDiagnostics"
+                && message["params"]["uri"] == json!(uri)
+            {
+                return message["params"].clone();
+            }
+        }
+    }
+}
+
+fn read_message(reader: &mut impl BufRead) -> Option<Value> {
+    let mut length = None;
+    loop {
+        let mut line = String::new();
+        if reader.read_line(&mut line).ok()? == 0 {
+            return None;
+        }
+        let line = line.trim_end();
+        if line.is_empty() {
+            break;
+        }
+        if let Some(value) = line.strip_prefix("Content-Length: ") {
+            length = value.parse::<usize>().ok();
+        }
+    }
+    let mut body = vec![0; length?];
+    reader.read_exact(&mut body).ok()?;
+    serde_json::from_slice(&body).ok()
+}
+
+fn at(uri: &Url, line: u32, character: u32) -> Value {
+    json!({"textDocument": {"uri": uri}, "position": {"line": line, "character": character}})
+}
+
+fn range(start: (u32, u32), end: (u32, u32)) -> Value {
+    json!({"start": {"line": start.0, "character": start.1},
+           "end": {"line": end.0, "character": end.1}})
+}
+
+/// Line 4 has a name with characters outside ASCII before the material's name, so its
+/// columns differ in bytes, characters and UTF-16 units (`é` is 2 bytes and 1 unit, `😀` 4
+/// bytes and 2 units).
+const MAIN: &str = "import \"lib.scene\"
+camera perspective { eye <0, 1, -5> look_at <0, 0, 0> }
+light point { position <5, 5, -5> }
+material glass { transmissive 0.9 ior 1.5 }
+sphere \"ballé😀\" { radius 1 material glass }
+sphere { center <2, 0, 0> material chrome }
+material mirror { reflective 0.9  }
+plane { normal <0, 1, 0> material mirror }
+";
+
+const LIB: &str = "material chrome { reflective 0.8 }\n";
+
+#[test]
+fn a_whole_session_over_stdio() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    std::fs::write(dir.path().join("lib.scene"), LIB).expect("lib.scene");
+    let main = Url::from_file_path(dir.path().join("main.scene")).expect("a file URI");
+    let lib = Url::from_file_path(dir.path().join("lib.scene")).expect("a file URI");
+
+    let mut session = Session::start();
+    let init = session.request("initialize", json!({"capabilities": {}}));
+    let capabilities = &init["capabilities"];
+    assert_eq!(capabilities["hoverProvider"], json!(true));
+    assert_eq!(capabilities["definitionProvider"], json!(true));
+    assert_eq!(capabilities["textDocumentSync"], json!(2));
+    session.notify("initialized", json!({}));
+
+    session.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": main, "languageId": "whitted", "version": 1, "text": MAIN}}),
+    );
+    let published = session.diagnostics(&main);
+    assert_eq!(published["version"], json!(1));
+    assert_eq!(published["diagnostics"], json!([]), "a clean scene");
+
+    // `glass` → `glas` on line 4: the name starts at byte 40, character 36, UTF-16 unit 37.
+    let glass = range((4, 37), (4, 42));
+    session.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": main, "version": 2},
+               "contentChanges": [{"range": glass, "text": "glas"}]}),
+    );
+    let published = session.diagnostics(&main);
+    assert_eq!(published["version"], json!(2));
+    let diagnostics = published["diagnostics"].as_array().expect("a list");
+    assert_eq!(diagnostics.len(), 1, "{diagnostics:?}");
+    assert_eq!(diagnostics[0]["range"], range((4, 37), (4, 41)));
+    assert_eq!(diagnostics[0]["severity"], json!(1));
+    assert_eq!(
+        diagnostics[0]["message"],
+        json!(EXPECTED_UNKNOWN_NAME),
+        "the compiler's message, label and help"
+    );
+
+    session.notify(
+        "textDocument/didChange",
+        json!({"textDocument": {"uri": main, "version": 3},
+               "contentChanges": [{"range": range((4, 37), (4, 41)), "text": "glass"}]}),
+    );
+    let published = session.diagnostics(&main);
+    assert_eq!(published["version"], json!(3));
+    assert_eq!(published["diagnostics"], json!([]), "fixed again");
+
+    // Hover on `radius` (line 4, after the name with the wide characters).
+    let hover = session.request("textDocument/hover", at(&main, 4, 21));
+    assert_eq!(
+        hover["contents"]["value"],
+        json!("**radius**: the radius\n\na value the shape checks with its other parameters; default `1` (in a sphere)")
+    );
+    assert_eq!(hover["range"], range((4, 19), (4, 25)));
+
+    // Completion in `material mirror { reflective 0.9 | }`: a material's properties but
+    // `reflective`, which it has, and nothing of a sphere's.
+    let completion = session.request("textDocument/completion", at(&main, 6, 33));
+    let labels: Vec<&str> = completion
+        .as_array()
+        .expect("a list")
+        .iter()
+        .map(|item| item["label"].as_str().expect("a label"))
+        .collect();
+    assert_eq!(labels, EXPECTED_MATERIAL_PROPERTIES);
+
+    // `glass` in the sphere goes to its definition on line 3; `chrome` into lib.scene.
+    let definition = session.request("textDocument/definition", at(&main, 4, 39));
+    assert_eq!(
+        definition,
+        json!({"uri": main, "range": range((3, 9), (3, 14))})
+    );
+    let definition = session.request("textDocument/definition", at(&main, 5, 37));
+    assert_eq!(
+        definition,
+        json!({"uri": lib, "range": range((0, 9), (0, 15))})
+    );
+
+    let outline = session.request(
+        "textDocument/documentSymbol",
+        json!({"textDocument": {"uri": main}}),
+    );
+    let names: Vec<&str> = outline
+        .as_array()
+        .expect("a list")
+        .iter()
+        .map(|symbol| symbol["name"].as_str().expect("a name"))
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "camera perspective",
+            "light point",
+            "glass",
+            "sphere \"ballé😀\"",
+            "sphere",
+            "mirror",
+            "plane"
+        ]
+    );
+
+    assert_eq!(session.request("shutdown", Value::Null), Value::Null);
+    session.notify("exit", Value::Null);
+    let status = session.child.wait().expect("the server exits");
+    assert!(status.success(), "exit status {status}");
+}
+
+const EXPECTED_UNKNOWN_NAME: &str =
+    "unknown name `glas` (nothing with this name is defined here)\nhelp: did you mean `glass`?";
+
+/// Every property of a material in the docs' order, but `reflective`, already written.
+const EXPECTED_MATERIAL_PROPERTIES: &[&str] = &[
+    "ambient",
+    "diffuse",
+    "specular",
+    "shininess",
+    "transmissive",
+    "ior",
+    "fresnel",
+    "absorption",
+    "emission",
+    "priority",
+];
