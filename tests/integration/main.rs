@@ -18,6 +18,7 @@ mod json_schema;
 mod lint;
 mod lsp;
 mod mit6837;
+mod neovim;
 mod provenance;
 mod query;
 mod ray_budget;
