@@ -25,6 +25,8 @@ usage: whitted mit6837 -input SCENE.txt -size W H [-output OUT.tga|.png|.ppm]
                        [-shadows] [-transparent_shadows] [-shade_back]
                        [-bounces N] [-weight W]
                        [-depth T0 T1 DEPTH.tga] [-normals NORMALS.tga]
+                       [-uniform_samples|-jittered_samples|-random_samples N]
+                       [-box_filter 0.5] [-stats]
 
 The MIT 6.837 (Fall 2004) ray tracer's command line, flags as the course wrote them.
 Images are 8-bit linear (colour times 255, clamped), as the course's were.
@@ -39,27 +41,27 @@ Images are 8-bit linear (colour times 255, clamped), as the course's were.
   -weight W           do not trace rays that contribute less than W (default 0)
   -depth T0 T1 F      the distance to the first hit, T0 white to T1 black
   -normals F          the first hit's normal, |x| |y| |z| as red, green, blue
+  -uniform_samples N  N samples per pixel on a regular grid (assignment 7)
+  -jittered_samples N N samples per pixel, stratified and jittered
+  -random_samples N   N samples per pixel, each anywhere in the pixel
+  -box_filter 0.5     average each pixel's own samples (what whitted does)
+  -stats              print the ray counts after the render
+  -tessellation T P, -gouraud, -grid X Y Z
+                      accepted and ignored (the course's OpenGL preview and grid)
 
 See docs/courses.md.";
 
-/// The course's flags of later assignments (OpenGL previews, grids, sampling and filters),
-/// which whitted does not have: named in their error so that it does not read as a typo.
-const LATER_ASSIGNMENTS: &[&str] = &[
-    "-gui",
-    "-tessellation",
-    "-gouraud",
-    "-grid",
-    "-visualize_grid",
-    "-stats",
-    "-random_samples",
-    "-uniform_samples",
-    "-jittered_samples",
-    "-box_filter",
-    "-tent_filter",
-    "-gaussian_filter",
-    "-render_samples",
-    "-filter_samples",
-    "-zoom_factor",
+/// The course's flags that whitted does not have yet, each with why, so that a teacher's
+/// script gets a reason rather than "unknown flag".
+const NOT_YET: &[(&str, &str)] = &[
+    ("-gui", "assignment 3's OpenGL preview window: open the scene with `whitted debug SCENE.txt` instead"),
+    ("-visualize_grid", "assignment 6's drawing of the grid cells a ray visits: whitted's acceleration structure is a BVH, not the course's grid"),
+    ("-tent_filter", "assignment 7's tent filter reaches into the neighbouring pixels' samples, which whitted does not gather yet; -box_filter 0.5 (each pixel's own samples) is what whitted does"),
+    ("-gaussian_filter", "assignment 7's gaussian filter reaches into the neighbouring pixels' samples, which whitted does not gather yet; -box_filter 0.5 (each pixel's own samples) is what whitted does"),
+    ("-render_samples", "assignment 7's picture of the sample positions is not made yet"),
+    ("-render_filter", "assignment 7's picture of the filter weights is not made yet"),
+    ("-filter_samples", "assignment 7's picture of the filter weights is not made yet"),
+    ("-zoom_factor", "it scales assignment 7's sample and filter pictures, which are not made yet"),
 ];
 
 /// A parsed command line.
@@ -77,6 +79,10 @@ pub struct CourseRun {
     /// `-depth t0 t1 file`.
     pub depth: Option<(f64, f64, PathBuf)>,
     pub normals: Option<PathBuf>,
+    /// `-stats`: print the ray counts after the render.
+    pub stats: bool,
+    /// What the command line asked that whitted accepts and ignores, said once each.
+    pub notes: Vec<String>,
 }
 
 /// Reads the course's flags. Every mistake is one message naming the flag.
@@ -87,6 +93,8 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
     let mut output = None;
     let mut depth = None;
     let mut normals = None;
+    let mut stats = false;
+    let mut notes: Vec<String> = Vec::new();
     let mut options = CourseOptions::default();
     let mut seen: Vec<String> = Vec::new();
     while let Some(word) = words.next() {
@@ -162,11 +170,58 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
                 depth = Some((near, far, image_path(value(what)?, "-depth")?));
             }
             "-normals" => normals = Some(image_path(value("an image file")?, "-normals")?),
-            later if LATER_ASSIGNMENTS.contains(&later) => {
-                return Err(format!(
-                "{later} is a flag of the course's later assignments, which whitted does not have \
-                     (see whitted mit6837 -help)"
-            ))
+            "-uniform_samples" | "-jittered_samples" | "-random_samples" => {
+                let what = "a number of samples per pixel";
+                let n = number::<u32>(&value(what)?, &flag, "count")?;
+                if !(1..=limits::MAX_SAMPLES_PER_PIXEL).contains(&n) {
+                    return Err(format!(
+                        "{flag} {n}: the samples per pixel must be from 1 to {}",
+                        limits::MAX_SAMPLES_PER_PIXEL
+                    ));
+                }
+                if seen.iter().any(|s| s.ends_with("_samples")) {
+                    return Err(format!("{flag}: give one of -uniform_samples, -jittered_samples and -random_samples"));
+                }
+                options.samples = n;
+                options.sampling = match flag.as_str() {
+                    "-uniform_samples" => whitted_ir::Sampling::Grid,
+                    "-random_samples" => whitted_ir::Sampling::Random,
+                    _ => whitted_ir::Sampling::Jittered,
+                };
+            }
+            "-box_filter" => {
+                let radius = number::<f64>(&value("a radius")?, "-box_filter", "radius")?;
+                if radius != 0.5 {
+                    return Err(format!(
+                        "-box_filter {radius}: only 0.5 (each pixel's own samples, averaged) for \
+                         now; a radius reaching into the neighbouring pixels is not gathered yet"
+                    ));
+                }
+            }
+            "-stats" => stats = true,
+            // They shape only the course's OpenGL preview, which whitted does not draw.
+            "-tessellation" => {
+                let what = "two numbers of steps (theta and phi)";
+                number::<u32>(&value(what)?, "-tessellation", "count")?;
+                number::<u32>(&value(what)?, "-tessellation", "count")?;
+                notes.push("-tessellation shapes the course's OpenGL preview only: whitted's spheres are exact".into());
+            }
+            "-gouraud" => notes.push(
+                "-gouraud shapes the course's OpenGL preview only: whitted ignores it".into(),
+            ),
+            "-grid" => {
+                let what = "three numbers of cells";
+                for _ in 0..3 {
+                    number::<u32>(&value(what)?, "-grid", "count")?;
+                }
+                notes.push("-grid: whitted accelerates with a BVH, not the course's grid; the image is the same".into());
+            }
+            later if NOT_YET.iter().any(|(name, _)| *name == later) => {
+                let why = NOT_YET
+                    .iter()
+                    .find(|(name, _)| *name == later)
+                    .map_or("", |(_, why)| why);
+                return Err(format!("{later} is not available in whitted: {why}"));
             }
             other => {
                 return Err(format!(
@@ -193,6 +248,8 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
         output,
         depth,
         normals,
+        stats,
+        notes,
     }))
 }
 
@@ -251,6 +308,9 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
             whitted_mit6837::TOP_LEVEL_KEYWORDS.join(", ")
         )));
     }
+    for note in &run.notes {
+        eprintln!("note: {note}");
+    }
     crate::interrupt::install();
     let scene_args = SceneArgs {
         scene: run.input.clone(),
@@ -263,12 +323,20 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
     let prepared = PreparedScene::new(&loaded.scene);
     let (width, height) = (options.width, options.height);
     if let Some(path) = &run.output {
-        let Some((image, _)) =
+        let Some((image, stats)) =
             whitted_tracer::render(&prepared, &options, &whitted_tracer::NoObserver)
         else {
             return Err(Failure::Message("the render was cancelled".into()));
         };
         write(path, width, height, to_linear8(&image.pixels))?;
+        if run.stats {
+            crate::scene_input::write_stdout(&course_stats(
+                &stats,
+                width,
+                height,
+                options.samples_per_pixel,
+            ))?;
+        }
     }
     if run.depth.is_some() || run.normals.is_some() {
         let hits = first_hits(&prepared, &options);
@@ -280,6 +348,39 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
         }
     }
     Ok(())
+}
+
+/// `-stats`: the ray counts of the render, per kind and per pixel, as the course's
+/// statistics listed them.
+fn course_stats(
+    stats: &whitted_tracer::RenderStats,
+    width: u32,
+    height: u32,
+    samples: u32,
+) -> String {
+    let pixels = u64::from(width) * u64::from(height);
+    let per_pixel = |n: u64| n as f64 / pixels.max(1) as f64;
+    format!(
+        "image            {width}x{height}, {samples} sample{} per pixel\n\
+         camera rays      {} ({:.2} per pixel)\n\
+         shadow rays      {} ({:.2} per pixel)\n\
+         reflected rays   {} ({:.2} per pixel)\n\
+         transmitted rays {} ({:.2} per pixel)\n\
+         total rays       {} ({:.2} per pixel)\n\
+         render           {:.3} s\n",
+        if samples == 1 { "" } else { "s" },
+        stats.camera_rays,
+        per_pixel(stats.camera_rays),
+        stats.shadow_rays,
+        per_pixel(stats.shadow_rays),
+        stats.reflected_rays,
+        per_pixel(stats.reflected_rays),
+        stats.transmitted_rays,
+        per_pixel(stats.transmitted_rays),
+        stats.total_rays(),
+        per_pixel(stats.total_rays()),
+        stats.render_seconds,
+    )
 }
 
 fn write(path: &Path, width: u32, height: u32, bytes: Vec<u8>) -> Result<(), Failure> {
@@ -413,7 +514,15 @@ mod tests {
             ),
             (
                 "-input a.txt -size 10 10 -output a.tga -gui",
-                "-gui is a flag of the course's later assignments",
+                "-gui is not available in whitted: assignment 3's OpenGL preview",
+            ),
+            (
+                "-input a.txt -size 10 10 -output a.tga -box_filter 1",
+                "-box_filter 1: only 0.5",
+            ),
+            (
+                "-input a.txt -size 10 10 -output a.tga -uniform_samples 4 -random_samples 4",
+                "give one of -uniform_samples, -jittered_samples and -random_samples",
             ),
             (
                 "-input a.txt -size 10 10 -output a.tga --shadows",
@@ -426,6 +535,31 @@ mod tests {
                 Err(message) => assert!(message.contains(expected), "{line}: {message}"),
                 Ok(request) => panic!("{line} was accepted: {request:?}"),
             }
+        }
+    }
+
+    /// Assignment 7's samplers become the sampling setting; the preview's flags are taken
+    /// and ignored with a note.
+    #[test]
+    fn the_course_s_samplers_and_preview_flags_are_read() {
+        let line = "-input a.txt -size 8 8 -output a.tga -uniform_samples 9 -box_filter 0.5 \
+                    -stats -tessellation 10 5 -gouraud -grid 10 10 10";
+        let Ok(Request::Run(run)) = parse_words(line) else {
+            panic!("{line} was refused");
+        };
+        assert_eq!(run.options.samples, 9);
+        assert_eq!(run.options.sampling, whitted_ir::Sampling::Grid);
+        assert!(run.stats);
+        assert_eq!(run.notes.len(), 3, "{:?}", run.notes);
+        for (flag, sampling) in [
+            ("-jittered_samples", whitted_ir::Sampling::Jittered),
+            ("-random_samples", whitted_ir::Sampling::Random),
+        ] {
+            let line = format!("-input a.txt -size 8 8 -output a.tga {flag} 4");
+            let Ok(Request::Run(run)) = parse_words(&line) else {
+                panic!("{line} was refused");
+            };
+            assert_eq!((run.options.samples, run.options.sampling), (4, sampling));
         }
     }
 

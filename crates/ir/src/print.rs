@@ -50,6 +50,7 @@ pub fn print(scene: &Scene) -> String {
         match s.sampling {
             crate::scene::Sampling::Jittered => "",
             crate::scene::Sampling::Grid => ", sampling grid",
+            crate::scene::Sampling::Random => ", sampling random",
         }
     );
     let c = &scene.camera;

@@ -75,6 +75,9 @@ pub enum Sampling {
     /// uniform sampler): repeatable by hand, and aliasing a fine pattern the same way in
     /// every pixel.
     Grid,
+    /// Each sample anywhere in the pixel, independently (the course's random sampler):
+    /// noisier than jittered for the same count. Hashed, so still the same on every run.
+    Random,
 }
 
 /// Render settings. Defaults live here so that the language, the CLI and tests agree.

@@ -152,18 +152,20 @@ pub const SAMPLES: SettingRow = SettingRow {
 
 pub const SAMPLING: SettingRow = SettingRow {
     name: "sampling",
-    kind: SettingKind::Word(&["jittered", "grid"]),
+    kind: SettingKind::Word(&["jittered", "grid", "random"]),
     default: "jittered",
-    doc: "where a pixel's samples fall: `jittered` (stratified, no pattern to alias) or `grid` (a regular grid, the course's uniform sampler)",
+    doc: "where a pixel's samples fall: `jittered` (stratified, no pattern to alias), `grid` (a regular grid, the course's uniform sampler) or `random` (each anywhere, the course's random sampler)",
     get: |s| {
         Some(SettingValue::Word(match s.sampling {
             Sampling::Jittered => "jittered",
             Sampling::Grid => "grid",
+            Sampling::Random => "random",
         }))
     },
     set: |s, v| {
         s.sampling = match word(v) {
             "grid" => Sampling::Grid,
+            "random" => Sampling::Random,
             _ => Sampling::Jittered,
         }
     },

@@ -116,8 +116,8 @@ fn settings(
         height: options.height,
         max_depth: options.bounces,
         min_weight: options.weight,
-        samples_per_pixel: 1,
-        sampling: whitted_ir::Sampling::Jittered,
+        samples_per_pixel: options.samples,
+        sampling: options.sampling,
         background: background.unwrap_or(DEFAULT_BACKGROUND),
         ambient: ambient.unwrap_or(Color::BLACK),
         // The error-bounded offset, not the course's fixed epsilon: it differs from the

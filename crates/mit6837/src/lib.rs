@@ -47,6 +47,10 @@ pub struct CourseOptions {
     pub bounces: u32,
     /// `-weight W`: rays contributing less than this are not traced.
     pub weight: f64,
+    /// `-uniform_samples N`, `-jittered_samples N` or `-random_samples N` (assignment 7):
+    /// samples per pixel and where they fall.
+    pub samples: u32,
+    pub sampling: whitted_ir::Sampling,
 }
 
 impl Default for CourseOptions {
@@ -59,6 +63,8 @@ impl Default for CourseOptions {
             shade_back: false,
             bounces: 0,
             weight: 0.0,
+            samples: 1,
+            sampling: whitted_ir::Sampling::Jittered,
         }
     }
 }

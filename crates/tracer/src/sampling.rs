@@ -20,6 +20,14 @@ pub fn sample_offset(x: u32, y: u32, sample: u32, samples: u32, sampling: Sampli
             correlated_multi_jitter(sample % samples, samples, pattern)
         }
         Sampling::Grid => grid(sample % samples, samples),
+        Sampling::Random => {
+            let pattern = pixel_seed(x, y);
+            let s = sample % samples;
+            (
+                random_unit(s, pattern.wrapping_mul(0x2545_f491)),
+                random_unit(s, pattern.wrapping_mul(0x9e37_79b9)),
+            )
+        }
     }
 }
 
@@ -152,6 +160,28 @@ mod tests {
         let jittered = |x, y| sample_offset(x, y, 3, 8, Sampling::Jittered);
         assert_eq!(jittered(5, 6), jittered(5, 6));
         assert_ne!(jittered(5, 6), jittered(6, 5));
+    }
+
+    /// Random samples: in the pixel, different from sample to sample and pixel to pixel,
+    /// and not stratified (two may share a row of a 2 x 2 grid, which jittered never does).
+    #[test]
+    fn random_samples_fall_anywhere_in_the_pixel() {
+        let random = |x, y, k| sample_offset(x, y, k, 16, Sampling::Random);
+        let mut shared_quadrant = false;
+        for pixel in 0..50 {
+            let offsets: Vec<_> = (0..16).map(|k| random(pixel, 3, k)).collect();
+            assert!(offsets
+                .iter()
+                .all(|(x, y)| (0.0..1.0).contains(x) && (0.0..1.0).contains(y)));
+            let quadrants: Vec<_> = offsets[..4]
+                .iter()
+                .map(|(x, y)| ((x * 2.0) as u32, (y * 2.0) as u32))
+                .collect();
+            shared_quadrant |= (0..4).any(|i| quadrants[..i].contains(&quadrants[i]));
+            assert_ne!(random(pixel, 3, 0), random(pixel + 1, 3, 0));
+        }
+        assert!(shared_quadrant, "random, not stratified");
+        assert_eq!(random(7, 7, 5), random(7, 7, 5));
     }
 
     /// The grid, worked by hand: 4 samples are the centres of a 2 x 2 grid, 8 of 2 x 4, the
