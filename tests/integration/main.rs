@@ -11,6 +11,7 @@ mod diff;
 mod exit_codes;
 mod explain;
 mod extremes;
+mod fmt;
 mod front_end_oracles;
 mod guards;
 mod json_schema;

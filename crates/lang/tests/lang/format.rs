@@ -409,3 +409,35 @@ fn fmt_keeps_the_ir_of_thousands_of_respaced_and_mutated_scenes() {
         "only {with_scene} variants compiled to a scene"
     );
 }
+
+/// A file written carelessly, with every kind of comment in awkward places, and its layout.
+const MESSY: &str = r#"// A messy scene.
+settings{width 320 height 240   background #102040}
+camera perspective {eye <0,2,-6> look_at<0 ,1,0>fov 45}   // aligned
+light point "key"{position <5,8,-5>}     /* block */ light point { position <-5, 8, -5> color 0.3 }
+
+
+
+material glass : base_glass {diffuse 0 specular 0.8 shininess 200 transmissive 0.9 ior 1.5 reflective 0.1 fresnel schlick}
+fn ring(n,r){
+for i in 0..n step 1{ sphere "bead {i}"{center <r*cos(i*360/n),0,r*sin(i*360/n)> radius 0.1
+material { diffuse -(1 - 0.5) } }
+}
+}
+fn sq(x)=x*x;
+let colours=[red,blue,];
+  // before the if
+if sq(2)>=4&&!false{group{ box{ } scale <1, 2, 1> }}else if 1<2 {disk{radius colours[0].x}}
+else{ /* empty */ }
+ring(6, 2) { translate <0, - 1, 0>   // up
+    rotate 30 about <1 , 1 , 0>
+}
+quadric { coefficients <1, 1, 1>,
+  <0, 0, 0>, <0, 0, 0>, -1 }
+"#;
+
+#[test]
+fn fmt_lays_out_a_messy_file() {
+    let formatted = format_checked("messy.scene", MESSY).expect("the messy file parses");
+    insta::assert_snapshot!(formatted);
+}
