@@ -209,7 +209,14 @@ fn fmt_keeps_the_ir_of_every_repository_scene() {
         };
         // Scenes the tests keep broken on purpose are refused; the rest are formatted. The
         // fuzzer's finds are formatted but not compiled: some take seconds by design.
-        if format_checked(&name, &text).is_none() || name.contains("fuzz-regressions") {
+        if format_checked(&name, &text).is_none() {
+            assert!(
+                compile_file(file, &mut Loader { formatted: false }, &options).has_errors(),
+                "{name} compiles, but the formatter refused it"
+            );
+            continue;
+        }
+        if name.contains("fuzz-regressions") {
             continue;
         }
         let before = compile_file(file, &mut Loader { formatted: false }, &options);
@@ -238,18 +245,17 @@ fn fmt_keeps_the_ir_of_every_docs_example() {
 /// The text and its formatted form compile alike (scene or diagnostics).
 fn check_same_ir(name: &str, text: &str) -> bool {
     let Some(formatted) = format_checked(name, text) else {
+        let mut loader = MapLoader {
+            files: HashMap::new(),
+        };
+        let compiled = compile_source("example.scene", text, &mut loader, &small_limits());
+        assert!(
+            compiled.has_errors(),
+            "{name} compiles, but the formatter refused it"
+        );
         return false;
     };
-    // A mutation can leave a loop without its end: the same small budgets on both sides
-    // keep such a text quick, and it must stop the same way after formatting.
-    let options = CompileOptions {
-        limits: Limits {
-            max_evaluation_steps: 100_000,
-            max_objects: 20_000,
-            ..Limits::default()
-        },
-        ..CompileOptions::default()
-    };
+    let options = small_limits();
     let mut loader = MapLoader {
         files: HashMap::new(),
     };
@@ -261,6 +267,19 @@ fn check_same_ir(name: &str, text: &str) -> bool {
         "{name}: formatting changed what it compiles to\n--- before\n{text}\n--- after\n{formatted}"
     );
     before.scene.is_some()
+}
+
+/// A mutation can leave a loop without its end: the same small budgets on both sides keep
+/// such a text quick, and it must stop the same way after formatting.
+fn small_limits() -> CompileOptions {
+    CompileOptions {
+        limits: Limits {
+            max_evaluation_steps: 100_000,
+            max_objects: 20_000,
+            ..Limits::default()
+        },
+        ..CompileOptions::default()
+    }
 }
 
 /// A tiny fixed-seed generator (splitmix64), so every run checks the same variants.
