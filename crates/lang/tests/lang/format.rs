@@ -345,11 +345,9 @@ fn respace(text: &str, rng: &mut Rng) -> String {
             in_line_comment = true;
         } else if rest.starts_with("/*") {
             in_block_comment = true;
-        } else if c == ' ' || c == '\n' {
-            if rng.below(4) == 0 {
-                out.push_str(GAPS[rng.below(GAPS.len())]);
-                continue;
-            }
+        } else if (c == ' ' || c == '\n') && rng.below(4) == 0 {
+            out.push_str(GAPS[rng.below(GAPS.len())]);
+            continue;
         }
         out.push(c);
     }
