@@ -454,6 +454,12 @@ impl<'a> Printer<'a> {
         self.tokens[k].kind == Kind::Punct && self.source(k) == "{"
     }
 
+    /// Whether the last entry of a block is a block comment (after which `}` may follow on
+    /// the same line, as it could not after a line comment).
+    fn last_is_block_comment(&self, block: &BlockNode) -> bool {
+        matches!(block.entries.last(), Some(Entry::Comment(k)) if self.tokens[*k].kind == Kind::BlockComment)
+    }
+
     /// A block over several lines; `{` is already printed.
     fn block(&mut self, block: &BlockNode, depth: usize) {
         if block.entries.is_empty() {
@@ -470,6 +476,11 @@ impl<'a> Printer<'a> {
             self.out.push_str(&space);
             self.out.push_str(self.source(*k));
             rest = tail;
+        }
+        if rest.is_empty() && !self.out.ends_with('\n') && self.last_is_block_comment(block) {
+            // `{ /* nothing yet */ }`: nothing needs a line of its own.
+            self.out.push_str(" }");
+            return;
         }
         if !rest.is_empty() {
             self.newline(depth + 1);
