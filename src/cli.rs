@@ -36,6 +36,9 @@ pub enum Command {
     Query(QueryArgs),
     /// Explore a scene in the terminal: pick a pixel, walk its ray tree, see the source.
     Debug(DebugArgs),
+    /// Lay scene files out in the one canonical way, in place (comments kept, meaning
+    /// unchanged); with --check, change nothing and show what would change.
+    Fmt(FmtArgs),
     /// Run the MIT 6.837 course's command line, flags as it wrote them (see -help).
     ///
     /// whitted mit6837 -input scene.txt -size 200 200 -output out.tga [-shadows] ...
@@ -44,6 +47,17 @@ pub enum Command {
     /// Run the language server on stdin and stdout, for editors (docs/editors.md):
     /// diagnostics, hover, completion, go to definition and the outline.
     Lsp,
+}
+
+#[derive(Args)]
+pub struct FmtArgs {
+    /// The .scene files to format in place, or folders to format every .scene file in;
+    /// `-` or none: read standard input and write the formatted text to standard output.
+    pub files: Vec<PathBuf>,
+    /// Write nothing: print a diff of every change formatting would make, and exit 1 if
+    /// there is one.
+    #[arg(long)]
+    pub check: bool,
 }
 
 /// Everything after `whitted mit6837`, read by the course's own flag rules

@@ -13,6 +13,7 @@ mod debug_cmd;
 mod diff_cmd;
 mod explain_cmd;
 mod failure;
+mod fmt_cmd;
 mod front_end;
 mod image_output;
 mod interrupt;
@@ -72,6 +73,7 @@ fn main() -> ExitCode {
         Command::Query(args) => query_cmd::query(&args),
         Command::Explain(args) => explain_cmd::explain_pixel(&args),
         Command::Debug(args) => debug_cmd::debug(&args),
+        Command::Fmt(args) => fmt_cmd::fmt(&args),
         Command::Mit6837(args) => mit6837_cmd::mit6837(&args.args),
         Command::Lsp => lsp_cmd::lsp(),
     });

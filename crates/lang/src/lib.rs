@@ -5,7 +5,8 @@
 //! (`lexical`); the pest grammar (`grammar/scene.pest`) and the tree it builds (`parser`,
 //! `ast`); name resolution and static checks (`resolve`); evaluation straight into the IR
 //! (`eval`); and the IR validator. [`compile_file`] runs them all; [`render_diagnostics`]
-//! (`diagnostic_text`) turns the result into rustc-style text. The library never touches the
+//! (`diagnostic_text`) turns the result into rustc-style text; [`format_source`] (`format`)
+//! lays a file out in the canonical way, `whitted fmt`. The library never touches the
 //! disk (imports go through a [`SourceLoader`]) and never prints.
 
 mod ast;
@@ -16,6 +17,7 @@ mod compile;
 mod diagnostic_text;
 pub mod editor;
 mod eval;
+mod format;
 mod hints;
 mod intern;
 mod lexical;
@@ -34,6 +36,7 @@ pub use whitted_ir::{Diagnostic, SourceMap};
 
 pub use compile::{compile_bytes, compile_file, compile_source};
 pub use diagnostic_text::render_diagnostics;
+pub use format::{format_source, FormatFailure};
 
 /// Supplies file contents for the root file and for imports; the library never touches the
 /// disk.

@@ -7,6 +7,7 @@ mod constructs;
 mod docs;
 mod errors;
 mod exporter_scale;
+mod format;
 mod fuzz;
 mod limits;
 mod material_colors;
