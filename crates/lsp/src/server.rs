@@ -13,7 +13,7 @@ use lsp_types::notification::{
     PublishDiagnostics,
 };
 use lsp_types::request::{
-    Completion, DocumentSymbolRequest, GotoDefinition, HoverRequest, Request as _,
+    Completion, DocumentSymbolRequest, Formatting, GotoDefinition, HoverRequest, Request as _,
 };
 use lsp_types::{
     CompletionOptions, CompletionResponse, DocumentSymbolResponse, GotoDefinitionResponse,
@@ -37,6 +37,7 @@ pub fn capabilities() -> ServerCapabilities {
         completion_provider: Some(CompletionOptions::default()),
         definition_provider: Some(OneOf::Left(true)),
         document_symbol_provider: Some(OneOf::Left(true)),
+        document_formatting_provider: Some(OneOf::Left(true)),
         ..ServerCapabilities::default()
     }
 }
@@ -223,6 +224,10 @@ impl Server {
                     None => Err(invalid_params()),
                 }
             }
+            Formatting::METHOD => match parse::<lsp_types::DocumentFormattingParams>(params) {
+                Some(p) => to_value(self.documents.get(&p.text_document.uri).and_then(format)),
+                None => Err(invalid_params()),
+            },
             _ => Err(ResponseError {
                 code: ErrorCode::MethodNotFound as i32,
                 message: format!("whitted lsp does not handle `{method}`"),
@@ -249,6 +254,28 @@ impl Server {
                 (document, uri, offset)
             }))
     }
+}
+
+/// `whitted fmt` on the document as the editor has it: one edit replacing the whole text
+/// (none when it is formatted already). A document that does not parse, or a 6.837 scene
+/// (the formatter knows only the scene language), gets no answer: its diagnostics say why.
+fn format(document: &Document) -> Option<Vec<lsp_types::TextEdit>> {
+    if whitted_mit6837::is_mit6837(document.text.as_bytes()) {
+        return None;
+    }
+    let name = document
+        .path
+        .as_ref()
+        .map_or("document.scene".to_string(), |p| p.display().to_string());
+    let formatted = whitted_lang::format_source(&name, &document.text).ok()?;
+    if formatted == document.text {
+        return Some(Vec::new());
+    }
+    let whole = document.lines.range(&document.text, 0..document.text.len());
+    Some(vec![lsp_types::TextEdit {
+        range: whole,
+        new_text: formatted,
+    }])
 }
 
 fn to_value<T: serde::Serialize>(value: T) -> Result<Value, ResponseError> {

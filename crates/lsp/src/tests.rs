@@ -532,3 +532,39 @@ fn random_edits_and_requests_never_fail() {
     let published = server.analyze_changed();
     assert!(published_for(&published, "a.scene").is_some());
 }
+
+/// Formatting is `whitted fmt` on the editor's text: one edit over the whole document,
+/// none when it is formatted already, and no answer for text that does not parse.
+#[test]
+fn formatting_is_whitted_fmt_on_the_editors_text() {
+    let mut server = Server::new(Box::new(Memory::default()));
+    let messy = "material m {diffuse 0.5}\nsphere {   radius 2 material m }\n";
+    open(&mut server, "messy.scene", messy);
+    let params = |name: &str| json!({"textDocument": {"uri": uri(name)}, "options": {"tabSize": 4, "insertSpaces": true}});
+    let edits = request(
+        &mut server,
+        "textDocument/formatting",
+        params("messy.scene"),
+    );
+    let expected = whitted_lang::format_source("messy.scene", messy).expect("formats");
+    assert_ne!(expected, messy);
+    assert_eq!(edits[0]["newText"], expected.as_str());
+    assert_eq!(
+        edits[0]["range"]["start"],
+        json!({"line": 0, "character": 0})
+    );
+    assert_eq!(edits[0]["range"]["end"], json!({"line": 2, "character": 0}));
+    assert_eq!(edits.as_array().map(Vec::len), Some(1));
+
+    open(&mut server, "tidy.scene", &expected);
+    let none = request(&mut server, "textDocument/formatting", params("tidy.scene"));
+    assert_eq!(none, json!([]));
+
+    open(&mut server, "broken.scene", "sphere { radius = 1 }\n");
+    let refused = request(
+        &mut server,
+        "textDocument/formatting",
+        params("broken.scene"),
+    );
+    assert_eq!(refused, Value::Null);
+}
