@@ -375,3 +375,18 @@ pub fn material_named(scene: &Scene, name: &str) -> Handle<Material> {
         None => panic!("no material `{name}` in the test scene"),
     }
 }
+
+/// An app on Whitted's scene whose glass-sphere pixel has been picked and traced, as after
+/// pressing Enter on it.
+pub fn picked_app() -> crate::app::App {
+    let mut app = crate::app::App::new(
+        "scenes/whitted.scene".into(),
+        crate::app::LoadedScene::new(whitted_scene()),
+        ratatui::layout::Rect::new(0, 0, 120, 40),
+        "/tmp/out".into(),
+    );
+    app.cursor = GLASS_PIXEL;
+    crate::update::update(&mut app, crate::action::Action::TraceCursor);
+    finish_trace(&mut app);
+    app
+}

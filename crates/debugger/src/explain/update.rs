@@ -68,23 +68,9 @@ pub fn go(app: &mut App) {
 mod tests {
     use super::*;
     use crate::action::Action;
-    use crate::app::LoadedScene;
-    use crate::test_scene::{finish_trace, whitted_scene, GLASS_PIXEL};
-    use crate::update::update;
-    use ratatui::layout::Rect;
 
-    fn picked_app() -> App {
-        let mut app = App::new(
-            "scenes/whitted.scene".into(),
-            LoadedScene::new(whitted_scene()),
-            Rect::new(0, 0, 120, 40),
-            "/tmp/out".into(),
-        );
-        app.cursor = GLASS_PIXEL;
-        update(&mut app, Action::TraceCursor);
-        finish_trace(&mut app);
-        app
-    }
+    use crate::test_scene::{finish_trace, picked_app, GLASS_PIXEL};
+    use crate::update::update;
 
     #[test]
     fn the_trace_worker_explains_the_tree_it_recorded() {

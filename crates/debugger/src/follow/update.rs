@@ -72,22 +72,9 @@ mod tests {
     use super::*;
     use crate::action::Action;
     use crate::app::LoadedScene;
-    use crate::test_scene::{finish_trace, whitted_scene, GLASS_PIXEL};
+    use crate::test_scene::{picked_app, whitted_scene};
     use crate::update::update;
     use ratatui::layout::Rect;
-
-    fn picked_app() -> App {
-        let mut app = App::new(
-            "scenes/whitted.scene".into(),
-            LoadedScene::new(whitted_scene()),
-            Rect::new(0, 0, 120, 40),
-            "/tmp/out".into(),
-        );
-        app.cursor = GLASS_PIXEL;
-        update(&mut app, Action::TraceCursor);
-        finish_trace(&mut app);
-        app
-    }
 
     #[test]
     fn follow_keys_without_a_tree_say_how_to_get_one() {
