@@ -433,6 +433,14 @@ impl Reshader<'_> {
         // Local illumination.
         let mut local =
             c(&m.ambient) * c(&self.scene.settings.ambient) * c(&m.diffuse) + c(&m.emission);
+        let settings = &self.scene.settings;
+        if !settings.shade_back && !settings.back_ambient && !hit.front_face {
+            // The handout's back face: its own colour is black.
+            local = DVec3::ZERO;
+        }
+        // Without the N·L gate (the course's Phong), a light behind the surface still
+        // counts when the material has a highlight.
+        let gated = settings.highlight_gate || c(&m.specular) == DVec3::ZERO;
         let lights = node.local.as_ref().map_or(&[][..], |l| &l.lights[..]);
         if lights.len() != self.scene.lights.len() {
             self.problem(path, format!("{} light entries", lights.len()));
@@ -464,7 +472,7 @@ impl Reshader<'_> {
                 if shadow.is_some() {
                     self.problem(path, "a shadow ray with shadows none".into());
                 }
-                if n_dot_l > 0.0 && strength > 0.0 {
+                if (n_dot_l > 0.0 || !gated) && strength > 0.0 {
                     local += self.light_terms(light, fatt * spot, DVec3::ONE, (n, l, d), &m);
                 }
                 continue;
@@ -472,7 +480,7 @@ impl Reshader<'_> {
             let Some(shadow) = shadow else {
                 // No shadow ray: right when the light cannot count here (or, as a shortcut
                 // some tracers take, when the material has no diffuse or specular term).
-                let counts = n_dot_l > KNIFE_EDGE && strength > KNIFE_EDGE;
+                let counts = (n_dot_l > KNIFE_EDGE || !gated) && strength > KNIFE_EDGE;
                 if counts && (kd != DVec3::ZERO || ks != DVec3::ZERO) {
                     self.problem(
                         path,
@@ -484,7 +492,7 @@ impl Reshader<'_> {
                 }
                 continue;
             };
-            if n_dot_l < -KNIFE_EDGE || strength == 0.0 {
+            if (n_dot_l < -KNIFE_EDGE && gated) || strength == 0.0 {
                 self.problem(
                     path,
                     format!(

@@ -26,8 +26,8 @@ pub use print::print;
 pub use provenance::{ArgValue, FrameId, Provenance, Site, SiteId, SiteKind, Step};
 pub use scene::{
     Attenuation, Camera, Color, CsgOp, Fresnel, Highlight, Light, LightKind, Material, Object,
-    ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, Sampling, Scene,
-    SceneFormat, Settings, ShadowMode, Shape, WorldFromObject,
+    ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, SamplePosition, Sampling,
+    Scene, SceneFormat, Settings, ShadowMode, Shape, WorldFromObject,
 };
 pub use source::{FileId, LineCol, SourceFile, SourceMap, Span};
 pub use validate::{validate, InvalidScene, ValidScene};

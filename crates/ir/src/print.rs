@@ -53,6 +53,17 @@ pub fn print(scene: &Scene) -> String {
             crate::scene::Sampling::Random => ", sampling random",
         }
     );
+    // The course's rules and the student-bug switches: a line only when one leaves its
+    // default, so that dumps of ordinary scenes read as before.
+    let defaults = crate::scene::Settings::default();
+    let changed: Vec<String> = crate::setting_rows::SWITCHES
+        .iter()
+        .filter(|row| (row.get)(s) != (row.get)(&defaults))
+        .map(|row| format!("{} {}", row.name, row.text(s)))
+        .collect();
+    if !changed.is_empty() {
+        let _ = writeln!(out, "  {}", changed.join(", "));
+    }
     let c = &scene.camera;
     let projection = match c.projection {
         Projection::Perspective {

@@ -112,6 +112,42 @@ pub struct Settings {
     /// to at most 1 (so that no bounce returns more light than arrives). MIT 6.837 adds
     /// `reflective·trace + transparent·trace` as given.
     pub energy_clamp: bool,
+    /// With `shade_back` off, whether a surface seen from its back keeps its ambient and
+    /// emission terms. When false its own colour is black (MIT 6.837's handout); its
+    /// reflected and transmitted rays stay either way.
+    pub back_ambient: bool,
+    /// Whether a light behind the surface (N·L <= 0) adds no highlight. MIT 6.837's Phong
+    /// adds `ks·(N·H)^n` whatever N·L is.
+    pub highlight_gate: bool,
+    /// Where in its pixel a single sample (and the pattern of several) is placed.
+    pub sample_position: SamplePosition,
+    /// Whether a surface hit from its back has its normal turned to face the ray before
+    /// shading and bouncing. False is the classic student bug (a normal never flipped
+    /// inside a solid), kept as a switch so that `whitted grade` can render it.
+    pub flip_normals: bool,
+    /// Whether a ray leaving a solid uses the inverted ratio of indices (ior → 1). False is
+    /// the classic bug of refracting out of glass as if entering it.
+    pub exit_ior_inverted: bool,
+    /// Whether total internal reflection stops the transmitted ray. False is the classic
+    /// bug of tracing it anyway: its direction is the square root of a negative number, so
+    /// it meets nothing and returns the background.
+    pub total_internal_reflection: bool,
+    /// Whether point and spot lights fade with distance (their `attenuation`); false: every
+    /// light at full colour everywhere (a student's missing attenuation).
+    pub light_falloff: bool,
+    /// A Fresnel rule for every material, replacing each material's own; `None`: each its own.
+    pub fresnel_rule: Option<Fresnel>,
+}
+
+/// Where a pixel's samples are placed relative to the pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SamplePosition {
+    /// One sample at the pixel's centre; a pattern of several spread over the pixel.
+    Centre,
+    /// Everything half a pixel up and to the left: one sample at the pixel's corner, as a
+    /// tracer that maps pixel `i` to `i / width` does.
+    Corner,
 }
 
 impl Default for Settings {
@@ -131,6 +167,14 @@ impl Default for Settings {
             shade_back: true,
             attenuation_clamp: true,
             energy_clamp: true,
+            back_ambient: true,
+            highlight_gate: true,
+            sample_position: SamplePosition::Centre,
+            flip_normals: true,
+            exit_ior_inverted: true,
+            total_internal_reflection: true,
+            light_falloff: true,
+            fresnel_rule: None,
         }
     }
 }

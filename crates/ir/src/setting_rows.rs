@@ -13,7 +13,7 @@
 //! the kind, default and doc from the row); then give it meaning in the tracer.
 
 use crate::limits::{self, MAX_INTENSITY};
-use crate::scene::{Color, Highlight, Sampling, Settings, ShadowMode};
+use crate::scene::{Color, Fresnel, Highlight, SamplePosition, Sampling, Settings, ShadowMode};
 
 /// The value a setting takes, with its range.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -192,12 +192,12 @@ pub const AMBIENT: SettingRow = SettingRow {
 pub const EPSILON: SettingRow = SettingRow {
     name: "epsilon",
     kind: SettingKind::Number {
-        min: limits::MIN_SIZE,
+        min: 0.0,
         open: false,
         max: 1.0,
     },
     default: "automatic",
-    doc: "how far off a surface secondary rays start",
+    doc: "how far off a surface secondary rays start (0: not at all, the classic shadow acne)",
     get: |s| s.epsilon.map(SettingValue::Number),
     set: |s, v| s.epsilon = Some(number(v)),
 };
@@ -269,6 +269,106 @@ pub const ENERGY_CLAMP: SettingRow = SettingRow {
     set: |s, v| s.energy_clamp = word(v) != "off",
 };
 
+pub const BACK_AMBIENT: SettingRow = SettingRow {
+    name: "back_ambient",
+    kind: SettingKind::Word(ON_OFF),
+    default: "on",
+    doc: "with `shade_back off`, whether a surface seen from its back keeps its ambient and emission (`off`: black but for its reflected and transmitted rays)",
+    get: |s| Some(on_off(s.back_ambient)),
+    set: |s, v| s.back_ambient = word(v) != "off",
+};
+
+pub const HIGHLIGHT_GATE: SettingRow = SettingRow {
+    name: "highlight_gate",
+    kind: SettingKind::Word(ON_OFF),
+    default: "on",
+    doc: "whether a light behind the surface (N·L <= 0) adds no highlight (`off`: the highlight whatever N·L is)",
+    get: |s| Some(on_off(s.highlight_gate)),
+    set: |s, v| s.highlight_gate = word(v) != "off",
+};
+
+pub const SAMPLE_POSITION: SettingRow = SettingRow {
+    name: "sample_position",
+    kind: SettingKind::Word(&["centre", "corner"]),
+    default: "centre",
+    doc: "where a pixel's one sample falls: its centre, or its corner (every sample half a pixel up and left)",
+    get: |s| {
+        Some(SettingValue::Word(match s.sample_position {
+            SamplePosition::Centre => "centre",
+            SamplePosition::Corner => "corner",
+        }))
+    },
+    set: |s, v| {
+        s.sample_position = match word(v) {
+            "corner" => SamplePosition::Corner,
+            _ => SamplePosition::Centre,
+        }
+    },
+};
+
+pub const FLIP_NORMALS: SettingRow = SettingRow {
+    name: "flip_normals",
+    kind: SettingKind::Word(ON_OFF),
+    default: "on",
+    doc: "whether a surface hit from its back has its normal turned to face the ray (`off`: the classic bug, for `whitted grade`)",
+    get: |s| Some(on_off(s.flip_normals)),
+    set: |s, v| s.flip_normals = word(v) != "off",
+};
+
+pub const EXIT_IOR: SettingRow = SettingRow {
+    name: "exit_ior",
+    kind: SettingKind::Word(&["inverted", "uninverted"]),
+    default: "inverted",
+    doc: "the indices a ray leaving a solid refracts with: `inverted` (ior to 1), or `uninverted` (1 to ior, the classic bug)",
+    get: |s| {
+        Some(SettingValue::Word(if s.exit_ior_inverted {
+            "inverted"
+        } else {
+            "uninverted"
+        }))
+    },
+    set: |s, v| s.exit_ior_inverted = word(v) != "uninverted",
+};
+
+pub const TOTAL_INTERNAL_REFLECTION: SettingRow = SettingRow {
+    name: "total_internal_reflection",
+    kind: SettingKind::Word(ON_OFF),
+    default: "on",
+    doc: "whether total internal reflection stops the transmitted ray (`off`: the classic bug, it is traced anyway and returns the background)",
+    get: |s| Some(on_off(s.total_internal_reflection)),
+    set: |s, v| s.total_internal_reflection = word(v) != "off",
+};
+
+pub const LIGHT_FALLOFF: SettingRow = SettingRow {
+    name: "light_falloff",
+    kind: SettingKind::Word(ON_OFF),
+    default: "on",
+    doc: "whether point and spot lights fade with distance as their `attenuation` says (`off`: full colour everywhere)",
+    get: |s| Some(on_off(s.light_falloff)),
+    set: |s, v| s.light_falloff = word(v) != "off",
+};
+
+pub const FRESNEL_RULE: SettingRow = SettingRow {
+    name: "fresnel_rule",
+    kind: SettingKind::Word(&["material", "off", "schlick", "exact"]),
+    default: "material",
+    doc: "the Fresnel rule of every material (`material`: each its own `fresnel`)",
+    get: |s| {
+        Some(SettingValue::Word(match s.fresnel_rule {
+            None => "material",
+            Some(f) => f.name(),
+        }))
+    },
+    set: |s, v| {
+        s.fresnel_rule = match word(v) {
+            "off" => Some(Fresnel::Off),
+            "schlick" => Some(Fresnel::Schlick),
+            "exact" => Some(Fresnel::Exact),
+            _ => None,
+        }
+    },
+};
+
 /// Every setting, in the order the docs list them.
 pub const SETTINGS: &[SettingRow] = &[
     WIDTH,
@@ -285,6 +385,27 @@ pub const SETTINGS: &[SettingRow] = &[
     SHADE_BACK,
     ATTENUATION_CLAMP,
     ENERGY_CLAMP,
+    BACK_AMBIENT,
+    HIGHLIGHT_GATE,
+    SAMPLE_POSITION,
+    FLIP_NORMALS,
+    EXIT_IOR,
+    TOTAL_INTERNAL_REFLECTION,
+    LIGHT_FALLOFF,
+    FRESNEL_RULE,
+];
+
+/// The rules where the MIT 6.837 course's model and whitted's differ, and the switches
+/// that render a classic student bug (`whitted grade`): every setting after the clamps.
+pub const SWITCHES: &[SettingRow] = &[
+    BACK_AMBIENT,
+    HIGHLIGHT_GATE,
+    SAMPLE_POSITION,
+    FLIP_NORMALS,
+    EXIT_IOR,
+    TOTAL_INTERNAL_REFLECTION,
+    LIGHT_FALLOFF,
+    FRESNEL_RULE,
 ];
 
 /// The row of the setting called `name`.
@@ -535,7 +656,7 @@ mod tests {
         );
         assert_eq!(
             setting("epsilon").map(|r| r.kind.range_in_words()),
-            Some("a number from 1e-9 to 1".to_string())
+            Some("a number from 0 to 1".to_string())
         );
     }
 

@@ -113,9 +113,11 @@ impl Checker {
                 span,
             );
         }
-        if let Some(epsilon) = s.epsilon.filter(|e| !(e.is_finite() && *e > 0.0)) {
+        // 0 is allowed: no offset at all, the classic acne (a student bug `whitted grade`
+        // renders).
+        if let Some(epsilon) = s.epsilon.filter(|e| !(e.is_finite() && *e >= 0.0)) {
             self.error(
-                format!("the surface offset epsilon must be > 0, not {epsilon}"),
+                format!("the surface offset epsilon must be >= 0, not {epsilon}"),
                 span,
             );
         }

@@ -242,6 +242,30 @@ properties! {
     EnergyClamp "energy_clamp" {
         Settings => setting_kind(&S::ENERGY_CLAMP), S::ENERGY_CLAMP.default, S::ENERGY_CLAMP.doc;
     }
+    BackAmbient "back_ambient" {
+        Settings => setting_kind(&S::BACK_AMBIENT), S::BACK_AMBIENT.default, S::BACK_AMBIENT.doc;
+    }
+    HighlightGate "highlight_gate" {
+        Settings => setting_kind(&S::HIGHLIGHT_GATE), S::HIGHLIGHT_GATE.default, S::HIGHLIGHT_GATE.doc;
+    }
+    SamplePosition "sample_position" {
+        Settings => setting_kind(&S::SAMPLE_POSITION), S::SAMPLE_POSITION.default, S::SAMPLE_POSITION.doc;
+    }
+    FlipNormals "flip_normals" {
+        Settings => setting_kind(&S::FLIP_NORMALS), S::FLIP_NORMALS.default, S::FLIP_NORMALS.doc;
+    }
+    ExitIor "exit_ior" {
+        Settings => setting_kind(&S::EXIT_IOR), S::EXIT_IOR.default, S::EXIT_IOR.doc;
+    }
+    TotalInternalReflection "total_internal_reflection" {
+        Settings => setting_kind(&S::TOTAL_INTERNAL_REFLECTION), S::TOTAL_INTERNAL_REFLECTION.default, S::TOTAL_INTERNAL_REFLECTION.doc;
+    }
+    LightFalloff "light_falloff" {
+        Settings => setting_kind(&S::LIGHT_FALLOFF), S::LIGHT_FALLOFF.default, S::LIGHT_FALLOFF.doc;
+    }
+    FresnelRule "fresnel_rule" {
+        Settings => setting_kind(&S::FRESNEL_RULE), S::FRESNEL_RULE.default, S::FRESNEL_RULE.doc;
+    }
     Position "position" {
         Light(POSITIONED) => Vector, "", "where the light is";
     }

@@ -135,6 +135,12 @@ fn settings(
         attenuation_clamp: false,
         // The course adds `reflectiveColor·trace + transparentColor·trace` as given.
         energy_clamp: false,
+        // Without `-shade_back` the handout colours a surface seen from behind black.
+        back_ambient: false,
+        // The course's Phong adds the highlight whatever N·L is.
+        highlight_gate: false,
+        sample_position: options.sample_position,
+        ..Settings::default()
     }
 }
 

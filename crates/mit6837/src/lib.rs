@@ -51,6 +51,9 @@ pub struct CourseOptions {
     /// samples per pixel and where they fall.
     pub samples: u32,
     pub sampling: whitted_ir::Sampling,
+    /// Where a pixel's sample falls (the handouts do not say; whitted's flag
+    /// `-sample_position corner` picks the corner).
+    pub sample_position: whitted_ir::SamplePosition,
 }
 
 impl Default for CourseOptions {
@@ -65,6 +68,7 @@ impl Default for CourseOptions {
             weight: 0.0,
             samples: 1,
             sampling: whitted_ir::Sampling::Jittered,
+            sample_position: whitted_ir::SamplePosition::Centre,
         }
     }
 }

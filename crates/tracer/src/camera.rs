@@ -2,7 +2,7 @@
 //! point of the image plane.
 
 use glam::Vec3A;
-use whitted_ir::{Camera, Projection};
+use whitted_ir::{Camera, Projection, SamplePosition};
 
 use whitted_bvh::Ray;
 
@@ -13,6 +13,9 @@ pub struct PreparedCamera {
     right: Vec3A,
     up: Vec3A,
     projection: CameraProjection,
+    /// Added to every image-plane point, in pixels: zero, or half a pixel towards the
+    /// pixel's lower-left corner with `sample_position corner`.
+    shift: (f32, f32),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -44,18 +47,30 @@ impl PreparedCamera {
             right: right.as_vec3a(),
             up: up.as_vec3a(),
             projection,
+            shift: (0.0, 0.0),
         }
     }
 
     /// The ray through the image-plane point `(x, y)` of a `width × height` image, measured
     /// in pixels from the top-left corner (so pixel centres are at `i + 0.5`).
     #[inline]
+    /// The camera whose samples are moved as `position` says. `Corner` is the lower-left
+    /// corner: where a tracer samples that maps pixel (i, j), j counted from the bottom
+    /// row as the course's images are, to the image-plane point (i / width, j / height).
+    pub fn placing_samples(self, position: SamplePosition) -> PreparedCamera {
+        let shift = match position {
+            SamplePosition::Centre => (0.0, 0.0),
+            SamplePosition::Corner => (-0.5, 0.5),
+        };
+        PreparedCamera { shift, ..self }
+    }
+
     pub fn ray(&self, x: f32, y: f32, width: u32, height: u32) -> Ray {
         let (w, h) = (width.max(1) as f32, height.max(1) as f32);
         let aspect = w / h;
         // Screen coordinates in [-1, 1], +v upwards.
-        let u = 2.0 * x / w - 1.0;
-        let v = 1.0 - 2.0 * y / h;
+        let u = 2.0 * (x + self.shift.0) / w - 1.0;
+        let v = 1.0 - 2.0 * (y + self.shift.1) / h;
         match self.projection {
             CameraProjection::Perspective { tan_half_fov } => {
                 let direction = self.forward

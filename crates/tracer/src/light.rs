@@ -1,7 +1,7 @@
 //! Lights in the tracer's f32 form: where light comes from as seen from a surface point.
 
 use glam::Vec3A;
-use whitted_ir::{Attenuation, Handle, Light, LightKind};
+use whitted_ir::{Attenuation, Handle, Light, LightKind, Settings};
 
 use crate::material::color;
 use crate::optics;
@@ -57,8 +57,17 @@ fn terms(a: &Attenuation) -> [f32; 3] {
 }
 
 impl PreparedLight {
-    /// `clamp` is the scene's `attenuation_clamp` setting.
-    pub fn new(handle: Handle<Light>, light: &Light, clamp: bool) -> PreparedLight {
+    /// The scene's `attenuation_clamp` and `attenuation` settings shape the fall-off.
+    pub fn new(handle: Handle<Light>, light: &Light, settings: &Settings) -> PreparedLight {
+        let clamp = settings.attenuation_clamp;
+        // `attenuation off`: every light at full colour at any distance.
+        let terms = |a: &Attenuation| {
+            if settings.light_falloff {
+                terms(a)
+            } else {
+                [1.0, 0.0, 0.0]
+            }
+        };
         let kind = match &light.kind {
             LightKind::Point {
                 position,

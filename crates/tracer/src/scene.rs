@@ -257,14 +257,19 @@ impl Shapes {
         let materials: Vec<PreparedMaterial> = scene
             .materials
             .iter()
-            .map(|(_, m)| PreparedMaterial::new(m))
+            .map(|(_, m)| {
+                let mut prepared = PreparedMaterial::new(m);
+                // `fresnel` in the settings overrides every material's own.
+                if let Some(fresnel) = scene.settings.fresnel_rule {
+                    prepared.fresnel = fresnel;
+                }
+                prepared
+            })
             .collect();
         let lights = scene
             .lights
             .iter()
-            .map(|(handle, light)| {
-                PreparedLight::new(handle, light, scene.settings.attenuation_clamp)
-            })
+            .map(|(handle, light)| PreparedLight::new(handle, light, &scene.settings))
             .collect();
         // Each mesh once (in parallel), shared by every object that instances it.
         let meshes: Vec<Arc<PreparedMesh>> = scene
@@ -276,7 +281,8 @@ impl Shapes {
             .collect();
         let shapes = Shapes {
             settings: scene.settings.clone(),
-            camera: PreparedCamera::new(&scene.camera),
+            camera: PreparedCamera::new(&scene.camera)
+                .placing_samples(scene.settings.sample_position),
             lights,
             nested_media: scene.materials.iter().any(|(_, m)| m.priority != 0),
             mesh_count: meshes.len(),

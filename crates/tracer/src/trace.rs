@@ -408,7 +408,8 @@ impl<'a> Tracer<'a> {
         let d = ray.direction;
         // Shading (and the secondary rays) use the shading normal; which side the ray is on
         // was decided by the geometric one.
-        let n = if front_face {
+        // `flip_normals off` keeps the outward normal on a back face: the student bug.
+        let n = if front_face || !scene.settings.flip_normals {
             surface.shading_normal
         } else {
             -surface.shading_normal
@@ -438,11 +439,18 @@ impl<'a> Tracer<'a> {
         let mut color = self.local_illumination(m, outside, n, -d, front_face, rec);
 
         // Secondary rays.
+        let ior = (self.ior(outer), self.ior(inner));
+        // `exit_ior uninverted`: a ray leaving a solid refracts as if entering it.
+        let ior = if front_face || scene.settings.exit_ior_inverted {
+            ior
+        } else {
+            (ior.1, ior.0)
+        };
         let split = split_at(
             m,
             d,
             n,
-            (self.ior(outer), self.ior(inner)),
+            ior,
             solid && front_face,
             self.scene.settings.energy_clamp,
         );
@@ -483,6 +491,12 @@ impl<'a> Tracer<'a> {
                 reason,
             });
             outcome.skipped(reason);
+            // `total_internal_reflection off`: the student traced the impossible ray anyway;
+            // its direction is the square root of a negative number, so it meets nothing
+            // and brings back the background, weighted by `kt`.
+            if !scene.settings.total_internal_reflection {
+                color += m.transmissive * scene.background;
+            }
         }
         if let Some(direction) = split.refracted.filter(|_| split.transmit != Vec3A::ZERO) {
             let beyond = match coincident_after {
@@ -768,15 +782,25 @@ impl<'a> Tracer<'a> {
         rec: &mut R,
     ) -> Vec3A {
         let scene = self.scene;
-        let ambient = m.ambient * scene.ambient * m.diffuse;
+        let back_face = !front_face && !scene.settings.shade_back;
+        // `back_ambient off` (MIT 6.837's handout): a back face's own colour is black.
+        let own = if back_face && !scene.settings.back_ambient {
+            0.0
+        } else {
+            1.0
+        };
+        let ambient = m.ambient * scene.ambient * m.diffuse * own;
         rec.ambient(ambient);
         // A self-lit surface: its emission counts whatever the lights and shadows.
-        rec.emission(m.emission);
-        let mut color = ambient + m.emission;
+        let emission = m.emission * own;
+        rec.emission(emission);
+        let mut color = ambient + emission;
         // With no diffuse and no specular colour a light adds nothing whatever its shadow
         // ray finds, so the ray is not cast (14% of a mirror scene's shadow rays).
         let unshaded = m.diffuse == Vec3A::ZERO && m.specular == Vec3A::ZERO;
-        let back_face = !front_face && !scene.settings.shade_back;
+        // `highlight_gate off` (the course's Phong): a light behind the surface still adds
+        // its highlight, so it is not skipped when the material has one.
+        let gated = scene.settings.highlight_gate || m.specular == Vec3A::ZERO;
         for light in &scene.lights {
             let incidence = light.incidence(outside);
             let n_dot_l = n.dot(incidence.to_light);
@@ -799,7 +823,7 @@ impl<'a> Tracer<'a> {
                 rec.light_sampled(&sample);
                 continue;
             }
-            if n_dot_l <= 0.0 || strength <= 0.0 || light.intensity == Vec3A::ZERO {
+            if (n_dot_l <= 0.0 && gated) || strength <= 0.0 || light.intensity == Vec3A::ZERO {
                 sample.no_shadow_ray = Some(unlit(n_dot_l, incidence.spot, light.intensity));
                 rec.light_sampled(&sample);
                 continue;
@@ -818,7 +842,7 @@ impl<'a> Tracer<'a> {
             sample.shadow_ray = shadow_ray;
             if passed != Vec3A::ZERO {
                 let light_in = light.intensity * strength * passed;
-                sample.diffuse = light_in * m.diffuse * n_dot_l;
+                sample.diffuse = light_in * m.diffuse * n_dot_l.max(0.0);
                 if m.specular != Vec3A::ZERO {
                     let cosine = match scene.settings.highlight {
                         Highlight::Phong => reflect(-incidence.to_light, n).dot(view),

@@ -9,10 +9,13 @@ use crate::value::{MaterialId, PatternId};
 /// Which properties a block has set, and where each was first set (for "set twice").
 #[derive(Clone, Copy)]
 pub(super) struct PropSet {
-    mask: u64,
+    mask: u128,
     first: [(Prop, Span); 10],
     len: u8,
 }
+
+// One bit per property: a property past the 128th needs a wider mask.
+const _: () = assert!(Prop::ALL.len() <= 128);
 
 impl PropSet {
     pub(super) fn new() -> Self {
@@ -25,7 +28,7 @@ impl PropSet {
 
     /// Records `prop`; if it was already set, returns where (detached if not remembered).
     pub(super) fn insert(&mut self, prop: Prop, span: Span) -> Result<(), Span> {
-        let bit = 1u64 << (prop as u32);
+        let bit = 1u128 << (prop as u32);
         if self.mask & bit != 0 {
             let first = self.first[..self.len as usize]
                 .iter()
@@ -42,7 +45,7 @@ impl PropSet {
     }
 
     pub(super) fn has(&self, prop: Prop) -> bool {
-        self.mask & (1u64 << (prop as u32)) != 0
+        self.mask & (1u128 << (prop as u32)) != 0
     }
 }
 

@@ -12,6 +12,7 @@ mod media_scenes;
 mod optics_scenes;
 mod ray_budget;
 mod shadow_rays;
+mod student_switches;
 mod switches;
 
 use glam::Vec3A;
