@@ -31,6 +31,9 @@ pub enum Command {
     /// Compare one pixel's ray trees under two scenes or settings, or an image with
     /// whitted's render (docs/diff.md).
     Diff(DiffArgs),
+    /// Say which classic tracer bug explains a student's image (docs/courses.md), or grade
+    /// a class: --class DIR --commands FILE.
+    Grade(GradeArgs),
     /// Find the pixels whose rays match a predicate, e.g. 'tir and not hit("floor")'
     /// (docs/query.md).
     Query(QueryArgs),
@@ -220,6 +223,61 @@ pub struct DiffArgs {
     /// Print a versioned JSON document instead of text.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub overrides: RenderOverrides,
+}
+
+#[derive(Args)]
+pub struct GradeArgs {
+    /// The scene (.scene, or the course's .txt) the student rendered; with --command, the
+    /// student's image.
+    #[arg(value_name = "SCENE", required_unless_present = "class")]
+    pub scene: Option<PathBuf>,
+    /// The student's image (PNG, TGA, PPM or EXR, the scene's size).
+    #[arg(value_name = "IMAGE")]
+    pub image: Option<PathBuf>,
+    /// The course's command line that made the reference, instead of SCENE and --set:
+    /// --command "raytracer -input scene4_03.txt -size 200 200 -shadows -bounces 4".
+    #[arg(long, value_name = "LINE", allow_hyphen_values = true, conflicts_with_all = ["define", "set", "class"])]
+    pub command: Option<String>,
+    /// Override a top-level `const`: -D N=316.
+    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+    pub define: Vec<(String, String)>,
+    /// Replace a setting of the scene: --set shadows=opaque (the course's -shadows).
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_setting)]
+    pub set: Vec<(String, String)>,
+    /// Compare in 8-bit linear values (colour times 255), as the MIT 6.837 course wrote
+    /// images (the default for a 6.837 scene).
+    #[arg(long, conflicts_with = "srgb")]
+    pub linear: bool,
+    /// Compare in 8-bit sRGB, as `whitted render` writes (the default for whitted's scenes).
+    #[arg(long)]
+    pub srgb: bool,
+    /// The largest difference (8-bit steps, any channel) that still counts as equal.
+    #[arg(long, default_value_t = 8)]
+    pub tolerance: u8,
+    /// Write the picture student | reference | best model | residual (x4) here (.png).
+    #[arg(long, value_name = "OUT.png", value_parser = parse_output)]
+    pub picture: Option<PathBuf>,
+    /// List at most this many explanations.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub top: u32,
+    /// Print a versioned JSON document instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Grade a class: a folder with one folder of images per student, named as the
+    /// command lines of --commands write them.
+    #[arg(long, value_name = "DIR", requires = "commands", conflicts_with_all = ["scene", "image", "picture", "json"])]
+    pub class: Option<PathBuf>,
+    /// With --class: the assignment's command lines, one per line, as the course wrote
+    /// them (`raytracer -input scene4_03.txt -size 200 200 -output output4_03.tga
+    /// -shadows`); scene paths are relative to this file.
+    #[arg(long, value_name = "FILE")]
+    pub commands: Option<PathBuf>,
+    /// With --class: where the report goes (default: DIR/grade-report). Students already
+    /// graded there, with the same images, are not graded again.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
     #[command(flatten)]
     pub overrides: RenderOverrides,
 }

@@ -15,6 +15,8 @@ mod explain_cmd;
 mod failure;
 mod fmt_cmd;
 mod front_end;
+mod grade_class;
+mod grade_cmd;
 mod image_output;
 mod interrupt;
 mod lsp_cmd;
@@ -71,6 +73,7 @@ fn main() -> ExitCode {
         Command::Trace(args) => trace_cmd::trace(&args),
         Command::Diff(args) => diff_cmd::diff(&args),
         Command::Query(args) => query_cmd::query(&args),
+        Command::Grade(args) => grade_cmd::grade(&args),
         Command::Explain(args) => explain_cmd::explain_pixel(&args),
         Command::Debug(args) => debug_cmd::debug(&args),
         Command::Fmt(args) => fmt_cmd::fmt(&args),

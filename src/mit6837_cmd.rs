@@ -83,6 +83,9 @@ pub struct CourseRun {
     pub stats: bool,
     /// What the command line asked that whitted accepts and ignores, said once each.
     pub notes: Vec<String>,
+    /// `--set NAME=VALUE` (whitted's own, repeatable): any setting on top of the course's,
+    /// such as a student bug model for `whitted grade`'s examples.
+    pub sets: Vec<(String, String)>,
 }
 
 /// Reads the course's flags. Every mistake is one message naming the flag.
@@ -97,8 +100,21 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
     let mut notes: Vec<String> = Vec::new();
     let mut options = CourseOptions::default();
     let mut seen: Vec<String> = Vec::new();
+    let mut sets = Vec::new();
     while let Some(word) = words.next() {
         let flag = word.to_string_lossy().into_owned();
+        if flag == "--set" {
+            let text = words
+                .next()
+                .ok_or("--set needs NAME=VALUE")?
+                .to_string_lossy()
+                .into_owned();
+            let (name, value) = text
+                .split_once('=')
+                .ok_or_else(|| format!("--set {text}: write NAME=VALUE, e.g. --set epsilon=0"))?;
+            sets.push((name.trim().to_string(), value.trim().to_string()));
+            continue;
+        }
         if seen.contains(&flag) {
             return Err(format!("{flag} is given twice"));
         }
@@ -199,6 +215,14 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
                 }
             }
             "-stats" => stats = true,
+            // The handouts do not say where in the pixel the ray goes; students differ.
+            "-sample_position" => {
+                options.sample_position = match value("centre or corner")?.to_str() {
+                    Some("centre" | "center") => whitted_ir::SamplePosition::Centre,
+                    Some("corner") => whitted_ir::SamplePosition::Corner,
+                    _ => return Err("-sample_position takes centre or corner".into()),
+                }
+            }
             // They shape only the course's OpenGL preview, which whitted does not draw.
             "-tessellation" => {
                 let what = "two numbers of steps (theta and phi)";
@@ -237,9 +261,6 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
     let Some((width, height)) = size else {
         return Err("-size W H is required (see whitted mit6837 -help)".into());
     };
-    if output.is_none() && depth.is_none() && normals.is_none() {
-        return Err("nothing to write: give -output, -depth or -normals".into());
-    }
     options.width = width;
     options.height = height;
     Ok(Request::Run(CourseRun {
@@ -250,6 +271,7 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
         normals,
         stats,
         notes,
+        sets,
     }))
 }
 
@@ -278,6 +300,11 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
         Request::Help => return crate::scene_input::write_stdout(&format!("{USAGE}\n")),
         Request::Run(run) => run,
     };
+    if run.output.is_none() && run.depth.is_none() && run.normals.is_none() {
+        return Err(Failure::Usage(
+            "nothing to write: give -output, -depth or -normals".into(),
+        ));
+    }
     let outputs: Vec<&Path> = [
         run.output.as_deref(),
         run.depth.as_ref().map(|(_, _, path)| path.as_path()),
@@ -315,7 +342,7 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
     let scene_args = SceneArgs {
         scene: run.input.clone(),
         define: Vec::new(),
-        set: Vec::new(),
+        set: run.sets.clone(),
     };
     let loaded = load_scene_with(&scene_args, false, &run.options)?;
     let options = RenderOptions::from_settings(&loaded.scene.settings);
@@ -495,7 +522,6 @@ mod tests {
                 "the height must be from 1",
             ),
             ("-input a.txt -size ten 10", "-size: `ten` is not a width"),
-            ("-input a.txt -size 10 10", "nothing to write"),
             (
                 "-input a.txt -size 10 10 -output a.jpg",
                 "the course's images are .tga, .png or .ppm",

@@ -14,6 +14,7 @@ mod explain;
 mod extremes;
 mod fmt;
 mod front_end_oracles;
+mod grade;
 mod guards;
 mod json_schema;
 mod lint;

@@ -12,6 +12,7 @@
 pub mod contributions;
 pub mod diff;
 pub mod findings;
+pub mod grade;
 mod inside;
 mod json;
 pub mod lint;

@@ -165,7 +165,7 @@ fn energy_note(scene: &whitted_ir::Scene) -> Option<Diagnostic> {
     Some(
         Diagnostic::warning(
             format!(
-                "this material's reflectiveColor + transparentColor is more than 1{more}: the                  course adds reflective·trace + transparent·trace as given, so it returns                  more light than arrives"
+                "this material's reflectiveColor + transparentColor is more than 1{more}: the course adds reflective·trace + transparent·trace as given, so it returns more light than arrives"
             ),
             span,
         )
@@ -174,7 +174,7 @@ fn energy_note(scene: &whitted_ir::Scene) -> Option<Diagnostic> {
             kr.r, kr.g, kr.b, kt.r, kt.g, kt.b
         ))
         .with_hint(
-            "this is the course's model (docs/courses.md, \"Reflection and refraction\");              a scene in whitted's language scales the two down to add up to 1 unless it sets              `energy_clamp off`",
+            "this is the course's model (docs/courses.md, \"Reflection and refraction\"); a scene in whitted's language scales the two down to add up to 1 unless it sets `energy_clamp off`",
         ),
     )
 }
