@@ -25,8 +25,8 @@ pub use mesh::{BadEdge, EdgeDefect, Mesh, NotSolid};
 pub use print::print;
 pub use provenance::{ArgValue, FrameId, Provenance, Site, SiteId, SiteKind, Step};
 pub use scene::{
-    Attenuation, Camera, Color, CsgOp, Fresnel, Highlight, Light, LightKind, Material, Object,
-    ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, Sampling, Scene,
+    Attenuation, Camera, Color, CsgOp, Filter, Fresnel, Highlight, Light, LightKind, Material,
+    Object, ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, Sampling, Scene,
     SceneFormat, Settings, ShadowMode, Shape, WorldFromObject,
 };
 pub use source::{FileId, LineCol, SourceFile, SourceMap, Span};

@@ -51,6 +51,10 @@ pub struct CourseOptions {
     /// samples per pixel and where they fall.
     pub samples: u32,
     pub sampling: whitted_ir::Sampling,
+    /// `-box_filter R`, `-tent_filter R` or `-gaussian_filter SIGMA` (assignment 7): the
+    /// filter and its radius (σ for the gaussian).
+    pub filter: whitted_ir::Filter,
+    pub filter_radius: f64,
 }
 
 impl Default for CourseOptions {
@@ -65,6 +69,8 @@ impl Default for CourseOptions {
             weight: 0.0,
             samples: 1,
             sampling: whitted_ir::Sampling::Jittered,
+            filter: whitted_ir::Filter::Box,
+            filter_radius: 0.5,
         }
     }
 }
