@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use whitted_debugger::{Compiled, DebugError, Recompile, Session};
 use whitted_ir::SourceMap;
+use whitted_mit6837::CourseOptions;
 
 use crate::cli::{DebugArgs, RenderOverrides, SceneArgs};
 use crate::scene_input::load_scene;
@@ -28,21 +29,56 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
             ));
         }
     }
+    let scene_args = args.scene.clone();
+    let overrides = args.overrides.clone();
+    let course = CourseOptions::default();
+    let recompile: Recompile = Box::new(move || compile(&scene_args, &overrides, &course));
+    run_debugger(
+        &args.scene,
+        loaded,
+        recompile,
+        args.pixel.map(|[x, y]| (x, y)),
+    )
+}
+
+/// `whitted mit6837 ... -gui`: the debugger on a 6.837 scene compiled with the command
+/// line's switches (`-shadows`, `-bounces`, the samples and the filter, `-size`), which
+/// every reload compiles with again.
+pub fn debug_course(
+    scene: &SceneArgs,
+    course: &CourseOptions,
+    loaded: crate::scene_input::Loaded,
+) -> Result<(), Failure> {
+    let (scene_args, course) = (scene.clone(), course.clone());
+    let overrides = RenderOverrides::default();
+    let recompile: Recompile = Box::new(move || compile(&scene_args, &overrides, &course));
+    run_debugger(scene, loaded, recompile, None)
+}
+
+/// Whether the debugger can start here: a terminal on stdin and stdout.
+pub fn has_terminal() -> bool {
+    use std::io::IsTerminal;
+    std::io::stdout().is_terminal() && std::io::stdin().is_terminal()
+}
+
+fn run_debugger(
+    scene: &SceneArgs,
+    loaded: crate::scene_input::Loaded,
+    recompile: Recompile,
+    pixel: Option<(u32, u32)>,
+) -> Result<(), Failure> {
     let watch = watch_list(
-        &args.scene.scene,
+        &scene.scene,
         &loaded.scene.sources,
         Some(loaded.scene.scene()),
     );
-    let scene_args = args.scene.clone();
-    let overrides = args.overrides.clone();
-    let recompile: Recompile = Box::new(move || compile(&scene_args, &overrides));
     let session = Session {
-        scene_name: args.scene.scene.display().to_string(),
+        scene_name: scene.scene.display().to_string(),
         scene: loaded.scene,
         watch,
         recompile,
-        pixel: args.pixel.map(|[x, y]| (x, y)),
-        export_dir: export_dir(&args.scene.scene),
+        pixel,
+        export_dir: export_dir(&scene.scene),
     };
     whitted_debugger::run(session).map_err(|error| match error {
         DebugError::NotATerminal => Failure::Usage(error.to_string()),
@@ -61,11 +97,11 @@ fn export_dir(scene: &Path) -> PathBuf {
     std::path::absolute(&folder).unwrap_or(folder)
 }
 
-/// Compiles the scene again (with the front end its content calls for, and the same `-D`
-/// and `--set` as the first compile), silently: the debugger shows the diagnostics itself.
-fn compile(args: &SceneArgs, overrides: &RenderOverrides) -> Compiled {
-    let mut compilation =
-        crate::front_end::compile(args, &whitted_mit6837::CourseOptions::default());
+/// Compiles the scene again (with the front end its content calls for, and the same `-D`,
+/// `--set` and course switches as the first compile), silently: the debugger shows the
+/// diagnostics itself.
+fn compile(args: &SceneArgs, overrides: &RenderOverrides, course: &CourseOptions) -> Compiled {
+    let mut compilation = crate::front_end::compile(args, course);
     if let Some(scene) = compilation.scene.take() {
         match crate::setting_flags::apply_to_scene(scene, overrides) {
             Ok(scene) => compilation.scene = Some(scene),

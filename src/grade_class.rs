@@ -116,7 +116,7 @@ fn course_run(line: &str) -> Result<mit6837_cmd::CourseRun, String> {
         .map(OsString::from)
         .collect();
     match mit6837_cmd::parse(&words)? {
-        Request::Run(run) => Ok(run),
+        Request::Run(run) => Ok(*run),
         Request::Help => Err("-help is not a command line to grade".into()),
     }
 }

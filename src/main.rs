@@ -21,6 +21,7 @@ mod image_output;
 mod interrupt;
 mod lsp_cmd;
 mod mit6837_cmd;
+mod mit6837_pictures;
 mod query_cmd;
 mod render_cmd;
 mod request;

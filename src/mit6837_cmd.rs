@@ -26,7 +26,9 @@ usage: whitted mit6837 -input SCENE.txt -size W H [-output OUT.tga|.png|.ppm]
                        [-bounces N] [-weight W]
                        [-depth T0 T1 DEPTH.tga] [-normals NORMALS.tga]
                        [-uniform_samples|-jittered_samples|-random_samples N]
-                       [-box_filter 0.5] [-stats]
+                       [-box_filter R|-tent_filter R|-gaussian_filter SIGMA]
+                       [-render_samples FILE ZOOM] [-render_filter FILE ZOOM]
+                       [-stats] [-gui]
 
 The MIT 6.837 (Fall 2004) ray tracer's command line, flags as the course wrote them.
 Images are 8-bit linear (colour times 255, clamped), as the course's were.
@@ -44,8 +46,15 @@ Images are 8-bit linear (colour times 255, clamped), as the course's were.
   -uniform_samples N  N samples per pixel on a regular grid (assignment 7)
   -jittered_samples N N samples per pixel, stratified and jittered
   -random_samples N   N samples per pixel, each anywhere in the pixel
-  -box_filter 0.5     average each pixel's own samples (what whitted does)
+  -box_filter R       each pixel the mean of the samples within R of its centre
+                      (a square; 0.5, the default, is the pixel's own samples)
+  -tent_filter R      the samples weighted 1 - d/R by their distance d
+  -gaussian_filter S  the samples weighted exp(-d^2/(2 S^2)), out to 2 S
+  -render_samples F Z every sample as a dot in its colour, the image zoomed Z times
+  -render_filter F Z  the filter's weights around the centre pixel, zoomed Z times
   -stats              print the ray counts after the render
+  -gui                open the scene in whitted's terminal debugger (whitted debug),
+                      with these settings, after writing any images
   -tessellation T P, -gouraud, -grid X Y Z
                       accepted and ignored (the course's OpenGL preview and grid)
 
@@ -54,21 +63,16 @@ See docs/courses.md.";
 /// The course's flags that whitted does not have yet, each with why, so that a teacher's
 /// script gets a reason rather than "unknown flag".
 const NOT_YET: &[(&str, &str)] = &[
-    ("-gui", "assignment 3's OpenGL preview window: open the scene with `whitted debug SCENE.txt` instead"),
-    ("-visualize_grid", "assignment 6's drawing of the grid cells a ray visits: whitted's acceleration structure is a BVH, not the course's grid"),
-    ("-tent_filter", "assignment 7's tent filter reaches into the neighbouring pixels' samples, which whitted does not gather yet; -box_filter 0.5 (each pixel's own samples) is what whitted does"),
-    ("-gaussian_filter", "assignment 7's gaussian filter reaches into the neighbouring pixels' samples, which whitted does not gather yet; -box_filter 0.5 (each pixel's own samples) is what whitted does"),
-    ("-render_samples", "assignment 7's picture of the sample positions is not made yet"),
-    ("-render_filter", "assignment 7's picture of the filter weights is not made yet"),
-    ("-filter_samples", "assignment 7's picture of the filter weights is not made yet"),
-    ("-zoom_factor", "it scales assignment 7's sample and filter pictures, which are not made yet"),
+    ("-visualize_grid", "assignment 6 draws the cells of the course's uniform grid that rays visit, and whitted accelerates with a BVH, which has no grid cells to draw (-grid is accepted and ignored for the same reason); to see which objects a ray meets, open the scene with -gui (or `whitted debug SCENE.txt`) and trace a pixel, or run `whitted trace SCENE.txt --pixel X,Y`"),
+    ("-filter_samples", "whitted draws the filter's weights with -render_filter FILE ZOOM and the samples with -render_samples FILE ZOOM"),
+    ("-zoom_factor", "the zoom is the second argument of -render_samples FILE ZOOM and -render_filter FILE ZOOM, as assignment 7 wrote them"),
 ];
 
 /// A parsed command line.
 #[derive(Debug, PartialEq)]
 pub enum Request {
     Help,
-    Run(CourseRun),
+    Run(Box<CourseRun>),
 }
 
 #[derive(Debug, PartialEq)]
@@ -81,6 +85,12 @@ pub struct CourseRun {
     pub normals: Option<PathBuf>,
     /// `-stats`: print the ray counts after the render.
     pub stats: bool,
+    /// `-render_samples file zoom`.
+    pub render_samples: Option<(PathBuf, u32)>,
+    /// `-render_filter file zoom`.
+    pub render_filter: Option<(PathBuf, u32)>,
+    /// `-gui`: open the debugger after writing the images.
+    pub gui: bool,
     /// What the command line asked that whitted accepts and ignores, said once each.
     pub notes: Vec<String>,
     /// `--set NAME=VALUE` (whitted's own, repeatable): any setting on top of the course's,
@@ -97,6 +107,9 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
     let mut depth = None;
     let mut normals = None;
     let mut stats = false;
+    let mut render_samples = None;
+    let mut render_filter = None;
+    let mut gui = false;
     let mut notes: Vec<String> = Vec::new();
     let mut options = CourseOptions::default();
     let mut seen: Vec<String> = Vec::new();
@@ -195,7 +208,10 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
                         limits::MAX_SAMPLES_PER_PIXEL
                     ));
                 }
-                if seen.iter().any(|s| s.ends_with("_samples")) {
+                if seen
+                    .iter()
+                    .any(|s| s.ends_with("_samples") && s != "-render_samples")
+                {
                     return Err(format!("{flag}: give one of -uniform_samples, -jittered_samples and -random_samples"));
                 }
                 options.samples = n;
@@ -205,15 +221,47 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
                     _ => whitted_ir::Sampling::Jittered,
                 };
             }
-            "-box_filter" => {
-                let radius = number::<f64>(&value("a radius")?, "-box_filter", "radius")?;
-                if radius != 0.5 {
+            "-box_filter" | "-tent_filter" | "-gaussian_filter" => {
+                let what = if flag == "-gaussian_filter" {
+                    "sigma"
+                } else {
+                    "radius"
+                };
+                let radius = number::<f64>(&value(&format!("a {what}"))?, &flag, what)?;
+                if !(radius > 0.0 && radius <= limits::MAX_FILTER_RADIUS) {
                     return Err(format!(
-                        "-box_filter {radius}: only 0.5 (each pixel's own samples, averaged) for \
-                         now; a radius reaching into the neighbouring pixels is not gathered yet"
+                        "{flag} {radius}: the {what} must be above 0 and at most {} pixels \
+                         (the filter radius limit)",
+                        limits::MAX_FILTER_RADIUS
                     ));
                 }
+                if seen
+                    .iter()
+                    .any(|s| s.ends_with("_filter") && s != "-render_filter")
+                {
+                    return Err(format!(
+                        "{flag}: give one of -box_filter, -tent_filter and -gaussian_filter"
+                    ));
+                }
+                options.filter = match flag.as_str() {
+                    "-tent_filter" => whitted_ir::Filter::Tent,
+                    "-gaussian_filter" => whitted_ir::Filter::Gaussian,
+                    _ => whitted_ir::Filter::Box,
+                };
+                options.filter_radius = radius;
             }
+            "-render_samples" | "-render_filter" => {
+                let what = "an image file and a zoom";
+                let path = image_path(value(what)?, &flag)?;
+                let zoom = number::<u32>(&value(what)?, &flag, "zoom")?;
+                crate::mit6837_pictures::picture_size(&flag, (1, 1), zoom)?;
+                if flag == "-render_samples" {
+                    render_samples = Some((path, zoom));
+                } else {
+                    render_filter = Some((path, zoom));
+                }
+            }
+            "-gui" => gui = true,
             "-stats" => stats = true,
             // The handouts do not say where in the pixel the ray goes; students differ.
             "-sample_position" => {
@@ -261,18 +309,30 @@ pub fn parse(args: &[OsString]) -> Result<Request, String> {
     let Some((width, height)) = size else {
         return Err("-size W H is required (see whitted mit6837 -help)".into());
     };
+    let pictures = [
+        ("-render_samples", &render_samples),
+        ("-render_filter", &render_filter),
+    ];
+    for (flag, picture) in pictures {
+        if let Some((_, zoom)) = picture {
+            crate::mit6837_pictures::picture_size(flag, (width, height), *zoom)?;
+        }
+    }
     options.width = width;
     options.height = height;
-    Ok(Request::Run(CourseRun {
+    Ok(Request::Run(Box::new(CourseRun {
         input,
         options,
         output,
         depth,
         normals,
         stats,
+        render_samples,
+        render_filter,
+        gui,
         notes,
         sets,
-    }))
+    })))
 }
 
 fn number<T: std::str::FromStr>(text: &OsString, flag: &str, what: &str) -> Result<T, String> {
@@ -300,15 +360,24 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
         Request::Help => return crate::scene_input::write_stdout(&format!("{USAGE}\n")),
         Request::Run(run) => run,
     };
-    if run.output.is_none() && run.depth.is_none() && run.normals.is_none() {
+    let nothing = [run.output.is_none(), run.depth.is_none(), run.normals.is_none()];
+    if nothing.iter().all(|&n| n)
+        && run.render_samples.is_none()
+        && run.render_filter.is_none()
+        && !run.gui
+    {
         return Err(Failure::Usage(
-            "nothing to write: give -output, -depth or -normals".into(),
+            "nothing to write: give -output, -depth, -normals, -render_samples or \
+             -render_filter (or -gui to look at the scene)"
+                .into(),
         ));
     }
     let outputs: Vec<&Path> = [
         run.output.as_deref(),
         run.depth.as_ref().map(|(_, _, path)| path.as_path()),
         run.normals.as_deref(),
+        run.render_samples.as_ref().map(|(path, _)| path.as_path()),
+        run.render_filter.as_ref().map(|(path, _)| path.as_path()),
     ]
     .into_iter()
     .flatten()
@@ -327,6 +396,14 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
             )));
         }
         crate::render_cmd::check_output_folder(path)?;
+    }
+    // Before any render: the debugger cannot start without a terminal.
+    if run.gui && !crate::debug_cmd::has_terminal() {
+        return Err(Failure::Usage(
+            "-gui opens whitted's terminal debugger, which needs a terminal on stdin and \
+             stdout; run it in one, or leave out -gui to only write the images"
+                .into(),
+        ));
     }
     if std::fs::metadata(&run.input).is_ok() && !crate::front_end::is_course_scene(&run.input) {
         return Err(Failure::Message(format!(
@@ -347,15 +424,41 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
     let loaded = load_scene_with(&scene_args, false, &run.options)?;
     let options = RenderOptions::from_settings(&loaded.scene.settings);
     crate::render_cmd::check_image_size(options.width, options.height)?;
-    let prepared = PreparedScene::new(&loaded.scene);
     let (width, height) = (options.width, options.height);
-    if let Some(path) = &run.output {
-        let Some((image, stats)) =
-            whitted_tracer::render(&prepared, &options, &whitted_tracer::NoObserver)
-        else {
+    if run.render_samples.is_some() {
+        // The picture needs every sample, which a filtered render keeps anyway (and
+        // validation bounded); the default box keeps them only for this picture.
+        let samples =
+            u64::from(width) * u64::from(height) * u64::from(options.samples_per_pixel.max(1));
+        if samples > limits::MAX_FILTERED_SAMPLES {
+            return Err(Failure::Usage(format!(
+                "-render_samples keeps every sample, and {width}x{height} with {} per pixel \
+                 is {samples}, past {}: use a smaller -size",
+                options.samples_per_pixel.max(1),
+                limits::describe("filtered samples")
+            )));
+        }
+    }
+    let prepared = PreparedScene::new(&loaded.scene);
+    if run.output.is_some() || run.render_samples.is_some() {
+        let observer = &whitted_tracer::NoObserver;
+        let rendered = if run.render_samples.is_some() {
+            whitted_tracer::render_film(&prepared, &options, observer)
+                .map(|(film, image, stats)| (image, stats, Some(film)))
+        } else {
+            whitted_tracer::render(&prepared, &options, observer)
+                .map(|(image, stats)| (image, stats, None))
+        };
+        let Some((image, stats, film)) = rendered else {
             return Err(Failure::Message("the render was cancelled".into()));
         };
-        write(path, width, height, to_linear8(&image.pixels))?;
+        if let Some(path) = &run.output {
+            write(path, width, height, to_linear8(&image.pixels))?;
+        }
+        if let (Some((path, zoom)), Some(film)) = (&run.render_samples, &film) {
+            let picture = crate::mit6837_pictures::samples_picture(film, *zoom);
+            write_picture(path, &picture)?;
+        }
         if run.stats {
             crate::scene_input::write_stdout(&course_stats(
                 &stats,
@@ -364,6 +467,11 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
                 options.samples_per_pixel,
             ))?;
         }
+    }
+    if let Some((path, zoom)) = &run.render_filter {
+        let filter = whitted_tracer::PixelFilter::from_settings(&loaded.scene.settings);
+        let picture = crate::mit6837_pictures::filter_picture(&filter, (width, height), *zoom);
+        write_picture(path, &picture)?;
     }
     if run.depth.is_some() || run.normals.is_some() {
         let hits = first_hits(&prepared, &options);
@@ -374,7 +482,16 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
             write(path, width, height, normals_image(&hits))?;
         }
     }
+    if run.gui {
+        drop(prepared);
+        return crate::debug_cmd::debug_course(&scene_args, &run.options, loaded);
+    }
     Ok(())
+}
+
+fn write_picture(path: &Path, picture: &crate::mit6837_pictures::Picture) -> Result<(), Failure> {
+    let bytes = to_linear8(&picture.pixels);
+    write(path, picture.width, picture.height, bytes)
 }
 
 /// `-stats`: the ray counts of the render, per kind and per pixel, as the course's
@@ -539,12 +656,40 @@ mod tests {
                 "the near distance must be less",
             ),
             (
-                "-input a.txt -size 10 10 -output a.tga -gui",
-                "-gui is not available in whitted: assignment 3's OpenGL preview",
+                "-input a.txt -size 10 10 -output a.tga -visualize_grid",
+                "-visualize_grid is not available in whitted: assignment 6 draws the cells",
             ),
             (
-                "-input a.txt -size 10 10 -output a.tga -box_filter 1",
-                "-box_filter 1: only 0.5",
+                "-input a.txt -size 10 10 -output a.tga -zoom_factor 4",
+                "the zoom is the second argument of -render_samples FILE ZOOM",
+            ),
+            (
+                "-input a.txt -size 10 10 -output a.tga -box_filter 5",
+                "-box_filter 5: the radius must be above 0 and at most 4 pixels",
+            ),
+            (
+                "-input a.txt -size 10 10 -output a.tga -gaussian_filter -1",
+                "-gaussian_filter -1: the sigma must be above 0",
+            ),
+            (
+                "-input a.txt -size 10 10 -output a.tga -tent_filter 1 -box_filter 1",
+                "give one of -box_filter, -tent_filter and -gaussian_filter",
+            ),
+            (
+                "-input a.txt -size 10 10 -render_samples s.tga",
+                "-render_samples needs an image file and a zoom",
+            ),
+            (
+                "-input a.txt -size 10 10 -render_filter f.jpg 4",
+                "the course's images are .tga, .png or .ppm",
+            ),
+            (
+                "-input a.txt -size 10 10 -render_filter f.tga 65",
+                "-render_filter: the zoom must be from 1 to 64, not 65",
+            ),
+            (
+                "-input a.txt -size 1000 1000 -render_samples s.tga 20",
+                "a 1000x1000 image zoomed 20 times is a 20000x20000 picture",
             ),
             (
                 "-input a.txt -size 10 10 -output a.tga -uniform_samples 4 -random_samples 4",
@@ -587,6 +732,38 @@ mod tests {
             };
             assert_eq!((run.options.samples, run.options.sampling), (4, sampling));
         }
+    }
+
+    /// Assignment 7's filters become the filter setting; its pictures and -gui are read
+    /// with their arguments in the course's order (file, then zoom).
+    #[test]
+    fn the_course_s_filters_pictures_and_gui_are_read() {
+        let line = "-input a.txt -size 9 9 -render_samples s.tga 20 -render_filter f.tga 10 \
+                    -jittered_samples 4 -tent_filter 1.5 -gui";
+        let Ok(Request::Run(run)) = parse_words(line) else {
+            panic!("{line} was refused");
+        };
+        assert_eq!(run.render_samples, Some((PathBuf::from("s.tga"), 20)));
+        assert_eq!(run.render_filter, Some((PathBuf::from("f.tga"), 10)));
+        assert_eq!(
+            (run.options.filter, run.options.filter_radius),
+            (whitted_ir::Filter::Tent, 1.5)
+        );
+        assert!(run.gui && run.output.is_none());
+        for (flag, filter) in [
+            ("-box_filter 0.5", whitted_ir::Filter::Box),
+            ("-gaussian_filter 0.4", whitted_ir::Filter::Gaussian),
+        ] {
+            let line = format!("-input a.txt -size 8 8 -output a.tga {flag}");
+            let Ok(Request::Run(run)) = parse_words(&line) else {
+                panic!("{line} was refused");
+            };
+            assert_eq!(run.options.filter, filter);
+        }
+        let Ok(Request::Run(run)) = parse_words("-input a.txt -size 8 8 -gui") else {
+            panic!("-gui alone was refused");
+        };
+        assert!(run.gui);
     }
 
     #[test]

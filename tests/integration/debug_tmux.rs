@@ -1136,3 +1136,29 @@ fn keys_act_on_the_focused_explanation() {
         "the explanation is zoomed, not the tree:\n{screen}"
     );
 }
+
+/// `whitted mit6837 ... -gui` opens the debugger on the course scene with the command
+/// line's settings (its `-size`, and its samples and filter in the render), after writing
+/// the image it was asked for; `q` ends it with exit code 0.
+#[test]
+fn the_course_s_gui_flag_opens_the_debugger_with_its_settings() {
+    let out = tempfile::tempdir().expect("a temporary directory");
+    let scene = repository().join("scenes/mit6837/spheres-orthographic.txt");
+    let command = format!(
+        "'{}' mit6837 -input '{}' -size 60 40 -jittered_samples 4 -gaussian_filter 0.6 \
+         -output out.png -gui",
+        whitted(),
+        scene.display()
+    );
+    let tmux = Tmux::start("gui", out.path(), &command, 120, 40);
+    let screen = tmux.wait_for("the finished image", |s| s.contains("rendered in"));
+    assert!(screen.contains("Image 60×40"), "{screen}");
+    assert!(
+        out.path().join("out.png").is_file(),
+        "the image is written first"
+    );
+    tmux.keys(&["q"]);
+    tmux.wait_for("the debugger's end", |s| {
+        s.contains("debugger exited with 0")
+    });
+}

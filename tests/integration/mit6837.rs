@@ -222,11 +222,20 @@ fn bad_course_flags_are_usage_errors_that_name_the_flag() {
     );
 
     let output = whitted(&[
-        "mit6837", "-input", SPHERES, "-size", "10", "10", "-output", "x.tga", "-gui",
+        "mit6837",
+        "-input",
+        SPHERES,
+        "-size",
+        "10",
+        "10",
+        "-output",
+        "x.tga",
+        "-visualize_grid",
     ]);
     assert_eq!(output.status.code(), Some(2));
-    assert!(stderr(&output).contains("-gui is not available in whitted"));
-    assert!(stderr(&output).contains("whitted debug"));
+    assert!(stderr(&output).contains("-visualize_grid is not available in whitted"));
+    assert!(stderr(&output).contains("whitted accelerates with a BVH"));
+    assert!(stderr(&output).contains("whitted trace SCENE.txt --pixel X,Y"));
 
     let output = whitted(&[
         "mit6837", "-input", SPHERES, "-size", "10", "10", "-output", SPHERES,
@@ -419,5 +428,158 @@ fn assignment_7_sampling_flags_render_the_grid_sampler() {
         stdout(&output).contains("the images match"),
         "{}",
         stdout(&output)
+    );
+}
+
+/// Assignment 7's filters: `-tent_filter 1` is the scene's `filter tent` with
+/// `filter_radius 1` (the same image as `render --set` makes, to the bit), and differs from
+/// the default box.
+#[test]
+fn assignment_7_filters_are_the_filter_setting() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let scene = "scenes/mit6837/spheres-orthographic.txt";
+    let tent = path_in(dir.path(), "tent.png");
+    let boxed = path_in(dir.path(), "box.png");
+    for (flag, path) in [("-tent_filter", &tent), ("-box_filter", &boxed)] {
+        let radius = if flag == "-tent_filter" { "1" } else { "0.5" };
+        let output = whitted(&[
+            "mit6837",
+            "-input",
+            scene,
+            "-size",
+            "24",
+            "24",
+            "-uniform_samples",
+            "4",
+            flag,
+            radius,
+            "-output",
+            path,
+        ]);
+        assert!(output.status.success(), "{}", stderr(&output));
+    }
+    let read = |path: &str| image::open(path).expect("an image").to_rgb8().into_raw();
+    assert_ne!(read(&tent), read(&boxed), "the tent blurs the edges");
+    let output = whitted(&[
+        "diff",
+        scene,
+        "--against-image",
+        &tent,
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--set",
+        "samples=4",
+        "--set",
+        "sampling=grid",
+        "--set",
+        "filter=tent",
+        "--set",
+        "filter_radius=1",
+        "--tolerance",
+        "0",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert!(
+        stdout(&output).contains("the images match"),
+        "{}",
+        stdout(&output)
+    );
+}
+
+/// `-render_samples FILE ZOOM`: the image zoomed (9 x 20 = 180), a checkerboard of 0.2 grey
+/// and black, each sample a dot of its own colour where its ray went (the uniform grid's
+/// first sample of pixel (0, 0) at (5, 5), in the colour `whitted trace` gives that
+/// sample). `-render_filter FILE ZOOM`: 181 x 181, the box's weight 1 white at the centre
+/// pixel, dark blue beyond its reach, blue grid lines.
+#[test]
+fn assignment_7_pictures_show_the_samples_and_the_filter() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let scene = "scenes/mit6837/spheres-orthographic.txt";
+    let samples = path_in(dir.path(), "samples.png");
+    let filter = path_in(dir.path(), "filter.png");
+    let output = whitted(&[
+        "mit6837",
+        "-input",
+        scene,
+        "-size",
+        "9",
+        "9",
+        "-uniform_samples",
+        "4",
+        "-render_samples",
+        &samples,
+        "20",
+        "-render_filter",
+        &filter,
+        "20",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let picture = image::open(&samples).expect("an image").to_rgb8();
+    assert_eq!(picture.dimensions(), (180, 180));
+    assert_eq!(
+        picture.get_pixel(0, 0).0,
+        [51, 51, 51],
+        "pixel (0, 0): light"
+    );
+    assert_eq!(picture.get_pixel(20, 0).0, [0, 0, 0], "pixel (1, 0): dark");
+    let output = whitted(&[
+        "trace",
+        scene,
+        "--pixel",
+        "0,0",
+        "--sample",
+        "0",
+        "--json",
+        "--width",
+        "9",
+        "--height",
+        "9",
+        "--set",
+        "samples=4",
+        "--set",
+        "sampling=grid",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let tree: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+    let color = &tree["samples"][0]["color"];
+    let expected: Vec<u8> = (0..3)
+        .map(|c| (color[c].as_f64().expect("a number").clamp(0.0, 1.0) * 255.0).round() as u8)
+        .collect();
+    assert_eq!(picture.get_pixel(5, 5).0.to_vec(), expected, "{tree}");
+    let picture = image::open(&filter).expect("an image").to_rgb8();
+    assert_eq!(picture.dimensions(), (181, 181));
+    assert_eq!(
+        picture.get_pixel(90, 90).0,
+        [255, 255, 255],
+        "the centre pixel"
+    );
+    assert_eq!(
+        picture.get_pixel(30, 30).0,
+        [0, 0, 128],
+        "beyond the box's reach"
+    );
+    assert_eq!(picture.get_pixel(40, 33).0, [0, 0, 255], "a grid line");
+}
+
+/// `-gui` opens the debugger, which needs a terminal: without one, a usage error that says
+/// so, before any render.
+#[test]
+fn gui_without_a_terminal_is_a_clear_error() {
+    let output = whitted(&[
+        "mit6837",
+        "-input",
+        "scenes/mit6837/spheres-orthographic.txt",
+        "-size",
+        "9",
+        "9",
+        "-gui",
+    ]);
+    assert_eq!(output.status.code(), Some(2), "{}", stderr(&output));
+    assert!(
+        stderr(&output).contains("-gui opens whitted's terminal debugger, which needs a terminal"),
+        "{}",
+        stderr(&output)
     );
 }

@@ -34,6 +34,12 @@ impl RenderObserver for StreamTiles {
         });
     }
 
+    /// With a filter that reaches past the pixel, the tiles were previews (each pixel's own
+    /// samples): the filtered image replaces them as one tile.
+    fn image_filtered(&self, image: &TileResult) {
+        self.tile_done(image);
+    }
+
     fn should_stop(&self) -> bool {
         self.cancel.load(Ordering::Relaxed)
     }

@@ -25,9 +25,9 @@ pub use mesh::{BadEdge, EdgeDefect, Mesh, NotSolid};
 pub use print::print;
 pub use provenance::{ArgValue, FrameId, Provenance, Site, SiteId, SiteKind, Step};
 pub use scene::{
-    Attenuation, Camera, Color, CsgOp, Fresnel, Highlight, Light, LightKind, Material, Object,
-    ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, SamplePosition, Sampling,
-    Scene, SceneFormat, Settings, ShadowMode, Shape, WorldFromObject,
+    Attenuation, Camera, Color, CsgOp, Filter, Fresnel, Highlight, Light, LightKind, Material,
+    Object, ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, SamplePosition,
+    Sampling, Scene, SceneFormat, Settings, ShadowMode, Shape, WorldFromObject,
 };
 pub use source::{FileId, LineCol, SourceFile, SourceMap, Span};
 pub use validate::{validate, InvalidScene, ValidScene};

@@ -57,6 +57,16 @@ pub const MAX_SAMPLES_PER_PIXEL: u32 = 4_096;
 /// Recursion depth of the tracer (`max_depth`).
 pub const MAX_DEPTH: u32 = 256;
 
+/// Samples a filtered render keeps (width times height times samples per pixel): a filter
+/// that reaches past the pixel (any but `box` of radius 0.5) needs every sample's colour
+/// until the image is filtered, 12 bytes each, so this is 384 MiB.
+pub const MAX_FILTERED_SAMPLES: u64 = 1 << 25;
+
+/// A filter's radius in pixels (the gaussian's σ, which reaches 2σ). A pixel's value weighs
+/// every sample of the (2·reach + 1)² pixels around it: at radius 4 a gaussian weighs 289
+/// pixels' samples.
+pub const MAX_FILTER_RADIUS: f64 = 4.0;
+
 /// Nodes one recorded ray tree may hold; a tree over this is cut, and says where.
 pub const MAX_RAY_TREE_NODES: usize = 100_000;
 
@@ -221,6 +231,16 @@ pub const ALL: &[Limit] = &[
         "anti-aliasing samples per pixel",
     ),
     count("max depth", MAX_DEPTH as u64, "recursion depth of the tracer (`max_depth`)"),
+    count(
+        "filtered samples",
+        MAX_FILTERED_SAMPLES,
+        "samples a render keeps to filter (width times height times samples, with any `filter` but `box` of radius 0.5)",
+    ),
+    number(
+        "filter radius",
+        MAX_FILTER_RADIUS,
+        "a filter's radius in pixels (`filter_radius`; the gaussian's σ)",
+    ),
     count(
         "ray tree nodes",
         MAX_RAY_TREE_NODES as u64,

@@ -21,7 +21,7 @@ pub fn print(scene: &Scene) -> String {
     );
     let _ = writeln!(
         out,
-        "  background {}, ambient {}, epsilon {}, shadows {}{}{}{}{}{}",
+        "  background {}, ambient {}, epsilon {}, shadows {}{}{}{}{}{}{}",
         color(&s.background),
         color(&s.ambient),
         s.epsilon.map_or("auto".to_string(), |e| e.to_string()),
@@ -51,6 +51,12 @@ pub fn print(scene: &Scene) -> String {
             crate::scene::Sampling::Jittered => "",
             crate::scene::Sampling::Grid => ", sampling grid",
             crate::scene::Sampling::Random => ", sampling random",
+        },
+        // Shown when it is not the default box of each pixel's own samples.
+        if s.filter_is_own_pixel() {
+            String::new()
+        } else {
+            format!(", filter {} {}", word(&s.filter), s.filter_radius)
         }
     );
     // The course's rules and the student-bug switches: a line only when one leaves its

@@ -10,8 +10,8 @@ use glam::{DMat4, DVec3};
 
 use crate::diagnostic::Diagnostic;
 use crate::limits::{
-    MAX_COORDINATE, MAX_DEPTH, MAX_IMAGE_SIDE, MAX_INTENSITY, MAX_IOR, MAX_PIXELS,
-    MAX_SAMPLES_PER_PIXEL, MIN_IOR, MIN_SIZE,
+    MAX_COORDINATE, MAX_DEPTH, MAX_FILTERED_SAMPLES, MAX_IMAGE_SIDE, MAX_INTENSITY, MAX_IOR,
+    MAX_PIXELS, MAX_SAMPLES_PER_PIXEL, MIN_IOR, MIN_SIZE,
 };
 use crate::scene::{Color, LightKind, Material, Object, ObjectKind, Projection, Scene, Shape};
 use crate::source::Span;
@@ -249,6 +249,18 @@ impl Ranges<'_> {
                 "max depth",
             ),
         ];
+        // Only a filter that reaches past the pixel keeps the samples.
+        let filtered_samples = if s.filter_is_own_pixel() {
+            0
+        } else {
+            u64::from(s.width) * u64::from(s.height) * u64::from(s.samples_per_pixel)
+        };
+        let counts = counts.into_iter().chain([(
+            "number of samples to filter (width times height times samples)",
+            filtered_samples,
+            MAX_FILTERED_SAMPLES,
+            "filtered samples",
+        )]);
         for (what, value, max, limit) in counts {
             if value > max {
                 self.errors.push(Diagnostic::error(
@@ -256,6 +268,17 @@ impl Ranges<'_> {
                     span,
                 ));
             }
+        }
+        let radius = s.filter_radius;
+        if !(radius.is_finite() && radius > 0.0 && radius <= crate::limits::MAX_FILTER_RADIUS) {
+            self.errors.push(Diagnostic::error(
+                format!(
+                    "the `filter_radius` is {radius}: it must be above 0 and at most the filter \
+                     radius limit ({})",
+                    crate::limits::MAX_FILTER_RADIUS
+                ),
+                span,
+            ));
         }
         // Unset, the tracer bounds the offset by the hit point's rounding error itself.
         if let Some(epsilon) = s.epsilon {

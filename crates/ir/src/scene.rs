@@ -80,6 +80,20 @@ pub enum Sampling {
     Random,
 }
 
+/// How a pixel's value is made from the samples around it (the course's reconstruction
+/// filters, assignment 7). Sample positions are measured in pixels from the pixel's centre.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Filter {
+    /// Weight 1 for a sample inside the square `-r <= dx < r`, `-r <= dy < r`, 0 outside.
+    /// With radius 0.5 (the default) that is exactly the pixel's own samples, averaged.
+    Box,
+    /// Weight `1 - d/r` at distance `d` from the centre, 0 from `r` on.
+    Tent,
+    /// Weight `exp(-d²/(2σ²))` with σ the filter radius, 0 from `2σ` on.
+    Gaussian,
+}
+
 /// Render settings. Defaults live here so that the language, the CLI and tests agree.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Settings {
@@ -93,6 +107,10 @@ pub struct Settings {
     pub samples_per_pixel: u32,
     /// Where those samples fall in the pixel.
     pub sampling: Sampling,
+    /// How the samples around a pixel make its value.
+    pub filter: Filter,
+    /// The box's and tent's radius, the gaussian's σ, in pixels.
+    pub filter_radius: f64,
     pub background: Color,
     /// The global ambient light `Ia`.
     pub ambient: Color,
@@ -150,6 +168,14 @@ pub enum SamplePosition {
     Corner,
 }
 
+impl Settings {
+    /// Whether each pixel is the plain mean of its own samples (the box filter of radius
+    /// 0.5, the default): the render then keeps no samples beyond the pixel.
+    pub fn filter_is_own_pixel(&self) -> bool {
+        self.filter == Filter::Box && self.filter_radius == 0.5
+    }
+}
+
 impl Default for Settings {
     fn default() -> Self {
         Settings {
@@ -159,6 +185,8 @@ impl Default for Settings {
             min_weight: 0.001,
             samples_per_pixel: 1,
             sampling: Sampling::Jittered,
+            filter: Filter::Box,
+            filter_radius: 0.5,
             background: Color::BLACK,
             ambient: Color::WHITE,
             epsilon: None,

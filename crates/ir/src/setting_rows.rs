@@ -13,7 +13,9 @@
 //! the kind, default and doc from the row); then give it meaning in the tracer.
 
 use crate::limits::{self, MAX_INTENSITY};
-use crate::scene::{Color, Fresnel, Highlight, SamplePosition, Sampling, Settings, ShadowMode};
+use crate::scene::{
+    Color, Filter, Fresnel, Highlight, SamplePosition, Sampling, Settings, ShadowMode,
+};
 
 /// The value a setting takes, with its range.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -169,6 +171,40 @@ pub const SAMPLING: SettingRow = SettingRow {
             _ => Sampling::Jittered,
         }
     },
+};
+
+pub const FILTER: SettingRow = SettingRow {
+    name: "filter",
+    kind: SettingKind::Word(&["box", "tent", "gaussian"]),
+    default: "box",
+    doc: "how the samples around a pixel make its value (the weighted mean of every sample within the filter's reach, from this pixel and its neighbours): `box` (weight 1 inside a square), `tent` (falling linearly to 0 at the radius) or `gaussian` (σ the radius, cut at 2σ)",
+    get: |s| {
+        Some(SettingValue::Word(match s.filter {
+            Filter::Box => "box",
+            Filter::Tent => "tent",
+            Filter::Gaussian => "gaussian",
+        }))
+    },
+    set: |s, v| {
+        s.filter = match word(v) {
+            "tent" => Filter::Tent,
+            "gaussian" => Filter::Gaussian,
+            _ => Filter::Box,
+        }
+    },
+};
+
+pub const FILTER_RADIUS: SettingRow = SettingRow {
+    name: "filter_radius",
+    kind: SettingKind::Number {
+        min: 0.0,
+        open: true,
+        max: limits::MAX_FILTER_RADIUS,
+    },
+    default: "0.5",
+    doc: "the filter's radius in pixels (the gaussian's σ); `box` with 0.5 is each pixel's own samples, averaged",
+    get: |s| Some(SettingValue::Number(s.filter_radius)),
+    set: |s, v| s.filter_radius = number(v),
 };
 
 pub const BACKGROUND: SettingRow = SettingRow {
@@ -377,6 +413,8 @@ pub const SETTINGS: &[SettingRow] = &[
     MIN_WEIGHT,
     SAMPLES,
     SAMPLING,
+    FILTER,
+    FILTER_RADIUS,
     BACKGROUND,
     AMBIENT,
     EPSILON,

@@ -30,7 +30,7 @@ const FOREIGN: &[(&str, &str)] = &[
     ),
     (
         "filter",
-        "light through a surface is the material's `transmissive` colour (with `ior` for refraction)",
+        "light through a surface is the material's `transmissive` colour (with `ior` for refraction); whitted's `filter` is a setting, how samples make a pixel (`settings { filter tent }`)",
     ),
     (
         "transmit",
@@ -430,8 +430,8 @@ mod tests {
     fn every_foreign_word_is_not_a_whitted_property() {
         // Advice for a word whitted itself uses would contradict the language.
         for (word, _) in FOREIGN {
-            if *word == "color" || *word == "background" {
-                // Both are whitted properties in some blocks (a light's `color`, a setting);
+            if *word == "color" || *word == "background" || *word == "filter" {
+                // All are whitted properties in some blocks (a light's `color`, a setting);
                 // their advice only appears where they are unknown or misused.
                 continue;
             }

@@ -217,6 +217,12 @@ properties! {
     Sampling "sampling" {
         Settings => setting_kind(&S::SAMPLING), S::SAMPLING.default, S::SAMPLING.doc;
     }
+    Filter "filter" {
+        Settings => setting_kind(&S::FILTER), S::FILTER.default, S::FILTER.doc;
+    }
+    FilterRadius "filter_radius" {
+        Settings => setting_kind(&S::FILTER_RADIUS), S::FILTER_RADIUS.default, S::FILTER_RADIUS.doc;
+    }
     Background "background" {
         Settings => setting_kind(&S::BACKGROUND), S::BACKGROUND.default, S::BACKGROUND.doc;
     }

@@ -118,6 +118,8 @@ fn settings(
         min_weight: options.weight,
         samples_per_pixel: options.samples,
         sampling: options.sampling,
+        filter: options.filter,
+        filter_radius: options.filter_radius,
         background: background.unwrap_or(DEFAULT_BACKGROUND),
         ambient: ambient.unwrap_or(Color::BLACK),
         // The error-bounded offset, not the course's fixed epsilon: it differs from the

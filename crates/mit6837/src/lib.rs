@@ -54,6 +54,10 @@ pub struct CourseOptions {
     /// Where a pixel's sample falls (the handouts do not say; whitted's flag
     /// `-sample_position corner` picks the corner).
     pub sample_position: whitted_ir::SamplePosition,
+    /// `-box_filter R`, `-tent_filter R` or `-gaussian_filter SIGMA` (assignment 7): the
+    /// filter and its radius (σ for the gaussian).
+    pub filter: whitted_ir::Filter,
+    pub filter_radius: f64,
 }
 
 impl Default for CourseOptions {
@@ -69,6 +73,8 @@ impl Default for CourseOptions {
             samples: 1,
             sampling: whitted_ir::Sampling::Jittered,
             sample_position: whitted_ir::SamplePosition::Centre,
+            filter: whitted_ir::Filter::Box,
+            filter_radius: 0.5,
         }
     }
 }

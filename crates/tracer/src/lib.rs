@@ -9,6 +9,7 @@
 mod camera;
 mod csg;
 pub mod display;
+mod filter;
 mod hit_error;
 mod light;
 mod material;
@@ -32,15 +33,16 @@ mod trace;
 mod tests;
 
 // The BVH lives in whitted-bvh; the walk the renderer takes is part of this API.
+pub use filter::{Film, PixelFilter};
 pub use recorder::{
     CoincidentSurface, Interface, LightSample, NoRecord, NoShadowRay, PixelStats, RayKind,
     RayStart, Recorder, ShadowRay, ShadowResult, SkippedRay, SurfaceHit, Termination,
     TerminationSet,
 };
 pub use render::{
-    render, render_from, render_with_pixel_stats, trace_pixel_preferring, trace_pixel_with, Image,
-    NoObserver, PixelAccumulator, RenderObserver, RenderOptions, RenderStats, TileResult,
-    TILE_SIZE,
+    render, render_film, render_from, render_with_pixel_stats, trace_pixel_preferring,
+    trace_pixel_with, Image, NoObserver, PixelAccumulator, RenderObserver, RenderOptions,
+    RenderStats, TileResult, TILE_SIZE,
 };
 pub use scene::PreparedScene;
 pub use whitted_bvh::{force_traversal_path, PathUnavailable, TraversalPath};

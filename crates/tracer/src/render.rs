@@ -19,6 +19,7 @@ use rayon::prelude::*;
 use whitted_ir::{Camera, Sampling, Settings};
 
 use crate::camera::PreparedCamera;
+use crate::filter::{Film, PixelFilter};
 use crate::query::Hit;
 use crate::recorder::{NoRecord, PixelStats, Recorder};
 use crate::sampling::sample_offset;
@@ -133,7 +134,13 @@ pub struct TileResult {
 /// Receives finished tiles as they complete (from worker threads), e.g. for a progress bar
 /// or a progressive display; `should_stop` lets a caller cancel a render.
 pub trait RenderObserver: Sync {
+    /// A finished tile. With a filter that reaches past the pixel (the `filter` setting),
+    /// a tile shows each pixel's own samples averaged, a preview: the image is filtered
+    /// once every sample is in, and [`RenderObserver::image_filtered`] brings it.
     fn tile_done(&self, _tile: &TileResult) {}
+    /// The whole filtered image as one tile, after every [`RenderObserver::tile_done`] of
+    /// a render whose filter reaches past the pixel (never for the default box filter).
+    fn image_filtered(&self, _image: &TileResult) {}
     fn should_stop(&self) -> bool {
         false
     }
@@ -178,12 +185,14 @@ impl PixelAccumulator {
 
 /// Renders with rayon over tiles on the *current* rayon pool. Output is bit-identical
 /// whatever the thread count and from run to run. Returns `None` if the observer cancels.
+/// Each pixel is made from its samples by the scene's `filter` (by default the mean of the
+/// pixel's own samples; see [`PixelFilter`]).
 pub fn render(
     scene: &PreparedScene,
     options: &RenderOptions,
     observer: &dyn RenderObserver,
 ) -> Option<(Image, RenderStats)> {
-    render_recorded::<NoRecord>(scene, &scene.camera, options, observer)
+    render_filtered::<NoRecord>(scene, &scene.camera, options, observer)
         .map(|(image, stats, _)| (image, stats))
 }
 
@@ -197,24 +206,103 @@ pub fn render_from(
     observer: &dyn RenderObserver,
 ) -> Option<(Image, RenderStats)> {
     let camera = PreparedCamera::new(camera);
-    render_recorded::<NoRecord>(scene, &camera, options, observer)
+    render_filtered::<NoRecord>(scene, &camera, options, observer)
         .map(|(image, stats, _)| (image, stats))
 }
 
 /// [`render`], also gathering [`PixelStats`] for every pixel (row-major, like the image),
-/// through the same tracing code.
+/// through the same tracing code. A pixel's statistics are those of its own samples.
 pub fn render_with_pixel_stats(
     scene: &PreparedScene,
     options: &RenderOptions,
     observer: &dyn RenderObserver,
 ) -> Option<(Image, RenderStats, Vec<PixelStats>)> {
-    render_recorded::<PixelStats>(scene, &scene.camera, options, observer)
+    render_filtered::<PixelStats>(scene, &scene.camera, options, observer)
+}
+
+/// [`render`], keeping every sample: the [`Film`] (for pictures of the samples) beside the
+/// image, which is the film filtered as [`render`] filters it, bit for bit. The film holds
+/// 12 bytes per sample; the caller bounds its size (`limits::MAX_FILTERED_SAMPLES`).
+pub fn render_film(
+    scene: &PreparedScene,
+    options: &RenderOptions,
+    observer: &dyn RenderObserver,
+) -> Option<(Film, Image, RenderStats)> {
+    let filter = PixelFilter::from_settings(scene.settings());
+    let (image, stats, _, film) =
+        render_recorded::<NoRecord>(scene, &scene.camera, options, observer, true)?;
+    let film = film?;
+    if filter.is_own_pixel() {
+        return Some((film, image, stats));
+    }
+    let (image, stats) = filter_image(&film, &filter, image, stats, observer)?;
+    Some((film, image, stats))
+}
+
+/// The render, then, for a filter that reaches past the pixel, the filtering pass over the
+/// samples it kept.
+fn render_filtered<R: Recorder + Default + Send>(
+    scene: &PreparedScene,
+    camera: &PreparedCamera,
+    options: &RenderOptions,
+    observer: &dyn RenderObserver,
+) -> Option<(Image, RenderStats, Vec<R>)> {
+    let filter = PixelFilter::from_settings(scene.settings());
+    let keep = !filter.is_own_pixel();
+    let (image, stats, recorders, film) =
+        render_recorded::<R>(scene, camera, options, observer, keep)?;
+    match film {
+        Some(film) => {
+            let (image, stats) = filter_image(&film, &filter, image, stats, observer)?;
+            Some((image, stats, recorders))
+        }
+        None => Some((image, stats, recorders)),
+    }
+}
+
+/// The filtering pass: every pixel of `image` made again from `film` by `filter`, rows in
+/// parallel (each pixel a pure function of the film, so the thread count changes nothing),
+/// then shown to the observer whole. The render's time includes it.
+fn filter_image(
+    film: &Film,
+    filter: &PixelFilter,
+    mut image: Image,
+    mut stats: RenderStats,
+    observer: &dyn RenderObserver,
+) -> Option<(Image, RenderStats)> {
+    let started = Instant::now();
+    let width = image.width as usize;
+    image
+        .pixels
+        .par_chunks_mut(width.max(1))
+        .enumerate()
+        .try_for_each(|(y, row)| {
+            if observer.should_stop() {
+                return None;
+            }
+            for (x, pixel) in row.iter_mut().enumerate() {
+                *pixel = film.filter_pixel(filter, x as u32, y as u32);
+            }
+            Some(())
+        })?;
+    stats.render_seconds += started.elapsed().as_secs_f64();
+    let tile = TileResult {
+        x: 0,
+        y: 0,
+        width: image.width,
+        height: image.height,
+        pixels: std::mem::take(&mut image.pixels),
+    };
+    observer.image_filtered(&tile);
+    image.pixels = tile.pixels;
+    Some((image, stats))
 }
 
 /// Traces sample `sample` of pixel `(x, y)` with `rec` attached, running exactly the code
 /// [`render`] runs for it, and returns that sample's colour. With one sample per pixel this
 /// is the rendered pixel, bit for bit; with more, the pixel is the [`PixelAccumulator`]
-/// mean of samples `0..samples_per_pixel`. Coordinates outside the image still trace a
+/// mean of samples `0..samples_per_pixel` (with the default filter; with another, it is
+/// [`PixelFilter::filter_pixel`] over the samples of the pixel and its neighbours). Coordinates outside the image still trace a
 /// ray (through the extended image plane); callers check ranges.
 pub fn trace_pixel_with<R: Recorder>(
     scene: &PreparedScene,
@@ -300,6 +388,8 @@ struct Worker<'a, R> {
     /// `None` for rays of a packet that could not walk together, which find their own.
     first_hits: Vec<Option<Option<Hit>>>,
     pixels: Vec<[f32; 3]>,
+    /// Every sample's colour of the tile, pixel by pixel, when the render keeps them.
+    samples: Vec<[f32; 3]>,
     recorders: Vec<R>,
 }
 
@@ -309,14 +399,20 @@ struct Worker<'a, R> {
 struct Band<'i, R> {
     pixels: &'i mut [[f32; 3]],
     recorders: &'i mut [R],
+    /// The band's samples in the film (empty when the render keeps none).
+    samples: &'i mut [[f32; 3]],
 }
 
+/// The sample pass: every pixel the mean of its own samples, and, when `keep_samples`, the
+/// film of every sample.
+#[allow(clippy::type_complexity)]
 fn render_recorded<R: Recorder + Default + Send>(
     scene: &PreparedScene,
     camera: &PreparedCamera,
     options: &RenderOptions,
     observer: &dyn RenderObserver,
-) -> Option<(Image, RenderStats, Vec<R>)> {
+    keep_samples: bool,
+) -> Option<(Image, RenderStats, Vec<R>, Option<Film>)> {
     let started = Instant::now();
     let (width, height) = (options.width, options.height);
     let tiles_x = width.div_ceil(TILE_SIZE);
@@ -327,10 +423,24 @@ fn render_recorded<R: Recorder + Default + Send>(
     let mut recorders: Vec<R> = Vec::with_capacity(pixel_count);
     recorders.resize_with(pixel_count, R::default);
     let band_len = (width as usize * TILE_SIZE as usize).max(1);
+    let samples = options.samples() as usize;
+    let mut film = if keep_samples {
+        vec![[0.0f32; 3]; pixel_count * samples]
+    } else {
+        Vec::new()
+    };
+    let mut film_bands = film.chunks_mut(band_len * samples);
     let bands: Vec<Mutex<Band<'_, R>>> = pixels
         .chunks_mut(band_len)
         .zip(recorders.chunks_mut(band_len))
-        .map(|(pixels, recorders)| Mutex::new(Band { pixels, recorders }))
+        .map(|(pixels, recorders)| {
+            let samples = film_bands.next().unwrap_or_default();
+            Mutex::new(Band {
+                pixels,
+                recorders,
+                samples,
+            })
+        })
         .collect();
     let counters = (0..tile_count)
         .into_par_iter()
@@ -340,6 +450,7 @@ fn render_recorded<R: Recorder + Default + Send>(
                 rays: Vec::new(),
                 first_hits: Vec::new(),
                 pixels: Vec::new(),
+                samples: Vec::new(),
                 recorders: Vec::new(),
             },
             |worker, index| {
@@ -347,7 +458,8 @@ fn render_recorded<R: Recorder + Default + Send>(
                 let y0 = (index as u32 / tiles_x) * TILE_SIZE;
                 let band = bands.get((y0 / TILE_SIZE) as usize)?;
                 let view = (camera, scene.settings().sampling);
-                render_tile::<R>(worker, view, options, observer, band, x0, y0)
+                let keep = keep_samples;
+                render_tile::<R>(worker, view, options, observer, band, (x0, y0), keep)
             },
         )
         .try_reduce(RayCounters::default, |mut a, b| {
@@ -372,7 +484,14 @@ fn render_recorded<R: Recorder + Default + Send>(
         height,
         pixels,
     };
-    Some((image, stats, recorders))
+    let film = keep_samples.then(|| Film {
+        width,
+        height,
+        samples_per_pixel: samples as u32,
+        sampling: scene.settings().sampling,
+        colors: film,
+    });
+    Some((image, stats, recorders, film))
 }
 
 /// Renders the tile at `(x0, y0)`, shows it to the observer, and copies it into its band
@@ -383,8 +502,8 @@ fn render_tile<R: Recorder + Default>(
     options: &RenderOptions,
     observer: &dyn RenderObserver,
     band: &Mutex<Band<'_, R>>,
-    x0: u32,
-    y0: u32,
+    (x0, y0): (u32, u32),
+    keep_samples: bool,
 ) -> Option<RayCounters> {
     let width = TILE_SIZE.min(options.width - x0);
     let height = TILE_SIZE.min(options.height - y0);
@@ -392,6 +511,7 @@ fn render_tile<R: Recorder + Default>(
     let tracer = &mut worker.tracer;
     let mut pixels = std::mem::take(&mut worker.pixels);
     pixels.clear();
+    worker.samples.clear();
     worker.recorders.clear();
     let rays = &mut worker.rays;
     for y in y0..y0 + height {
@@ -431,6 +551,9 @@ fn render_tile<R: Recorder + Default>(
                     None => tracer.trace(ray, &PathState::camera(), &mut rec),
                 };
                 accumulator.add(color.to_array());
+                if keep_samples {
+                    worker.samples.push(color.to_array());
+                }
             }
             pixels.push(accumulator.mean());
             worker.recorders.push(rec);
@@ -464,6 +587,14 @@ fn render_tile<R: Recorder + Default>(
             if let Some(targets) = band.recorders.get_mut(start..end) {
                 for (target, recorder) in targets.iter_mut().zip(recorders.by_ref()) {
                     *target = recorder;
+                }
+            }
+            if keep_samples {
+                let samples = samples as usize;
+                let from = row * tile_width * samples;
+                let tile_samples = &worker.samples[from..from + tile_row.len() * samples];
+                if let Some(target) = band.samples.get_mut(start * samples..end * samples) {
+                    target.copy_from_slice(tile_samples);
                 }
             }
         }

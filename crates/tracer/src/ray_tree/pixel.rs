@@ -1,5 +1,7 @@
 //! `trace_pixel`: one pixel's ray tree, recorded from the same code path `render` runs, with
-//! the pixel's colour averaged exactly as `render` averages it.
+//! the pixel's colour averaged exactly as `render` averages it (with a filter that reaches
+//! past the pixel, filtered from its own samples and its neighbours', which are traced again
+//! unrecorded: the tree holds the pixel's own samples).
 
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -8,6 +10,7 @@ use whitted_ir::Scene;
 
 use super::model::{RayTree, SampleChoice, SampleTree, ShadingModel};
 use super::tree_recorder::TreeRecorder;
+use crate::filter::PixelFilter;
 use crate::recorder::NoRecord;
 use crate::render::{trace_pixel_with, PixelAccumulator, RenderOptions};
 use crate::scene::PreparedScene;
@@ -151,6 +154,7 @@ pub fn trace_pixel_request(
     let mut recorder = TreeRecorder::with_budget(scene, node_budget, cancel);
     let mut accumulator = PixelAccumulator::new();
     let mut samples = Vec::new();
+    let mut own_colors = Vec::with_capacity(samples_per_pixel as usize);
     for index in 0..samples_per_pixel {
         let recorded = match which {
             SampleChoice::All => true,
@@ -167,14 +171,40 @@ pub fn trace_pixel_request(
             trace_pixel_with(prepared, options, x, y, index, &mut NoRecord)
         };
         accumulator.add(color);
+        own_colors.push(color);
         if cancelled() {
             return Err(TraceError::Cancelled);
         }
     }
+    // A filter that reaches past the pixel weighs the neighbours' samples too: they are
+    // traced again (not recorded), and the pixel's colour is what the render filtered.
+    let filter = PixelFilter::from_settings(prepared.settings());
+    let color = if filter.is_own_pixel() {
+        accumulator.mean()
+    } else {
+        let mut neighbours_cancelled = false;
+        let color = filter.filter_pixel(
+            (x, y),
+            (options.width, options.height),
+            (samples_per_pixel, prepared.settings().sampling),
+            |nx, ny, k| {
+                if (nx, ny) == (x, y) {
+                    own_colors[k as usize]
+                } else {
+                    neighbours_cancelled |= cancelled();
+                    trace_pixel_with(prepared, options, nx, ny, k, &mut NoRecord)
+                }
+            },
+        );
+        if neighbours_cancelled {
+            return Err(TraceError::Cancelled);
+        }
+        color
+    };
     Ok(RayTree {
         pixel: [x, y],
         image_size: [options.width, options.height],
-        color: accumulator.mean(),
+        color,
         samples_per_pixel,
         max_depth: options.depth_limit(),
         min_weight: options.min_weight,
