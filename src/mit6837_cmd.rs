@@ -360,7 +360,11 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
         Request::Help => return crate::scene_input::write_stdout(&format!("{USAGE}\n")),
         Request::Run(run) => run,
     };
-    let nothing = [run.output.is_none(), run.depth.is_none(), run.normals.is_none()];
+    let nothing = [
+        run.output.is_none(),
+        run.depth.is_none(),
+        run.normals.is_none(),
+    ];
     if nothing.iter().all(|&n| n)
         && run.render_samples.is_none()
         && run.render_filter.is_none()

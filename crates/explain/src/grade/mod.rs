@@ -21,8 +21,9 @@ pub use models::{Change, StudentBug, BUGS};
 pub use picture::side_by_side;
 pub use score::Score;
 
-/// How many of the best single models are paired with each other.
-const PAIRED: usize = 5;
+/// How many of the best single models are paired with every other model: a second bug
+/// often matches nothing alone (the first one changes every pixel it touches too).
+const PAIRED: usize = 3;
 
 /// How 8-bit values encode light.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -252,18 +253,32 @@ impl<'a> Grader<'a> {
             }
         }
         let mut singles = scored(&baseline, student, &reference, images);
-        // Pairs of the best singles that explain something: a pair stays when it explains
-        // clearly more than either of its models alone.
-        let best: Vec<&Candidate> = singles
+        // Pairs: each of the best singles with every other model that shows in this scene.
+        // A pair stays when it explains clearly more than either of its models alone.
+        let best: Vec<&'static StudentBug> = singles
             .iter()
             .filter(|c| c.0.score.net() > 0)
             .take(PAIRED)
-            .map(|c| &c.0)
+            .map(|c| c.0.bugs[0])
+            .collect();
+        let visible: Vec<&'static StudentBug> = singles
+            .iter()
+            .flat_map(|c| std::iter::once(c.0.bugs[0]).chain(c.0.same_as.iter().copied()))
             .collect();
         let mut pair_images = Vec::new();
-        for (i, a) in best.iter().enumerate() {
-            for b in &best[i + 1..] {
-                let pair = vec![a.bugs[0], b.bugs[0]];
+        let mut tried: Vec<(&str, &str)> = Vec::new();
+        for a in &best {
+            for b in &visible {
+                let (first, second) = if catalogue_index(a) < catalogue_index(b) {
+                    (*a, *b)
+                } else {
+                    (*b, *a)
+                };
+                if first.id == second.id || tried.contains(&(first.id, second.id)) {
+                    continue;
+                }
+                tried.push((first.id, second.id));
+                let pair = vec![first, second];
                 if let Some(image) = self.image_of(&pair)? {
                     pair_images.push((pair, image));
                 }
@@ -298,6 +313,12 @@ impl<'a> Grader<'a> {
         grade.ranked = singles.into_iter().map(|(c, _)| c).collect();
         Ok(grade)
     }
+}
+
+fn catalogue_index(bug: &StudentBug) -> usize {
+    BUGS.iter()
+        .position(|b| b.id == bug.id)
+        .unwrap_or(usize::MAX)
 }
 
 /// Scores each image, folding models whose images are identical into one candidate (the

@@ -37,11 +37,10 @@ fn set(name: &'static str, value: impl Into<String>) -> Option<Change> {
 pub const BUGS: &[StudentBug] = &[
     StudentBug {
         id: "no-shadow-offset",
-        words: "shadow rays start exactly on the surface and hit it again (shadow acne)",
-        handout: "assignment 4, shadows: start the shadow ray a small epsilon off the surface",
-        fix: "start shadow (and secondary) rays a small epsilon off the surface",
-        change: |s| (s.shadows != ShadowMode::None && s.epsilon != Some(0.0)).then_some(())
-            .and_then(|_| set("epsilon", "0")),
+        words: "rays leaving a surface start exactly on it and hit it again (shadow acne, speckled reflections)",
+        handout: "assignment 4, shadows and traceRay: start shadow, reflected and refracted rays a small epsilon off the surface",
+        fix: "start shadow and secondary rays a small epsilon off the surface (or ignore hits closer than epsilon)",
+        change: |s| (s.epsilon != Some(0.0)).then(|| Change::Set(vec![("epsilon", "0".into())])),
     },
     StudentBug {
         id: "no-shadows",
