@@ -16,6 +16,7 @@ mod media;
 mod mesh;
 mod noise;
 pub mod optics;
+mod perlin;
 mod query;
 pub mod ray_tree;
 mod recorder;
@@ -32,6 +33,7 @@ mod trace;
 mod tests;
 
 // The BVH lives in whitted-bvh; the walk the renderer takes is part of this API.
+pub use material::Blend;
 pub use recorder::{
     CoincidentSurface, Interface, LightSample, NoRecord, NoShadowRay, PixelStats, RayKind,
     RayStart, Recorder, ShadowRay, ShadowResult, SkippedRay, SurfaceHit, Termination,
