@@ -422,7 +422,10 @@ impl Reshader<'_> {
             return background * beer_lambert(a, f64::INFINITY);
         };
         let absorption = beer_lambert(a, f64::from(hit.t));
-        let m = self.material(hit.resolved_material.handle).clone();
+        let m = match &hit.blend {
+            None => self.material(hit.resolved_material.handle).clone(),
+            Some(blend) => self.blended(hit, blend),
+        };
         self.check_pattern(hit, path);
         let p = v(hit.point);
         let n = v(hit.shading_normal).normalize();
@@ -875,6 +878,97 @@ impl Reshader<'_> {
         )
     }
 
+    /// The course's blend of two materials (docs/courses.md, "Procedural materials"): the
+    /// colours and the exponent interpolated, the medium's numbers (ior, Fresnel, priority,
+    /// absorption) the recorded material's, which is the one with the larger weight.
+    fn blended(
+        &self,
+        hit: &whitted_tracer::ray_tree::HitInfo,
+        blend: &whitted_tracer::ray_tree::BlendInfo,
+    ) -> Material {
+        let (first, second) = (
+            self.material(blend.first.handle),
+            self.material(blend.second.handle),
+        );
+        let w = f64::from(blend.weight);
+        let mix = |a: &whitted_ir::Color, b: &whitted_ir::Color| {
+            whitted_ir::Color::new(
+                a.r + (b.r - a.r) * w,
+                a.g + (b.g - a.g) * w,
+                a.b + (b.b - a.b) * w,
+            )
+        };
+        Material {
+            ambient: mix(&first.ambient, &second.ambient),
+            diffuse: mix(&first.diffuse, &second.diffuse),
+            specular: mix(&first.specular, &second.specular),
+            shininess: first.shininess + (second.shininess - first.shininess) * w,
+            reflective: mix(&first.reflective, &second.reflective),
+            transmissive: mix(&first.transmissive, &second.transmissive),
+            emission: mix(&first.emission, &second.emission),
+            ..self.material(hit.resolved_material.handle).clone()
+        }
+    }
+
+    /// The course's patterns read the world-space point: the blend's weight (or the
+    /// checker's cell) recomputed in f64 from the formulas, with the reference noise.
+    fn check_course_pattern(
+        &mut self,
+        hit: &whitted_tracer::ray_tree::HitInfo,
+        pattern: &whitted_ir::Pattern,
+        path: &str,
+    ) {
+        let q = pattern.pattern_from_object.transform_point3(v(hit.point));
+        let n = |octaves| whitted_tracer::testing::reference_octave_sum(q.to_array(), octaves);
+        let weight = match pattern.kind {
+            PatternKind::CourseNoise { octaves } => n(octaves).clamp(0.0, 1.0),
+            PatternKind::CourseMarble {
+                octaves,
+                frequency,
+                amplitude,
+            } => (1.0 + (frequency * q.x + amplitude * n(octaves)).sin()) / 2.0,
+            PatternKind::CourseWood {
+                octaves,
+                frequency,
+                amplitude,
+            } => {
+                let radius = (q.x * q.x + q.z * q.z).sqrt();
+                (1.0 + (frequency * radius + amplitude * n(octaves)).sin()) / 2.0
+            }
+            _ => return,
+        };
+        let Some(blend) = &hit.blend else {
+            self.problem(
+                path,
+                format!("a {} pattern without a blend", pattern.kind.name()),
+            );
+            return;
+        };
+        let plain = |h: Handle<Material>| self.material(h.index() as u32).pattern.is_none();
+        if plain(pattern.a)
+            && plain(pattern.b)
+            && (blend.first.handle as usize, blend.second.handle as usize)
+                != (pattern.a.index(), pattern.b.index())
+        {
+            self.problem(
+                path,
+                "the blend is not of the pattern's two materials".into(),
+            );
+        }
+        // The point is f32 and the weight's slope is about frequency plus amplitude times
+        // the noise's: 1e-3 is far above the rounding and far below any formula mistake.
+        if (f64::from(blend.weight) - weight).abs() > 1e-3 {
+            self.problem(
+                path,
+                format!(
+                    "the {} weight at {q:?} is {weight}, recorded {}",
+                    pattern.kind.name(),
+                    blend.weight
+                ),
+            );
+        }
+    }
+
     /// Recomputes which of a pattern's two materials covers the hit point (away from cell
     /// edges) from the leaf's transform and the pattern's own, in f64.
     fn check_pattern(&mut self, hit: &whitted_tracer::ray_tree::HitInfo, path: &str) {
@@ -885,16 +979,27 @@ impl Reshader<'_> {
             }
             return;
         };
+        if pattern.kind.blends() {
+            let pattern = pattern.clone();
+            return self.check_course_pattern(hit, &pattern, path);
+        }
         let leaf = &self.scene.objects[Handle::from_index(hit.leaf.handle as usize)];
-        let object_from_world: DMat4 = leaf.world_from_object.inverse();
+        let object_from_world: DMat4 = if pattern.kind.world_space() {
+            DMat4::IDENTITY
+        } else {
+            leaf.world_from_object.inverse()
+        };
         let q = (pattern.pattern_from_object * object_from_world).transform_point3(v(hit.point))
             / pattern.scale;
         let coordinates: &[f64] = match pattern.kind {
-            PatternKind::Checker => &[q.x, q.y, q.z],
+            PatternKind::Checker | PatternKind::CourseCheckerboard => &[q.x, q.y, q.z],
             PatternKind::Stripes => &[q.x],
             // Noise patterns are checked by their own tests (crates/tracer/src/noise.rs):
             // recomputing them here would repeat the code under test.
             PatternKind::Marble | PatternKind::Wood | PatternKind::Turbulence => return,
+            PatternKind::CourseNoise { .. }
+            | PatternKind::CourseMarble { .. }
+            | PatternKind::CourseWood { .. } => return,
         };
         // The hit point is f32: near a cell edge the cell is not decidable from it.
         if coordinates
@@ -909,6 +1014,10 @@ impl Reshader<'_> {
         } else {
             pattern.b
         };
+        if self.material(expected.index() as u32).pattern.is_some() {
+            // A pattern of patterns: the recorded material is the inner one's choice.
+            return;
+        }
         if expected.index() != hit.resolved_material.handle as usize {
             self.problem(
                 path,

@@ -48,7 +48,7 @@ fn trace_json(args: &[&str]) -> Value {
 #[test]
 fn json_matches_the_documented_schema_on_varied_scenes() {
     let schema = schema();
-    let cases: [&[&str]; 8] = [
+    let cases: [&[&str]; 9] = [
         &["scenes/whitted.scene", "--pixel", "400,270"],
         // A spot cone that misses (`outside_cone` with its `cone`), and the ray budget.
         &[
@@ -79,6 +79,16 @@ fn json_matches_the_documented_schema_on_varied_scenes() {
         ],
         // A 6.837 scene: the course's model, `energy_clamp` off in the tree's model.
         &["scenes/mit6837/glass-gem.txt", "--pixel", "100,100"],
+        // The course's `Marble`: a blend of two materials.
+        &[
+            "scenes/mit6837/procedural.txt",
+            "--pixel",
+            "100,110",
+            "--width",
+            "200",
+            "--height",
+            "200",
+        ],
         &[
             "scenes/transparent-shadows.scene",
             "--pixel",
@@ -125,6 +135,7 @@ fn json_matches_the_documented_schema_on_varied_scenes() {
         "\"facing_away\"",
         "\"ray_budget\"",
         "\"cone\":{",
+        "\"blend\":{",
     ] {
         assert!(words.contains(word), "no {word} in the documents checked");
     }

@@ -119,6 +119,11 @@ pub const MAX_REFLECTANCE: f64 = 1.0;
 /// The largest nested-media priority of a material (any order of a few solids fits).
 pub const MAX_PRIORITY: u32 = 1_000;
 
+/// Octaves of noise in one of the MIT 6.837 course's `Noise`, `Marble` or `Wood` materials:
+/// each octave is one more noise evaluation per shading point, and past 16 an octave's
+/// weight (`2^-16`) is below what an 8-bit image shows.
+pub const MAX_NOISE_OCTAVES: u32 = 16;
+
 /// The smallest index of refraction.
 pub const MIN_IOR: f64 = 1e-3;
 
@@ -257,6 +262,11 @@ pub const ALL: &[Limit] = &[
         "estimated bytes of memory for one render",
     ),
     count("priority", MAX_PRIORITY as u64, "a material's nested-media priority"),
+    count(
+        "noise octaves",
+        MAX_NOISE_OCTAVES as u64,
+        "octaves of a 6.837 `Noise`, `Marble` or `Wood` material",
+    ),
     number(
         "largest coordinate",
         MAX_COORDINATE,

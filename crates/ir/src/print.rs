@@ -7,7 +7,9 @@ use std::fmt::Write;
 use glam::{DMat4, DVec3};
 
 use crate::arena::Handle;
-use crate::scene::{Color, LightKind, Material, Object, ObjectKind, Projection, Scene, Shape};
+use crate::scene::{
+    Color, LightKind, Material, Object, ObjectKind, PatternKind, Projection, Scene, Shape,
+};
 
 /// Prints the scene as indented text. Numbers use Rust's shortest round-trip form.
 pub fn print(scene: &Scene) -> String {
@@ -138,10 +140,31 @@ pub fn print(scene: &Scene) -> String {
         );
         let _ = writeln!(out, "  {}", material_fields(material));
         if let Some(p) = &material.pattern {
+            let parameters = match p.kind {
+                PatternKind::CourseNoise { octaves } => format!(" octaves {octaves}"),
+                PatternKind::CourseMarble {
+                    octaves,
+                    frequency,
+                    amplitude,
+                }
+                | PatternKind::CourseWood {
+                    octaves,
+                    frequency,
+                    amplitude,
+                } => format!(" octaves {octaves} frequency {frequency} amplitude {amplitude}"),
+                _ => String::new(),
+            };
+            let (between, space) = if p.kind.blends() {
+                ("blend", " (world space)")
+            } else if p.kind.world_space() {
+                ("of", " (world space)")
+            } else {
+                ("of", "")
+            };
             let _ = writeln!(
                 out,
-                "  pattern {} of {} and {} scale {}{}",
-                word(&p.kind),
+                "  pattern {} {between} {} and {}{parameters} scale {}{}{space}",
+                p.kind.name(),
                 p.a,
                 p.b,
                 p.scale,

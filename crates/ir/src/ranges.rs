@@ -334,6 +334,20 @@ impl Ranges<'_> {
         if let Some(pattern) = &m.pattern {
             self.size("pattern's scale", pattern.scale, span);
             self.matrix("pattern transform", &pattern.pattern_from_object, span);
+            if let crate::scene::PatternKind::CourseMarble {
+                frequency,
+                amplitude,
+                ..
+            }
+            | crate::scene::PatternKind::CourseWood {
+                frequency,
+                amplitude,
+                ..
+            } = pattern.kind
+            {
+                self.coordinate("pattern's frequency", frequency, span);
+                self.coordinate("pattern's amplitude", amplitude, span);
+            }
         }
     }
 

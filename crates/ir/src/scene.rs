@@ -303,7 +303,7 @@ impl Fresnel {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PatternKind {
     /// Alternating cubes of side `scale` in pattern space.
@@ -316,16 +316,88 @@ pub enum PatternKind {
     Wood,
     /// Blotches where fractal noise is at least 0.
     Turbulence,
+    /// The MIT 6.837 course's `Checkerboard`: `a` where `floor(x) + floor(y) + floor(z)` of
+    /// the texture-space point is even, `b` where it is odd.
+    CourseCheckerboard,
+    /// The course's `Noise`: `a` and `b` blended by `v = clamp(N(p), 0, 1)`, where `N` sums
+    /// `octaves` octaves of Perlin's improved noise (`N(p) = Σ noise(2^i·p) / 2^i`).
+    CourseNoise { octaves: u32 },
+    /// The course's `Marble`: blended by `v = (1 + sin(frequency·x + amplitude·N(p))) / 2`.
+    CourseMarble {
+        octaves: u32,
+        frequency: f64,
+        amplitude: f64,
+    },
+    /// The course's `Wood`: rings around texture-space y, blended by
+    /// `v = (1 + sin(frequency·sqrt(x² + z²) + amplitude·N(p))) / 2`.
+    CourseWood {
+        octaves: u32,
+        frequency: f64,
+        amplitude: f64,
+    },
 }
 
-/// A procedural choice between two materials at each surface point.
+impl PatternKind {
+    /// The course's four read the world-space hit point (the course's hit point is in world
+    /// space, whatever `Transform` the object is under); whitted's own read the object-space
+    /// point, so that a pattern moves with its object.
+    pub fn world_space(self) -> bool {
+        matches!(
+            self,
+            PatternKind::CourseCheckerboard
+                | PatternKind::CourseNoise { .. }
+                | PatternKind::CourseMarble { .. }
+                | PatternKind::CourseWood { .. }
+        )
+    }
+
+    /// Whether the pattern blends its two materials (a weight in [0, 1] at each point)
+    /// rather than choosing one of them.
+    pub fn blends(self) -> bool {
+        matches!(
+            self,
+            PatternKind::CourseNoise { .. }
+                | PatternKind::CourseMarble { .. }
+                | PatternKind::CourseWood { .. }
+        )
+    }
+
+    /// The noise octaves of a blending pattern.
+    pub fn octaves(self) -> Option<u32> {
+        match self {
+            PatternKind::CourseNoise { octaves }
+            | PatternKind::CourseMarble { octaves, .. }
+            | PatternKind::CourseWood { octaves, .. } => Some(octaves),
+            _ => None,
+        }
+    }
+
+    /// The name `whitted ir` shows: the scene language's word, or the course's block name.
+    pub fn name(self) -> &'static str {
+        match self {
+            PatternKind::Checker => "checker",
+            PatternKind::Stripes => "stripes",
+            PatternKind::Marble => "marble",
+            PatternKind::Wood => "wood",
+            PatternKind::Turbulence => "turbulence",
+            PatternKind::CourseCheckerboard => "Checkerboard",
+            PatternKind::CourseNoise { .. } => "Noise",
+            PatternKind::CourseMarble { .. } => "Marble",
+            PatternKind::CourseWood { .. } => "Wood",
+        }
+    }
+}
+
+/// A procedural choice between two materials at each surface point, or (the course's
+/// `Noise`, `Marble` and `Wood`) a blend of the two.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Pattern {
     pub kind: PatternKind,
     pub a: Handle<Material>,
     pub b: Handle<Material>,
     pub scale: f64,
-    /// Maps the object-space hit point into pattern space (before dividing by `scale`).
+    /// Maps the object-space hit point into pattern space (before dividing by `scale`); for
+    /// the course's kinds ([`PatternKind::world_space`]) it maps the world-space point.
     pub pattern_from_object: DMat4,
 }
 

@@ -5,10 +5,11 @@ use glam::{DMat4, DVec3};
 
 use crate::arena::Handle;
 use crate::diagnostic::Diagnostic;
-use crate::limits::{MAX_MESH_TRIANGLES, MAX_SCENE_TRIANGLES};
+use crate::limits::{MAX_MESH_TRIANGLES, MAX_NOISE_OCTAVES, MAX_SCENE_TRIANGLES};
 use crate::mesh::{BadEdge, NotSolid};
 use crate::scene::{
-    Attenuation, Color, LightKind, Material, Object, ObjectKind, Projection, Scene, Shape,
+    Attenuation, Color, LightKind, Material, Object, ObjectKind, PatternKind, Projection, Scene,
+    Shape,
 };
 use crate::source::Span;
 
@@ -290,6 +291,56 @@ impl Checker {
                 );
             }
             self.transform(&pattern.pattern_from_object, "pattern transform", span);
+            if let Some(octaves) = pattern.kind.octaves() {
+                if !(1..=MAX_NOISE_OCTAVES).contains(&octaves) {
+                    self.error(
+                        format!(
+                            "a noise pattern's octaves must be 1 to {MAX_NOISE_OCTAVES} (the \
+                             `noise octaves` limit), not {octaves}"
+                        ),
+                        span,
+                    );
+                }
+            }
+            if let PatternKind::CourseMarble {
+                frequency,
+                amplitude,
+                ..
+            }
+            | PatternKind::CourseWood {
+                frequency,
+                amplitude,
+                ..
+            } = pattern.kind
+            {
+                if !(frequency.is_finite() && amplitude.is_finite()) {
+                    self.error(
+                        format!(
+                            "a pattern's frequency and amplitude must be finite, not \
+                             {frequency} and {amplitude}"
+                        ),
+                        span,
+                    );
+                }
+            }
+            if pattern.kind.blends() && pattern.a < handle && pattern.b < handle {
+                for part in [pattern.a, pattern.b] {
+                    if let Some(inner) = blend_within(scene, part) {
+                        let through = if inner == part {
+                            String::new()
+                        } else {
+                            format!(" (through material {inner})")
+                        };
+                        self.error(
+                            format!(
+                                "a blending pattern's material {part} blends materials \
+                                 itself{through}: a blend of blends is not supported"
+                            ),
+                            span,
+                        );
+                    }
+                }
+            }
         }
     }
 
@@ -619,6 +670,29 @@ fn is_solid(scene: &Scene, handle: Handle<Object>) -> bool {
     }
 }
 
+/// The first material with a blending pattern that `start` reaches through choosing
+/// patterns (itself included): the tracer blends two materials that are each resolved by
+/// choices alone. Parts come earlier in the arena, so the walk ends; each material is
+/// visited once.
+fn blend_within(scene: &Scene, start: Handle<Material>) -> Option<Handle<Material>> {
+    let mut seen = vec![false; scene.materials.len()];
+    let mut stack = vec![start];
+    while let Some(h) = stack.pop() {
+        if seen.get(h.index()).copied().unwrap_or(true) {
+            continue;
+        }
+        seen[h.index()] = true;
+        let Some(pattern) = scene.materials.get(h).and_then(|m| m.pattern.as_ref()) else {
+            continue;
+        };
+        if pattern.kind.blends() {
+            return Some(h);
+        }
+        stack.extend([pattern.a, pattern.b].into_iter().filter(|p| *p < h));
+    }
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -650,6 +724,76 @@ mod tests {
             Ok(_) => Vec::new(),
             Err(invalid) => invalid.diagnostics.into_iter().map(|d| d.message).collect(),
         }
+    }
+
+    /// A scene with a chain of patterns: each of `kinds` over the one before it (the first
+    /// over a plain material) and a second plain material.
+    fn patterned(kinds: &[PatternKind]) -> Scene {
+        let mut scene = scene_with(Shape::Sphere {
+            center: DVec3::ZERO,
+            radius: 1.0,
+        });
+        let mut last = scene.materials.append(Material::default(), span(2));
+        let plain = scene.materials.append(Material::default(), span(3));
+        for (i, kind) in kinds.iter().enumerate() {
+            last = scene.materials.append(
+                Material {
+                    pattern: Some(crate::scene::Pattern {
+                        kind: *kind,
+                        a: last,
+                        b: plain,
+                        scale: 1.0,
+                        pattern_from_object: DMat4::IDENTITY,
+                    }),
+                    ..Material::default()
+                },
+                span(4 + i),
+            );
+        }
+        scene
+    }
+
+    #[test]
+    fn course_patterns_are_checked() {
+        let noise = |octaves| PatternKind::CourseNoise { octaves };
+        assert!(errors(patterned(&[noise(1), PatternKind::CourseCheckerboard])).is_empty());
+        assert!(errors(patterned(&[PatternKind::CourseCheckerboard, noise(16)])).is_empty());
+        for octaves in [0, 17, u32::MAX] {
+            assert_eq!(
+                errors(patterned(&[noise(octaves)])),
+                [format!(
+                    "a noise pattern's octaves must be 1 to 16 (the `noise octaves` limit), \
+                     not {octaves}"
+                )]
+            );
+        }
+        assert_eq!(
+            errors(patterned(&[noise(2), noise(3)])),
+            [
+                "a blending pattern's material #3 blends materials itself: a blend of blends is \
+              not supported"
+            ]
+        );
+        assert_eq!(
+            errors(patterned(&[
+                noise(2),
+                PatternKind::CourseCheckerboard,
+                noise(3)
+            ])),
+            [
+                "a blending pattern's material #4 blends materials itself (through material #3): \
+              a blend of blends is not supported"
+            ]
+        );
+        let marble = PatternKind::CourseMarble {
+            octaves: 2,
+            frequency: f64::NAN,
+            amplitude: 1.0,
+        };
+        assert_eq!(
+            errors(patterned(&[marble])),
+            ["a pattern's frequency and amplitude must be finite, not NaN and 1"]
+        );
     }
 
     #[test]

@@ -552,24 +552,19 @@ impl<'a> Converter<'a, '_> {
                     )
                 }
                 "PhongMaterial" | "Material" => self.material(token)?,
-                "Checkerboard" | "Noise" | "Marble" | "Wood" => {
-                    return Err(Box::new(
-                        Diagnostic::error(
-                            format!("`{}` materials are not supported", token.text),
-                            self.reader.span(token),
-                        )
-                        .with_hint(
-                            "the procedural materials of the course's later assignments have no \
-                             6.837 reading here; the scene language has checker, marble and wood \
-                             patterns",
-                        ),
-                    ))
+                "Checkerboard" | "Noise" | "Marble" | "Wood" if read == count => {
+                    return self.reader.error_at(
+                        token,
+                        format!("`numMaterials` is {count}, but here is one more material"),
+                    )
                 }
+                "Checkerboard" | "Noise" | "Marble" | "Wood" => self.procedural(token, read)?,
                 other => {
                     return self.reader.error_at(
                         token,
                         format!(
-                            "expected `PhongMaterial`, `Material` or `}}` in `{}`, found `{other}`",
+                            "expected `PhongMaterial`, `Material`, `Checkerboard`, `Noise`, \
+                             `Marble`, `Wood` or `}}` in `{}`, found `{other}`",
                             keyword.text
                         ),
                     )

@@ -11,9 +11,12 @@
 mod convert;
 mod mesh;
 mod objects;
+mod procedural;
 mod reader;
 mod tokens;
 
+#[cfg(test)]
+mod procedural_tests;
 #[cfg(test)]
 mod tests;
 

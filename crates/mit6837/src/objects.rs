@@ -32,6 +32,14 @@ const TRANSFORMS: &[&str] = &[
     "Matrix",
 ];
 
+/// How one transform word composes with the ones before it in its block.
+enum Step {
+    /// Multiplied on the right: it applies to the object before the ones written earlier.
+    Then(DMat4),
+    /// `Matrix`, multiplied on the left: it applies after the ones written earlier.
+    Before(DMat4),
+}
+
 impl<'a> Converter<'a, '_> {
     /// One object starting at `keyword`, under the transform `world_from_parent`.
     fn object(&mut self, keyword: Token<'a>, world_from_parent: DMat4) -> Read<Handle<Object>> {
@@ -204,29 +212,16 @@ impl<'a> Converter<'a, '_> {
         let mut local = DMat4::IDENTITY;
         let object = loop {
             let token = self.reader.next("a transform or an object")?;
-            let step = match token.text {
-                "Scale" => DMat4::from_scale(self.argument(|r| r.reader.vector("a scale factor"))?),
-                "UniformScale" => DMat4::from_scale(DVec3::splat(
-                    self.argument(|r| r.reader.number("a scale factor"))?,
-                )),
-                "Translate" => {
-                    DMat4::from_translation(self.argument(|r| r.reader.vector("a translation"))?)
-                }
-                "XRotate" => DMat4::from_rotation_x(self.argument(Self::degrees)?),
-                "YRotate" => DMat4::from_rotation_y(self.argument(Self::degrees)?),
-                "ZRotate" => DMat4::from_rotation_z(self.argument(Self::degrees)?),
-                "Rotate" => self.rotate(token)?,
-                "Matrix" => {
-                    local = self.matrix(token)? * local;
-                    continue;
-                }
-                _ if OBJECTS.contains(&token.text) => {
+            match self.transform_step(token)? {
+                Some(Step::Then(step)) => local *= step,
+                Some(Step::Before(matrix)) => local = matrix * local,
+                None if OBJECTS.contains(&token.text) => {
                     break self.object(token, world_from_parent * local)?
                 }
-                other => {
+                None => {
                     return Err(Box::new(
                         Diagnostic::error(
-                            format!("expected a transform or an object, found `{other}`"),
+                            format!("expected a transform or an object, found `{}`", token.text),
                             self.reader.span(token),
                         )
                         .with_hint(format!(
@@ -236,12 +231,62 @@ impl<'a> Converter<'a, '_> {
                         )),
                     ))
                 }
-            };
-            local *= step;
+            }
         };
         self.reader.expect("}")?;
         self.depth -= 1;
         Ok(object)
+    }
+
+    /// `Transform { <transforms> }` with no object: a procedural material's matrix, composed
+    /// as an object's `Transform` composes its transforms.
+    pub(crate) fn transform_only(&mut self, keyword: Token<'a>) -> Read<DMat4> {
+        self.reader.expect("{")?;
+        let mut local = DMat4::IDENTITY;
+        loop {
+            let token = self.reader.next("a transform or `}`")?;
+            match self.transform_step(token)? {
+                Some(Step::Then(step)) => local *= step,
+                Some(Step::Before(matrix)) => local = matrix * local,
+                None if token.text == "}" => return Ok(local),
+                None => {
+                    return Err(Box::new(
+                        Diagnostic::error(
+                            format!(
+                                "expected a transform or `}}` in a material's `{}`, found `{}`",
+                                keyword.text, token.text
+                            ),
+                            self.reader.span(token),
+                        )
+                        .with_hint(format!(
+                            "the transforms are {}; a material's `Transform` holds no object",
+                            crate::convert::list(TRANSFORMS)
+                        )),
+                    ))
+                }
+            }
+        }
+    }
+
+    /// The transform that the word `token` starts, read with its argument; `None` for a
+    /// word that is not a transform (nothing is read then).
+    fn transform_step(&mut self, token: Token<'a>) -> Read<Option<Step>> {
+        let step = match token.text {
+            "Scale" => DMat4::from_scale(self.argument(|r| r.reader.vector("a scale factor"))?),
+            "UniformScale" => DMat4::from_scale(DVec3::splat(
+                self.argument(|r| r.reader.number("a scale factor"))?,
+            )),
+            "Translate" => {
+                DMat4::from_translation(self.argument(|r| r.reader.vector("a translation"))?)
+            }
+            "XRotate" => DMat4::from_rotation_x(self.argument(Self::degrees)?),
+            "YRotate" => DMat4::from_rotation_y(self.argument(Self::degrees)?),
+            "ZRotate" => DMat4::from_rotation_z(self.argument(Self::degrees)?),
+            "Rotate" => self.rotate(token)?,
+            "Matrix" => return Ok(Some(Step::Before(self.matrix(token)?))),
+            _ => return Ok(None),
+        };
+        Ok(Some(Step::Then(step)))
     }
 
     /// A transform's argument, bare (`Scale 1 2 3`) or in braces (`Scale { 1 2 3 }`, as some

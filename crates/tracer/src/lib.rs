@@ -17,6 +17,7 @@ mod media;
 mod mesh;
 mod noise;
 pub mod optics;
+mod perlin;
 mod query;
 pub mod ray_tree;
 mod recorder;
@@ -34,6 +35,7 @@ mod tests;
 
 // The BVH lives in whitted-bvh; the walk the renderer takes is part of this API.
 pub use filter::{Film, PixelFilter};
+pub use material::Blend;
 pub use recorder::{
     CoincidentSurface, Interface, LightSample, NoRecord, NoShadowRay, PixelStats, RayKind,
     RayStart, Recorder, ShadowRay, ShadowResult, SkippedRay, SurfaceHit, Termination,

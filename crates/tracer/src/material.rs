@@ -105,24 +105,111 @@ pub fn powi(x: f32, n: i32) -> f32 {
     }
 }
 
+/// What a pattern makes of a point: one of its two materials, or (the course's blending
+/// patterns) the weight of its second material in a blend of the two.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Pick {
+    One(Handle<Material>),
+    Blend(f32),
+}
+
+/// A blend of two materials, each resolved by choosing patterns alone: `(1 - weight)` of
+/// `first` and `weight` of `second`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Blend {
+    pub first: Handle<Material>,
+    pub second: Handle<Material>,
+    pub weight: f32,
+}
+
+impl Blend {
+    /// The material with the larger weight (`first` at one half): it stands for the blend
+    /// where one material must (the medium inside a solid, its index of refraction).
+    pub fn dominant(&self) -> Handle<Material> {
+        if self.weight > 0.5 {
+            self.second
+        } else {
+            self.first
+        }
+    }
+}
+
 impl PreparedPattern {
-    /// Which of the two materials covers the object-space point.
-    #[inline]
+    /// Which of the two materials covers the object-space point (for a pattern that
+    /// chooses and reads object space; the tests' shorthand for [`PreparedPattern::pick`]).
+    #[cfg(test)]
     pub fn choose(&self, object_point: Vec3A) -> Handle<Material> {
-        let p = self.cell_from_object.transform_point3a(object_point);
+        match self.pick(object_point, object_point) {
+            Pick::One(h) => h,
+            Pick::Blend(w) => {
+                if w > 0.5 {
+                    self.b
+                } else {
+                    self.a
+                }
+            }
+        }
+    }
+
+    /// What the pattern makes of a surface point, given in object space and in world space
+    /// (whitted's own patterns read the first, the course's the second).
+    #[inline]
+    pub fn pick(&self, object_point: Vec3A, world_point: Vec3A) -> Pick {
+        let space = if self.kind.world_space() {
+            world_point
+        } else {
+            object_point
+        };
+        let p = self.cell_from_object.transform_point3a(space);
         let first = match self.kind {
-            PatternKind::Checker => {
+            PatternKind::Checker | PatternKind::CourseCheckerboard => {
                 cell(p.x).wrapping_add(cell(p.y)).wrapping_add(cell(p.z)) & 1 == 0
             }
             PatternKind::Stripes => cell(p.x) & 1 == 0,
             PatternKind::Marble => crate::noise::marble(p.x, p.y, p.z),
             PatternKind::Wood => crate::noise::wood(p.x, p.y, p.z),
             PatternKind::Turbulence => crate::noise::blotches(p.x, p.y, p.z),
+            PatternKind::CourseNoise { .. }
+            | PatternKind::CourseMarble { .. }
+            | PatternKind::CourseWood { .. } => {
+                let weight = crate::perlin::course_weight(self.kind, p.x, p.y, p.z);
+                return Pick::Blend(weight.unwrap_or(0.0));
+            }
         };
-        if first {
-            self.a
+        Pick::One(if first { self.a } else { self.b })
+    }
+}
+
+impl PreparedMaterial {
+    /// The course's blend of two (pattern-free) materials: every colour and number
+    /// interpolated linearly, which is the course's blend of the two materials' Phong
+    /// results wherever their exponents are equal (with different exponents the exponent is
+    /// interpolated too). The Fresnel model, the index of refraction and the medium's rank
+    /// and absorption are the dominant material's (a medium is one material).
+    pub fn blend(first: &PreparedMaterial, second: &PreparedMaterial, blend: &Blend) -> Self {
+        let w = blend.weight;
+        let mix = |a: Vec3A, b: Vec3A| a + (b - a) * w;
+        let dominant = if blend.dominant() == blend.second {
+            second
         } else {
-            self.b
+            first
+        };
+        let shininess = first.shininess + (second.shininess - first.shininess) * w;
+        PreparedMaterial {
+            ambient: mix(first.ambient, second.ambient),
+            diffuse: mix(first.diffuse, second.diffuse),
+            specular: mix(first.specular, second.specular),
+            shininess,
+            shininess_integer: (shininess.fract() == 0.0 && shininess <= 4096.0)
+                .then_some(shininess as i32),
+            reflective: mix(first.reflective, second.reflective),
+            transmissive: mix(first.transmissive, second.transmissive),
+            ior: dominant.ior,
+            fresnel: dominant.fresnel,
+            rank: dominant.rank,
+            absorption: dominant.absorption,
+            emission: mix(first.emission, second.emission),
+            pattern: None,
         }
     }
 }
@@ -146,6 +233,9 @@ fn cell(x: f32) -> i64 {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PatternFrame {
     pub object_from_world: Affine3A,
+    /// Back to world space, for the course's patterns, which read the world-space point:
+    /// the object-space point is snapped first, so a checker on a plane does not speckle.
+    pub world_from_object: Affine3A,
     pub snap: Snap,
 }
 
@@ -286,6 +376,7 @@ mod tests {
     fn plane_points_snap_onto_the_plane() {
         let frame = PatternFrame {
             object_from_world: Affine3A::IDENTITY,
+            world_from_object: Affine3A::IDENTITY,
             snap: Snap::plane(DVec3::Y, 0.0),
         };
         let p = frame.object_point(Vec3A::new(0.3, -1e-7, 0.2), 0);

@@ -12,6 +12,7 @@ use whitted_ir::{Handle, Material};
 
 use crate::csg::CsgScratch;
 use crate::hit_error;
+use crate::material::{Blend, Pick};
 use crate::scene::{Item, Leaf, PreparedScene};
 use crate::shapes::{plane_first_hit, sphere_first_hit, unit_normal, Geometry, Part};
 use whitted_bvh::Ray;
@@ -435,8 +436,14 @@ impl PreparedScene {
                     flip,
                 };
                 let leaf = item.leaf(leaf);
-                let material = self.resolve_material(leaf, ray.at(t), part);
-                let kt = self.materials[material.index()].transmissive;
+                let kt = match self.resolve_material(leaf, ray.at(t), part) {
+                    Resolved { blend: Some(b), .. } => {
+                        let first = self.materials[b.first.index()].transmissive;
+                        let second = self.materials[b.second.index()].transmissive;
+                        first + (second - first) * b.weight
+                    }
+                    Resolved { material, .. } => self.materials[material.index()].transmissive,
+                };
                 if kt == Vec3A::ZERO {
                     blocked = Some(hit);
                     return Step::Stop;
@@ -528,23 +535,60 @@ impl PreparedScene {
         }
     }
 
-    /// The material at a point of a leaf, after (possibly nested) patterns.
+    /// The material at a point of a leaf, after (possibly nested) patterns: one material,
+    /// or a blend of two (the course's `Noise`, `Marble`, `Wood`), each of which is resolved
+    /// by choosing patterns alone (validation refuses a blend of blends).
     #[inline]
-    pub(crate) fn resolve_material(
-        &self,
-        leaf: &Leaf,
-        point: Vec3A,
-        part: Part,
-    ) -> Handle<Material> {
+    pub(crate) fn resolve_material(&self, leaf: &Leaf, point: Vec3A, part: Part) -> Resolved {
         let mut material = leaf.material;
         let Some(frame) = &leaf.pattern_frame else {
-            return material;
+            return Resolved {
+                material,
+                blend: None,
+            };
         };
         let object_point = frame.object_point(point, part);
-        // Pattern parts always come earlier in the arena (validated), so this ends.
+        let world_point = frame.world_from_object.transform_point3a(object_point);
+        let choose = |mut material: Handle<Material>| {
+            // Pattern parts always come earlier in the arena (validated), so this ends.
+            while let Some(pattern) = &self.materials[material.index()].pattern {
+                match pattern.pick(object_point, world_point) {
+                    Pick::One(next) => material = next,
+                    // Validation keeps blends out of a blend's parts; should one arrive,
+                    // its first material stands for it.
+                    Pick::Blend(_) => material = pattern.a,
+                }
+            }
+            material
+        };
         while let Some(pattern) = &self.materials[material.index()].pattern {
-            material = pattern.choose(object_point);
+            match pattern.pick(object_point, world_point) {
+                Pick::One(next) => material = next,
+                Pick::Blend(weight) => {
+                    let blend = Blend {
+                        first: choose(pattern.a),
+                        second: choose(pattern.b),
+                        weight,
+                    };
+                    return Resolved {
+                        material: blend.dominant(),
+                        blend: Some(blend),
+                    };
+                }
+            }
         }
-        material
+        Resolved {
+            material,
+            blend: None,
+        }
     }
+}
+
+/// The material at a surface point: `material` is the one to use wherever a single
+/// material must stand (the medium inside, the recorded material), and `blend`, when the
+/// course's blending patterns made one, is what shading uses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Resolved {
+    pub material: Handle<Material>,
+    pub blend: Option<Blend>,
 }

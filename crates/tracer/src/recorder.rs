@@ -194,8 +194,12 @@ pub struct SurfaceHit {
     pub leaf: Handle<Object>,
     /// The leaf's material, as the scene gives it.
     pub material: Handle<Material>,
-    /// The material in effect at the point once patterns are resolved.
+    /// The material in effect at the point once patterns are resolved (with a blend, the
+    /// one with the larger weight).
     pub resolved_material: Handle<Material>,
+    /// The course's blend of two materials, when its `Noise`, `Marble` or `Wood` made one:
+    /// shading used their interpolation.
+    pub blend: Option<crate::material::Blend>,
     /// Beer-Lambert transmittance over this ray's path when it travels inside an
     /// absorbing solid (1 otherwise); the returned colour includes it.
     pub absorption: Vec3A,

@@ -505,6 +505,7 @@ fn prepare_leaf(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (
     let pattern_frame = patterned.then(|| {
         Box::new(PatternFrame {
             object_from_world: world_from_object.inverse().as_affine3a(),
+            world_from_object: world_from_object.as_affine3a(),
             snap,
         })
     });

@@ -380,3 +380,67 @@ pub fn sphere_grid(n: u32) -> SceneBuilder {
     }
     b
 }
+
+/// Perlin's improved noise as an independent f64 oracle, written from the algorithm's
+/// description rather than from `perlin.rs`'s code (with the same published permutation):
+/// each of the eight corners' gradient from the table of directions, dotted with the offset
+/// from that corner and weighted by the product of the fade curves.
+pub fn reference_improved_noise(p: [f64; 3]) -> f64 {
+    // The sixteen gradient directions of the reference code, in hash order.
+    const DIRECTIONS: [[f64; 3]; 16] = [
+        [1.0, 1.0, 0.0],
+        [-1.0, 1.0, 0.0],
+        [1.0, -1.0, 0.0],
+        [-1.0, -1.0, 0.0],
+        [1.0, 0.0, 1.0],
+        [-1.0, 0.0, 1.0],
+        [1.0, 0.0, -1.0],
+        [-1.0, 0.0, -1.0],
+        [0.0, 1.0, 1.0],
+        [0.0, -1.0, 1.0],
+        [0.0, 1.0, -1.0],
+        [0.0, -1.0, -1.0],
+        [1.0, 1.0, 0.0],
+        [0.0, -1.0, 1.0],
+        [-1.0, 1.0, 0.0],
+        [0.0, -1.0, -1.0],
+    ];
+    let table = |i: i64| i64::from(crate::perlin::PERMUTATION[i.rem_euclid(256) as usize]);
+    let cell = p.map(f64::floor);
+    let frac = [p[0] - cell[0], p[1] - cell[1], p[2] - cell[2]];
+    let smooth = |t: f64| 6.0 * t.powi(5) - 15.0 * t.powi(4) + 10.0 * t.powi(3);
+    let mut total = 0.0;
+    for corner in 0..8 {
+        let d = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1].map(i64::from);
+        let c = [
+            cell[0] as i64 + d[0],
+            cell[1] as i64 + d[1],
+            cell[2] as i64 + d[2],
+        ];
+        let hash = table(table(table(c[0]) + c[1].rem_euclid(256)) + c[2].rem_euclid(256));
+        let g = DIRECTIONS[(hash & 15) as usize];
+        let offset = [
+            frac[0] - d[0] as f64,
+            frac[1] - d[1] as f64,
+            frac[2] - d[2] as f64,
+        ];
+        let dot = g[0] * offset[0] + g[1] * offset[1] + g[2] * offset[2];
+        let mut weight = 1.0;
+        for axis in 0..3 {
+            let s = smooth(frac[axis]);
+            weight *= if d[axis] == 1 { s } else { 1.0 - s };
+        }
+        total += weight * dot;
+    }
+    total
+}
+
+/// The course's `N(p)` over [`reference_improved_noise`]: `Σ_{i<octaves} noise(2^i·p) / 2^i`.
+pub fn reference_octave_sum(p: [f64; 3], octaves: u32) -> f64 {
+    (0..octaves)
+        .map(|i| {
+            let s = f64::from(2u32.pow(i));
+            reference_improved_noise([s * p[0], s * p[1], s * p[2]]) / s
+        })
+        .sum()
+}

@@ -15,10 +15,10 @@
 use glam::Vec3A;
 use whitted_ir::{Fresnel, Handle, Highlight, Material, Object, ShadowMode};
 
-use crate::material::PreparedMaterial;
+use crate::material::{Blend, PreparedMaterial};
 use crate::media::{same_medium, Medium, MediumStack};
 use crate::optics::{beer_lambert, fresnel_exact, max_channel, reflect, refract, schlick};
-use crate::query::{Crossed, Hit, Scratch, Shadow, Surface};
+use crate::query::{Crossed, Hit, Resolved, Scratch, Shadow, Surface};
 use crate::recorder::{
     CoincidentSurface, Interface, LightSample, NoShadowRay, RayKind, RayStart, Recorder, ShadowRay,
     ShadowResult, SkippedRay, SurfaceHit, Termination,
@@ -145,6 +145,9 @@ struct Meeting<'s> {
     /// Whether the surface is a solid's (thin surfaces have no media of their own).
     solid: bool,
     material: Handle<Material>,
+    /// The course's blend of two materials at the point, when its patterns make one
+    /// (`material` is then the dominant one, which the media use).
+    blend: Option<Blend>,
     change: Change,
     /// The current medium before the surface (where a reflected ray travels) and beyond it.
     outer: Option<Medium>,
@@ -376,6 +379,7 @@ impl<'a> Tracer<'a> {
             front_face,
             solid,
             material: material_handle,
+            blend,
             change,
             outer,
             inner,
@@ -415,7 +419,18 @@ impl<'a> Tracer<'a> {
             -surface.shading_normal
         };
         let point = surface.point;
-        let m = &scene.materials[material_handle.index()];
+        let blended;
+        let m = match &blend {
+            None => &scene.materials[material_handle.index()],
+            Some(b) => {
+                blended = PreparedMaterial::blend(
+                    &scene.materials[b.first.index()],
+                    &scene.materials[b.second.index()],
+                    b,
+                );
+                &blended
+            }
+        };
         let offset = scene.offset_at(&surface) * self.offset_scale;
         rec.surface_hit(&SurfaceHit {
             t: hit.t,
@@ -427,6 +442,7 @@ impl<'a> Tracer<'a> {
             leaf: surface.leaf.object,
             material: surface.leaf.material,
             resolved_material: material_handle,
+            blend,
             absorption,
             error_bound: crate::hit_error::error_along(surface.geometric_normal, surface.error),
             offset,
@@ -606,7 +622,8 @@ impl<'a> Tracer<'a> {
         let scene = self.scene;
         let surface = scene.surface(ray, &hit);
         let front_face = surface.geometric_normal.dot(ray.direction) < 0.0;
-        let material = scene.resolve_material(surface.leaf, surface.point, hit.part);
+        let Resolved { material, blend } =
+            scene.resolve_material(surface.leaf, surface.point, hit.part);
         let current = media.current();
         let solid = surface.leaf.geometry.is_solid();
         let mut meeting = Meeting {
@@ -615,6 +632,7 @@ impl<'a> Tracer<'a> {
             front_face,
             solid,
             material,
+            blend,
             change: Change::Thin,
             outer: current,
             inner: current,
@@ -684,7 +702,9 @@ impl<'a> Tracer<'a> {
         let mut count = 0usize;
         let crossing = |hit: Hit| {
             let surface = scene.surface(ray, &hit);
-            let material = scene.resolve_material(surface.leaf, surface.point, hit.part);
+            let material = scene
+                .resolve_material(surface.leaf, surface.point, hit.part)
+                .material;
             NearCrossing {
                 hit,
                 entering: surface.geometric_normal.dot(ray.direction) < 0.0,
@@ -747,11 +767,15 @@ impl<'a> Tracer<'a> {
         let mut meeting = match chosen {
             Some(c) => {
                 let surface = scene.surface(ray, &c.hit);
+                let blend = scene
+                    .resolve_material(surface.leaf, surface.point, c.hit.part)
+                    .blend;
                 Meeting {
                     hit: c.hit,
                     surface,
                     front_face: c.entering,
                     material: Handle::from_index(c.medium.material as usize),
+                    blend,
                     ..first
                 }
             }
@@ -930,7 +954,9 @@ impl<'a> Tracer<'a> {
                 t: other.t,
                 object: found.item.object(),
                 leaf: found.leaf.object,
-                material: scene.resolve_material(found.leaf, found.point, other.part),
+                material: scene
+                    .resolve_material(found.leaf, found.point, other.part)
+                    .material,
             });
         }
     }

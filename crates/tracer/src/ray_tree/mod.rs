@@ -14,10 +14,10 @@ mod tests;
 
 pub use json::RayTreeDocument;
 pub use model::{
-    Blocker, CoincidentInfo, ConeInfo, HitInfo, InterfaceInfo, LightContribution, LightRef,
-    LocalIllumination, MaterialRef, ObjectRef, RayNode, RayTree, SampleChoice, SampleTree,
-    ShadingModel, ShadowInfo, ShadowOutcome, SkippedInfo, StackArg, StackStep, Visibility,
-    RAY_TREE_JSON_VERSION,
+    BlendInfo, Blocker, CoincidentInfo, ConeInfo, HitInfo, InterfaceInfo, LightContribution,
+    LightRef, LocalIllumination, MaterialRef, ObjectRef, RayNode, RayTree, SampleChoice,
+    SampleTree, ShadingModel, ShadowInfo, ShadowOutcome, SkippedInfo, StackArg, StackStep,
+    Visibility, RAY_TREE_JSON_VERSION,
 };
 pub use pixel::{check_request, trace_pixel, trace_pixel_request, TraceError, TraceRequest};
 pub use text::{format_text, TextOptions};

@@ -184,8 +184,13 @@ pub struct HitInfo {
     pub csg_path: Vec<ObjectRef>,
     /// The leaf's material as the scene gives it.
     pub material: MaterialRef,
-    /// The material in effect at the point once patterns are resolved.
+    /// The material in effect at the point once patterns are resolved (with a blend, the
+    /// one with the larger weight: the medium inside is its).
     pub resolved_material: MaterialRef,
+    /// The course's blend (`Noise`, `Marble`, `Wood` of a 6.837 scene): shading used
+    /// `(1 - weight)·first + weight·second` of the two materials' colours and numbers.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub blend: Option<BlendInfo>,
     /// Beer-Lambert transmittance over this ray's path inside an absorbing solid (1 in air);
     /// the returned colour includes it.
     pub absorption: [f32; 3],
@@ -269,6 +274,15 @@ pub struct MaterialRef {
     pub location: String,
     #[serde(skip)]
     pub span: Span,
+}
+
+/// Two materials blended at a point, and the second's weight.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BlendInfo {
+    pub first: MaterialRef,
+    pub second: MaterialRef,
+    /// The second material's weight, in [0, 1].
+    pub weight: f32,
 }
 
 /// An IR light, named for people and located in the source.

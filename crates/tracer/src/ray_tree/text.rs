@@ -239,6 +239,17 @@ impl Printer {
                 hit.resolved_material.location
             )));
         }
+        if let Some(blend) = &hit.blend {
+            lines.push(printable(&format!(
+                "blend      {}·{} ({}) + {}·{} ({})",
+                num(1.0 - blend.weight),
+                blend.first.label,
+                blend.first.location,
+                num(blend.weight),
+                blend.second.label,
+                blend.second.location
+            )));
+        }
         if hit.absorption != [1.0; 3] {
             lines.push(format!("absorption {}", self.color(hit.absorption)));
         }

@@ -15,7 +15,7 @@ use glam::Vec3A;
 use whitted_ir::{LightKind, Scene};
 
 use super::model::{
-    Blocker, CoincidentInfo, ConeInfo, HitInfo, InterfaceInfo, LightContribution,
+    BlendInfo, Blocker, CoincidentInfo, ConeInfo, HitInfo, InterfaceInfo, LightContribution,
     LocalIllumination, RayNode, ShadowInfo, ShadowOutcome, SkippedInfo, Visibility,
 };
 use super::scene_refs::{csg_path, light_ref, material_ref, object_ref};
@@ -148,6 +148,11 @@ impl Recorder for TreeRecorder<'_> {
             csg_path: csg_path(scene, hit.object, hit.leaf),
             material: material_ref(scene, hit.material),
             resolved_material: material_ref(scene, hit.resolved_material),
+            blend: hit.blend.map(|b| BlendInfo {
+                first: material_ref(scene, b.first),
+                second: material_ref(scene, b.second),
+                weight: b.weight,
+            }),
             absorption: hit.absorption.to_array(),
             error_bound: hit.error_bound,
             offset: hit.offset,
