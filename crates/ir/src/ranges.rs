@@ -281,8 +281,13 @@ impl Ranges<'_> {
             ));
         }
         // Unset, the tracer bounds the offset by the hit point's rounding error itself.
+        // 0 (no offset, the classic acne) is allowed; between 0 and the smallest size, not.
         if let Some(epsilon) = s.epsilon {
-            self.size("`epsilon`", epsilon, span);
+            let at = self
+                .written
+                .setting("epsilon")
+                .map_or(span, |p| p.value_span);
+            self.size("`epsilon`", epsilon, at);
         }
         self.color(
             "`background`",

@@ -354,7 +354,7 @@ mod tests {
             (depth(), "2.5"),
             (depth(), "257"),
             (Param::setting(&setting_rows::MIN_WEIGHT), "1.5"),
-            (Param::setting(&setting_rows::EPSILON), "0"),
+            (Param::setting(&setting_rows::EPSILON), "-0.5"),
             (reflective(h), "1.2"),
             (reflective(h), "rgb(1, 2)"),
             (Param::light_color(Handle::from_index(0)), "-1"),
