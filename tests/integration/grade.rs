@@ -340,15 +340,18 @@ fn a_class_of_thirty_is_graded_right_and_a_rerun_reuses_the_records() {
         planted.push((name, model));
     }
     let report = dir.path().join("report");
-    let summary = ok(&[
-        "grade",
-        "--class",
-        class.to_str().unwrap(),
-        "--commands",
-        commands.to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-    ]);
+    let grade_class = || {
+        ok(&[
+            "grade",
+            "--class",
+            class.to_str().unwrap(),
+            "--commands",
+            commands.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ])
+    };
+    let summary = grade_class();
     let scores: Value =
         serde_json::from_str(&std::fs::read_to_string(report.join("scores.json")).unwrap())
             .unwrap();
@@ -380,15 +383,7 @@ fn a_class_of_thirty_is_graded_right_and_a_rerun_reuses_the_records() {
     assert_eq!(csv.lines().count(), 1 + 30 * 2);
 
     // A second run reuses every record; a changed image is graded again.
-    let again = ok(&[
-        "grade",
-        "--class",
-        class.to_str().unwrap(),
-        "--commands",
-        commands.to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-    ]);
+    let again = grade_class();
     assert!(again.contains("graded 0, reused 30"), "{again}");
     let first = &planted[0].0;
     let words: Vec<&str> = lines[0].split_whitespace().skip(1).collect();
@@ -404,14 +399,34 @@ fn a_class_of_thirty_is_graded_right_and_a_rerun_reuses_the_records() {
     }
     args.extend(["--set", "ambient=0"]);
     ok(&args);
-    let third = ok(&[
-        "grade",
-        "--class",
-        class.to_str().unwrap(),
-        "--commands",
-        commands.to_str().unwrap(),
-        "--report",
-        report.to_str().unwrap(),
-    ]);
+    let third = grade_class();
     assert!(third.contains("graded 1, reused 29"), "{third}");
+}
+
+#[test]
+fn a_scene_in_whitted_s_language_is_graded_in_srgb() {
+    // `whitted render` writes sRGB, the default comparison for the language's scenes.
+    let dir = tempfile::tempdir().unwrap();
+    let image = dir.path().join("student.png");
+    let size = ["--width", "96", "--height", "72"];
+    let mut args = vec![
+        "render",
+        "scenes/whitted.scene",
+        "--quiet",
+        "--set",
+        "shadows=none",
+    ];
+    args.extend(size);
+    args.extend(["-o", image.to_str().unwrap()]);
+    ok(&args);
+    let mut args = vec![
+        "grade",
+        "scenes/whitted.scene",
+        image.to_str().unwrap(),
+        "--json",
+    ];
+    args.extend(size);
+    let document: Value = serde_json::from_str(&ok(&args)).unwrap();
+    assert_eq!(document["encoding"], "srgb");
+    assert_eq!(top(&document), "no-shadows", "{document}");
 }

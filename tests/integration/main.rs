@@ -25,6 +25,7 @@ mod provenance;
 mod query;
 mod ray_budget;
 mod ray_trees;
+mod report_browser;
 mod reshade;
 mod sampling;
 mod tidy;
