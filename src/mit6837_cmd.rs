@@ -633,6 +633,37 @@ mod tests {
     }
 
     #[test]
+    fn whitted_s_own_set_and_the_sample_position_are_read() {
+        let line = "-input a.txt -size 8 8 -output a.tga --set epsilon=0 -sample_position corner \
+                    --set ambient=0";
+        let Ok(Request::Run(run)) = parse_words(line) else {
+            panic!("{line} was refused");
+        };
+        assert_eq!(
+            run.sets,
+            vec![
+                ("epsilon".to_string(), "0".to_string()),
+                ("ambient".to_string(), "0".to_string())
+            ]
+        );
+        assert_eq!(
+            run.options.sample_position,
+            whitted_ir::SamplePosition::Corner
+        );
+        for (line, message) in [
+            ("-input a.txt -size 8 8 --set", "--set needs NAME=VALUE"),
+            ("-input a.txt -size 8 8 --set epsilon", "write NAME=VALUE"),
+            (
+                "-input a.txt -size 8 8 -sample_position middle",
+                "-sample_position takes centre or corner",
+            ),
+        ] {
+            let error = parse_words(line).err().unwrap_or_default();
+            assert!(error.contains(message), "{line}: {error}");
+        }
+    }
+
+    #[test]
     fn mistakes_name_their_flag() {
         let cases = [
             ("-size 10 10 -output a.tga", "-input SCENE.txt is required"),
