@@ -107,8 +107,8 @@ impl<'a> Evaluator<'a> {
         let largest = sums.iter().copied().fold(0.0, f64::max);
         if largest > 1.0 + 1e-9 && self.warned_materials.insert(span) {
             let hint = match material.fresnel {
-                whitted_ir::Fresnel::Schlick | whitted_ir::Fresnel::Exact => "with `fresnel schlick` or `fresnel exact`, `transmissive` is already split between reflection and refraction: set `reflective 0` for plain glass (the tracer scales the two down to add up to 1 at each surface)",
-                whitted_ir::Fresnel::Off => "keep `reflective + transmissive` at most 1 on every channel (the tracer scales the two down to add up to 1 at each surface)",
+                whitted_ir::Fresnel::Schlick | whitted_ir::Fresnel::Exact => "with `fresnel schlick` or `fresnel exact`, `transmissive` is already split between reflection and refraction: set `reflective 0` for plain glass (by default the tracer scales the two down to add up to 1 at each surface; with `energy_clamp off` they are used as given)",
+                whitted_ir::Fresnel::Off => "keep `reflective + transmissive` at most 1 on every channel (by default the tracer scales the two down to add up to 1 at each surface; with `energy_clamp off` they are used as given)",
             };
             self.diagnostics.push(
                 Diagnostic::warning(
