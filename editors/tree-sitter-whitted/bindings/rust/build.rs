@@ -1,4 +1,4 @@
-//! Compiles the generated parser (`src/parser.c`, committed, so building needs no tree-sitter CLI).
+//! Compiles the generated parser (`parser.c`, committed, so building needs no tree-sitter CLI).
 
 fn main() {
     let src = std::path::Path::new("src");

@@ -1,4 +1,4 @@
-//! The tree-sitter grammar of the scene language (`grammar.js`, generated into `src/parser.c`) and its editor queries.
+//! The tree-sitter grammar of the scene language (`grammar.js`, generated into `parser.c`) and its editor queries.
 //!
 //! ```
 //! let mut parser = tree_sitter::Parser::new();
