@@ -37,7 +37,7 @@ fn rust_files() -> Vec<String> {
     }
     let root = root();
     let mut found = Vec::new();
-    for dir in ["crates", "src", "xtask", "tests", "examples"] {
+    for dir in ["crates", "src", "xtask", "tests", "examples", "editors"] {
         walk(&root.join(dir), &root, &mut found);
     }
     found.sort();
@@ -211,7 +211,7 @@ fn every_path_architecture_md_names_exists() {
     }
     // Paths written as plain words too ("checked by tests/integration/tidy.rs"): any word
     // that starts with one of the repository's top-level folders.
-    const TOP: [&str; 8] = [
+    const TOP: [&str; 9] = [
         "crates/",
         "src/",
         "tests/",
@@ -220,6 +220,7 @@ fn every_path_architecture_md_names_exists() {
         "scenes/",
         "grammar/",
         "examples/",
+        "editors/",
     ];
     for word in text.split(|c: char| c.is_whitespace() || c == '`') {
         let word = word.trim_end_matches("'s");

@@ -146,11 +146,46 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         ])
     })?;
     step("tests", || run_cargo(&["test", "--workspace", "--locked"]))?;
+    step("VS Code grammar", check_textmate_grammar)?;
     step("dependency directions", check_dependency_directions)?;
     step("golden images and ray trees", || crate::golden::run(&[]))?;
     eprintln!(
         "\nci: all checks passed in {:.0} s",
         started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// The TextMate grammar (editors/vscode/syntaxes) under VS Code's own engine: a Node script
+/// over every scene (under a second). `.ci/run` installs its two npm packages (`npm ci`); on a
+/// machine without Node the step says so and is skipped, but with Node and without the
+/// packages it fails and says how to install them.
+fn check_textmate_grammar() -> anyhow::Result<()> {
+    let root = workspace_root();
+    let folder = root.join("editors/vscode");
+    if std::process::Command::new("node")
+        .arg("--version")
+        .output()
+        .is_err()
+    {
+        eprintln!("VS Code grammar: skipped, `node` is not installed");
+        return Ok(());
+    }
+    if !folder.join("node_modules/vscode-textmate").is_dir() {
+        bail!(
+            "the VS Code grammar's test needs its packages: run `npm ci` in {}",
+            folder.display()
+        );
+    }
+    eprintln!("$ node editors/vscode/test/grammar.test.js");
+    let status = std::process::Command::new("node")
+        .arg("editors/vscode/test/grammar.test.js")
+        .current_dir(&root)
+        .status()
+        .context("cannot run node")?;
+    anyhow::ensure!(
+        status.success(),
+        "the VS Code grammar's test failed ({status})"
     );
     Ok(())
 }
