@@ -135,6 +135,18 @@ material mirror { reflective 0.9  }
 plane { normal <0, 1, 0> material mirror }
 ";
 
+/// What the view features show: a comment run and a multi-line block to fold, a colour, a
+/// material's defaults and a loop's object count.
+const VIEW: &str = "// view
+// features
+material red {
+  diffuse <1, 0, 0>
+}
+camera perspective { }
+light point { position <0, 5, 0> }
+for i in 0..3 { sphere { center <i, 0, 0> material red } }
+";
+
 const LIB: &str = "material chrome { reflective 0.8 }\n";
 
 #[test]
@@ -239,6 +251,73 @@ fn a_whole_session_over_stdio() {
             "sphere",
             "mirror",
             "plane"
+        ]
+    );
+
+    // The view features, on a scene that has what they show.
+    assert_eq!(capabilities["foldingRangeProvider"], json!(true));
+    assert_eq!(capabilities["colorProvider"], json!(true));
+    assert_eq!(capabilities["inlayHintProvider"], json!(true));
+    assert_eq!(
+        capabilities["semanticTokensProvider"]["legend"]["tokenModifiers"],
+        json!(["definition"])
+    );
+    let view = Url::from_file_path(dir.path().join("view.scene")).expect("a file URI");
+    session.notify(
+        "textDocument/didOpen",
+        json!({"textDocument": {"uri": view, "languageId": "whitted", "version": 1, "text": VIEW}}),
+    );
+    let document = json!({"textDocument": {"uri": view}});
+    let tokens = session.request("textDocument/semanticTokens/full", document.clone());
+    let data = tokens["data"].as_array().expect("token data");
+    // `// view`, `// features` (comments), `material` (keyword), `red` (a variable, defined).
+    assert_eq!(
+        data[..20],
+        json!([0, 0, 7, 8, 0, 1, 0, 11, 8, 0, 1, 0, 8, 0, 0, 0, 9, 3, 3, 1])
+            .as_array()
+            .expect("numbers")[..]
+    );
+    let folds = session.request("textDocument/foldingRange", document.clone());
+    assert_eq!(
+        folds,
+        json!([{"startLine": 0, "endLine": 1, "kind": "comment"},
+               {"startLine": 2, "endLine": 3}])
+    );
+    let colors = session.request("textDocument/documentColor", document.clone());
+    assert_eq!(
+        colors,
+        json!([{"range": range((3, 10), (3, 19)),
+                "color": {"red": 1.0, "green": 0.0, "blue": 0.0, "alpha": 1.0}}])
+    );
+    let presentations = session.request(
+        "textDocument/colorPresentation",
+        json!({"textDocument": {"uri": view},
+               "color": {"red": 0.5, "green": 0.25, "blue": 1.0, "alpha": 1.0},
+               "range": range((3, 10), (3, 19))}),
+    );
+    assert_eq!(presentations[0]["label"], json!("rgb(0.5, 0.25, 1)"));
+    assert_eq!(
+        presentations[0]["textEdit"],
+        json!({"range": range((3, 10), (3, 19)), "newText": "rgb(0.5, 0.25, 1)"})
+    );
+    let hints = session.request(
+        "textDocument/inlayHint",
+        json!({"textDocument": {"uri": view}, "range": range((0, 0), (8, 0))}),
+    );
+    let hints: Vec<(Value, Value)> = hints
+        .as_array()
+        .expect("hints")
+        .iter()
+        .map(|h| (h["position"].clone(), h["label"].clone()))
+        .collect();
+    assert_eq!(
+        hints,
+        [
+            (
+                json!({"line": 4, "character": 1}),
+                json!("defaults: ambient 0.1, specular 0, shininess 32, reflective 0, …")
+            ),
+            (json!({"line": 7, "character": 13}), json!("3 objects")),
         ]
     );
 

@@ -1,7 +1,9 @@
 //! What the server's answers cost on a big scene (issue 29): a generated scene of 100,000
 //! literal sphere statements (the bench's "scenes written by programs" form), then the time
 //! from a one-character `didChange` to its diagnostics, and the time of a hover, a
-//! completion and a definition near its end. Prints the figures; measures, asserts nothing.
+//! completion and a definition near its end, and of the whole document's semantic tokens,
+//! folding ranges, colours and inlay hints. Prints the figures; measures, asserts nothing.
+//! `cargo xtask bench` runs it in a release build.
 #![allow(clippy::print_stdout)]
 
 use std::fmt::Write as _;
@@ -107,6 +109,24 @@ fn main() {
         );
         println!(
             "{what}: {:.1} ms (answered: {})",
+            ms(started),
+            result.is_ok_and(|v| !v.is_null())
+        );
+    }
+    for (what, method) in [
+        ("semantic tokens", "textDocument/semanticTokens/full"),
+        ("folding ranges", "textDocument/foldingRange"),
+        ("document colours", "textDocument/documentColor"),
+        ("inlay hints", "textDocument/inlayHint"),
+    ] {
+        let whole = lines.range(&text, 0..text.len());
+        let started = Instant::now();
+        let (result, _) = server.request(
+            method,
+            json!({"textDocument": {"uri": uri}, "range": whole}),
+        );
+        println!(
+            "{what} of the whole document: {:.1} ms (answered: {})",
             ms(started),
             result.is_ok_and(|v| !v.is_null())
         );

@@ -24,6 +24,8 @@ pub struct Analysis {
     pub index: Option<Index>,
     /// The diagnostics for each file, the document's first (even when it has none).
     pub diagnostics: Vec<(Url, Vec<LspDiagnostic>)>,
+    /// Each loop that made objects, with how many (`inlays.rs`), when the scene compiled.
+    pub loops: Vec<(Span, usize)>,
 }
 
 /// Whether the document is a 6.837 scene: named `.txt`, or starting with one of the
@@ -39,6 +41,7 @@ fn is_course_scene(document: &Document) -> bool {
 
 pub fn analyze(uri: &Url, document: &Document, mut overlay: Overlay<'_>) -> Analysis {
     let name = document.name(uri);
+    let mut loops = Vec::new();
     let (sources, index, diagnostics) = if is_course_scene(document) {
         let conversion = whitted_mit6837::convert(
             Path::new(&name),
@@ -54,6 +57,9 @@ pub fn analyze(uri: &Url, document: &Document, mut overlay: Overlay<'_>) -> Anal
         };
         let compilation =
             whitted_lang::compile_source(&name, &document.text, &mut overlay, &options);
+        if let Some(scene) = &compilation.scene {
+            loops = crate::inlays::loop_counts(scene);
+        }
         (
             compilation.sources,
             compilation.index,
@@ -66,6 +72,7 @@ pub fn analyze(uri: &Url, document: &Document, mut overlay: Overlay<'_>) -> Anal
         sources,
         index,
         diagnostics,
+        loops,
     }
 }
 

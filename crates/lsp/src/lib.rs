@@ -1,6 +1,7 @@
 //! whitted-lsp: the language server behind `whitted lsp`: diagnostics from the compiler
 //! (the scene language, and 6.837 `.txt` scenes), hover and completion from the property
-//! table, go to definition and the outline from the resolver.
+//! table, go to definition and the outline from the resolver, and the view features
+//! (semantic tokens, folding, colours, inlay hints: `view.rs`).
 //!
 //! The crate speaks the protocol over an lsp-server `Connection` the binary makes on stdio
 //! (`run.rs`); what each message does is [`Server`] (`server.rs`), which tests drive
@@ -8,14 +9,19 @@
 //! documents first, then through [`Files`], which the binary implements.
 
 mod analysis;
+mod colors;
 mod completion;
 mod documents;
+mod folding;
 mod hover;
+mod inlays;
 mod loader;
 mod navigation;
 pub mod position;
 mod run;
 mod server;
+mod tokens;
+mod view;
 
 pub use run::serve;
 pub use server::{capabilities, Server};
@@ -32,3 +38,5 @@ pub trait Files {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod view_tests;

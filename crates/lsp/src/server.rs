@@ -38,6 +38,11 @@ pub fn capabilities() -> ServerCapabilities {
         definition_provider: Some(OneOf::Left(true)),
         document_symbol_provider: Some(OneOf::Left(true)),
         document_formatting_provider: Some(OneOf::Left(true)),
+        // The view features (`view.rs`).
+        semantic_tokens_provider: Some(crate::tokens::options().into()),
+        folding_range_provider: Some(lsp_types::FoldingRangeProviderCapability::Simple(true)),
+        color_provider: Some(lsp_types::ColorProviderCapability::Simple(true)),
+        inlay_hint_provider: Some(OneOf::Left(true)),
         ..ServerCapabilities::default()
     }
 }
@@ -228,6 +233,9 @@ impl Server {
                 Some(p) => to_value(self.documents.get(&p.text_document.uri).and_then(format)),
                 None => Err(invalid_params()),
             },
+            method if crate::view::METHODS.contains(&method) => {
+                crate::view::answer(&self.documents, method, params)
+            }
             _ => Err(ResponseError {
                 code: ErrorCode::MethodNotFound as i32,
                 message: format!("whitted lsp does not handle `{method}`"),
@@ -278,7 +286,7 @@ fn format(document: &Document) -> Option<Vec<lsp_types::TextEdit>> {
     }])
 }
 
-fn to_value<T: serde::Serialize>(value: T) -> Result<Value, ResponseError> {
+pub(crate) fn to_value<T: serde::Serialize>(value: T) -> Result<Value, ResponseError> {
     serde_json::to_value(value).map_err(|e| ResponseError {
         code: ErrorCode::InternalError as i32,
         message: e.to_string(),
@@ -286,11 +294,11 @@ fn to_value<T: serde::Serialize>(value: T) -> Result<Value, ResponseError> {
     })
 }
 
-fn parse<P: DeserializeOwned>(params: Value) -> Option<P> {
+pub(crate) fn parse<P: DeserializeOwned>(params: Value) -> Option<P> {
     serde_json::from_value(params).ok()
 }
 
-fn invalid_params() -> ResponseError {
+pub(crate) fn invalid_params() -> ResponseError {
     ResponseError {
         code: ErrorCode::InvalidParams as i32,
         message: "the parameters do not read as this request's".to_string(),

@@ -435,7 +435,7 @@ fn random_edits_and_requests_never_fail() {
         "\"lib.scene\"",
         "#ff0000",
     ];
-    const START: &str = "import \"lib.scene\"\nsettings { shadows filtered }\nmaterial glass { ior 1.5 }\nfn ring(n) { for i in 0..n { sphere { center <i, 0, 0> radius 0.5 material glass } } }\nring(3) { translate <0, 1, 0> }\n";
+    const START: &str = "import \"lib.scene\"\nsettings { shadows filtered }\nmaterial glass { ior 1.5 diffuse <1, 0, 0> }\nfn ring(n) { for i in 0..n { sphere { center <i, 0, 0> radius 0.5 material glass } } }\nring(3) { translate <0, 1, 0> }\n";
     let mut disk = Memory::default();
     disk.0.insert(
         PathBuf::from("/project/lib.scene"),
@@ -495,20 +495,29 @@ fn random_edits_and_requests_never_fail() {
             server.analyze_changed();
         }
         let lines = LineIndex::new(&text);
-        for _ in 0..3 {
+        for _ in 0..5 {
             let offset = rng.below(text.len() + 1);
             let mut position = lines.position(&text, offset);
             if rng.below(10) == 0 {
                 position =
                     Position::new(position.line + rng.below(3) as u32, rng.below(200) as u32);
             }
-            let method = [
+            let methods = [
                 "textDocument/hover",
                 "textDocument/completion",
                 "textDocument/definition",
                 "textDocument/documentSymbol",
-            ][rng.below(4)];
-            let params = json!({"textDocument": {"uri": uri("a.scene")}, "position": position});
+                "textDocument/semanticTokens/full",
+                "textDocument/foldingRange",
+                "textDocument/documentColor",
+                "textDocument/colorPresentation",
+                "textDocument/inlayHint",
+            ];
+            let method = methods[rng.below(methods.len())];
+            let end = Position::new(position.line + rng.below(4) as u32, rng.below(80) as u32);
+            let params = json!({"textDocument": {"uri": uri("a.scene")}, "position": position,
+                "range": {"start": position, "end": end},
+                "color": {"red": 0.5, "green": 2.0, "blue": -1.0, "alpha": 1.0}});
             let (result, _) = server.request(method, params);
             if result
                 .as_ref()
@@ -523,7 +532,7 @@ fn random_edits_and_requests_never_fail() {
         }
     }
     // Every kind of request was asked where it has an answer, some of the time.
-    assert_eq!(answered.len(), 4, "{answered:?}");
+    assert_eq!(answered.len(), 9, "{answered:?}");
     // The server's text is the text the edits make.
     server.notify(
         "textDocument/didChange",

@@ -143,9 +143,10 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
             "--programs" => only_programs = true,
             "--mesh" => only_mesh = true,
             "--csg" => only_csg = true,
+            "--lsp" => return lsp_latency(),
             other => {
                 bail!(
-                    "unknown bench option `{other}` (known: --size WxH, --programs, --mesh, --csg)"
+                    "unknown bench option `{other}` (known: --size WxH, --programs, --mesh, --csg, --lsp)"
                 )
             }
         }
@@ -244,7 +245,25 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
         });
         println!("{:<34} {:>7.3}s {:>12}", case.label, wall, memory);
     }
-    programs::run(&exe, &out_dir, RUNS)
+    programs::run(&exe, &out_dir, RUNS)?;
+    lsp_latency()
+}
+
+/// The language server's latency on the 100,000-statement generated scene
+/// (`crates/lsp/examples/latency.rs`, release build): keystroke to diagnostics, hover,
+/// semantic tokens and the other whole-document answers.
+fn lsp_latency() -> anyhow::Result<()> {
+    println!("\nlanguage server on 100,000 generated statements (crates/lsp/examples/latency.rs)");
+    run_cargo(&[
+        "run",
+        "--quiet",
+        "--release",
+        "--locked",
+        "-p",
+        "whitted-lsp",
+        "--example",
+        "latency",
+    ])
 }
 
 /// Runs the tracer's bench example (`crates/tracer/examples/bench.rs`) with `args`, its BVH

@@ -9,6 +9,7 @@
 
 pub mod cursor;
 pub(crate) mod index;
+pub mod view;
 
 use whitted_ir::setting_rows::SETTINGS;
 use whitted_ir::Span;

@@ -11,7 +11,7 @@
 
 mod layout;
 mod structure;
-mod tokens;
+pub(crate) mod tokens;
 
 use whitted_ir::{limits, Diagnostic, FileId, SourceFile, SourceMap, Span};
 

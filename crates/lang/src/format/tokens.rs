@@ -10,7 +10,7 @@ use std::collections::{HashMap, HashSet};
 
 /// What a token is, as far as spacing cares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Kind {
+pub(crate) enum Kind {
     /// A name or a keyword.
     Word,
     Number,
@@ -24,7 +24,7 @@ pub(super) enum Kind {
 
 /// What the syntax tree says a punctuation token does, where spacing depends on it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Role {
+pub(crate) enum Role {
     Plain,
     /// An infix operator: `a - b`, `a < b`.
     Binary,
@@ -46,7 +46,7 @@ pub(super) enum Role {
 }
 
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Token {
+pub(crate) struct Token {
     pub kind: Kind,
     pub role: Role,
     pub start: u32,
@@ -66,7 +66,7 @@ impl Token {
 
 /// Where the syntax tree puts operators and brackets whose reading depends on context.
 #[derive(Debug, Default)]
-pub(super) struct Roles {
+pub(crate) struct Roles {
     /// Start offset and length of every infix operator.
     pub binary: HashMap<u32, u32>,
     /// Offsets of the `(` of calls' arguments.
@@ -87,7 +87,7 @@ fn is_ident_char(c: char) -> bool {
 
 /// Splits `text` (which parsed) into tokens. Whitespace is what the grammar calls
 /// whitespace, the byte-order mark included.
-pub(super) fn tokenize(text: &str, roles: &Roles) -> Vec<Token> {
+pub(crate) fn tokenize(text: &str, roles: &Roles) -> Vec<Token> {
     let bytes = text.as_bytes();
     let at = |i: usize| text.get(i..).and_then(|s| s.chars().next());
     let mut tokens = Vec::new();
