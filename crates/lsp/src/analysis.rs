@@ -24,6 +24,8 @@ pub struct Analysis {
     pub index: Option<Index>,
     /// The diagnostics for each file, the document's first (even when it has none).
     pub diagnostics: Vec<(Url, Vec<LspDiagnostic>)>,
+    /// The quick fixes the diagnostics offer (`actions.rs`).
+    pub fixes: Vec<crate::actions::Fix>,
 }
 
 /// Whether the document is a 6.837 scene: named `.txt`, or starting with one of the
@@ -60,12 +62,18 @@ pub fn analyze(uri: &Url, document: &Document, mut overlay: Overlay<'_>) -> Anal
             compilation.diagnostics,
         )
     };
+    let fixes = crate::actions::fixes(
+        &mut Locator::new(uri, &sources, &document.lines),
+        &sources,
+        &diagnostics,
+    );
     let mut diagnostics = convert_all(Locator::new(uri, &sources, &document.lines), &diagnostics);
     summarize_imports(uri, document, &name, &mut diagnostics);
     Analysis {
         sources,
         index,
         diagnostics,
+        fixes,
     }
 }
 
@@ -153,7 +161,7 @@ fn convert_all(
 
 /// The message as the terminal shows it, minus the drawing: the message, the label under
 /// the underline, and each hint as a `help:` line.
-fn message(diagnostic: &Diagnostic) -> String {
+pub(crate) fn message(diagnostic: &Diagnostic) -> String {
     let mut text = diagnostic.message.clone();
     if let Some(label) = &diagnostic.label {
         text.push_str(&format!(" ({label})"));
