@@ -1,6 +1,7 @@
 //! `whitted lsp` as an editor runs it: the real binary over stdio, one whole session with
 //! exact answers (diagnostics appearing at their range and going away, hover, completion in a
-//! material block, go to definition here and into an import, the outline), and exit status 0
+//! material block, go to definition here and into an import, the outline, a quick fix,
+//! references and rename across an import), and exit status 0
 //! after `shutdown` and `exit`. The Content-Length framing is written here by hand: it is the
 //! protocol, not the server under test.
 
@@ -70,6 +71,23 @@ impl Session {
             if message["id"] == json!(id) {
                 assert!(message.get("error").is_none(), "{method}: {message}");
                 return message["result"].clone();
+            }
+        }
+    }
+
+    /// Sends a request that must fail and returns its error's message.
+    fn refused(&mut self, method: &str, params: Value) -> String {
+        self.next_id += 1;
+        let id = self.next_id;
+        self.send(json!({"jsonrpc": "2.0", "id": id, "method": method, "params": params}));
+        loop {
+            let message = self.receive();
+            if message["id"] == json!(id) {
+                assert!(message.get("result").is_none(), "{method}: {message}");
+                return message["error"]["message"]
+                    .as_str()
+                    .unwrap_or_default()
+                    .to_string();
             }
         }
     }
@@ -191,6 +209,24 @@ fn a_whole_session_over_stdio() {
         "the compiler's message, label and help"
     );
 
+    // The "did you mean" is a quick fix with its exact edit, linked to the diagnostic.
+    let actions = session.request(
+        "textDocument/codeAction",
+        json!({"textDocument": {"uri": main}, "range": range((4, 38), (4, 38)),
+               "context": {"diagnostics": []}}),
+    );
+    assert_eq!(actions.as_array().map(Vec::len), Some(1), "{actions}");
+    assert_eq!(actions[0]["kind"], json!("quickfix"));
+    assert_eq!(actions[0]["title"], json!("Replace `glas` with `glass`"));
+    assert_eq!(
+        actions[0]["diagnostics"][0]["message"],
+        json!(EXPECTED_UNKNOWN_NAME)
+    );
+    assert_eq!(
+        actions[0]["edit"]["changes"][main.as_str()],
+        json!([{"range": range((4, 37), (4, 41)), "newText": "glass"}])
+    );
+
     session.notify(
         "textDocument/didChange",
         json!({"textDocument": {"uri": main, "version": 3},
@@ -229,6 +265,38 @@ fn a_whole_session_over_stdio() {
     assert_eq!(
         definition,
         json!({"uri": lib, "range": range((0, 9), (0, 15))})
+    );
+
+    // References of `chrome`, from its use: the definition in lib.scene and the use.
+    let mut params = at(&main, 5, 37);
+    params["context"] = json!({"includeDeclaration": true});
+    let references = session.request("textDocument/references", params);
+    assert_eq!(
+        references,
+        json!([{"uri": lib, "range": range((0, 9), (0, 15))},
+               {"uri": main, "range": range((5, 35), (5, 41))}])
+    );
+    // Renaming it edits lib.scene (not open) and main.scene.
+    let mut params = at(&main, 5, 37);
+    params["newName"] = json!("steel");
+    let edit = session.request("textDocument/rename", params);
+    assert_eq!(
+        edit["changes"],
+        json!({lib.as_str(): [{"range": range((0, 9), (0, 15)), "newText": "steel"}],
+               main.as_str(): [{"range": range((5, 35), (5, 41)), "newText": "steel"}]})
+    );
+    // `glass` (after the wide characters) may not become a keyword nor `mirror`.
+    let mut params = at(&main, 4, 39);
+    params["newName"] = json!("light");
+    assert_eq!(
+        session.refused("textDocument/rename", params),
+        "`light` is a keyword of the language, not a name"
+    );
+    let mut params = at(&main, 4, 39);
+    params["newName"] = json!("mirror");
+    assert_eq!(
+        session.refused("textDocument/rename", params),
+        "renaming `glass` to `mirror` would clash with another definition: `mirror` is already defined here (defined a second time)"
     );
 
     let outline = session.request(

@@ -529,9 +529,10 @@ fn compile_root(
     work.name_probes = resolution.name_probes;
     // An editor's questions are about the text as written, so the index is read off the
     // resolved tree before evaluation consumes it.
-    let index = options
+    let mut index = options
         .index
         .then(|| crate::editor::index::build(&program, &interner, &resolution));
+    let mut shown = index.as_ref().map(|_| HashMap::new());
     let mut compilation = evaluate_and_validate(
         EvaluationInput {
             program,
@@ -546,7 +547,11 @@ fn compile_root(
         loader,
         limits,
         max_evaluation_depth,
+        &mut shown,
     );
+    if let (Some(index), Some(shown)) = (index.as_mut(), shown) {
+        index.shown.extend(shown);
+    }
     compilation.index = index;
     compilation
 }
@@ -569,6 +574,7 @@ fn evaluate_and_validate(
     loader: &mut dyn SourceLoader,
     limits: &Limits,
     max_evaluation_depth: usize,
+    shown: &mut Option<HashMap<Span, crate::editor::Shown>>,
 ) -> Compilation {
     let EvaluationInput {
         mut program,
@@ -591,7 +597,7 @@ fn evaluate_and_validate(
         .first_mut()
         .map(|root| std::mem::take(&mut root.items))
         .unwrap_or_default();
-    let evaluator = crate::eval::Evaluator::new(
+    let mut evaluator = crate::eval::Evaluator::new(
         &program,
         &interner,
         limits,
@@ -603,7 +609,9 @@ fn evaluate_and_validate(
         sources.clone(),
         max_evaluation_depth,
     );
-    let (mut scene, eval_diagnostics, failed) = evaluator.run(root_items);
+    evaluator.shown = shown.take();
+    let (mut scene, eval_diagnostics, failed, recorded) = evaluator.run(root_items);
+    *shown = recorded;
     diagnostics.extend(eval_diagnostics);
     if failed || has_error(&diagnostics) {
         return finish(sources, None, diagnostics, work);

@@ -16,6 +16,7 @@ use crate::lexical;
 use crate::syntax_error;
 
 mod fast;
+pub(crate) use fast::is_keyword;
 mod indexing_and_expression_bodies;
 
 #[derive(pest_derive::Parser)]

@@ -88,6 +88,8 @@ pub struct Resolution {
     /// is: (use, definition). Kept only when [`Resolver::record_links`] is set (an editor
     /// asks for it; a render does not pay for a million of them).
     pub links: Vec<(Span, Span)>,
+    /// Every definition's name and kind, used or not; kept with [`Resolution::links`].
+    pub definitions: Vec<(Span, DefKind)>,
 }
 
 pub struct Resolver<'a> {
@@ -164,6 +166,14 @@ impl<'a> Resolver<'a> {
         self.report_unused();
         self.report_unused_defines();
         self.resolution.name_probes = self.name_probes.get();
+        if self.record_links {
+            self.resolution.definitions = self
+                .definitions
+                .iter()
+                .filter(|d| !d.span.is_detached())
+                .map(|d| (d.span, d.kind))
+                .collect();
+        }
         (self.resolution, self.diagnostics)
     }
 

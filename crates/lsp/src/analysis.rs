@@ -26,6 +26,8 @@ pub struct Analysis {
     pub diagnostics: Vec<(Url, Vec<LspDiagnostic>)>,
     /// Each loop that made objects, with how many (`inlays.rs`), when the scene compiled.
     pub loops: Vec<(Span, usize)>,
+    /// The quick fixes the diagnostics offer (`actions.rs`).
+    pub fixes: Vec<crate::actions::Fix>,
 }
 
 /// Whether the document is a 6.837 scene: named `.txt`, or starting with one of the
@@ -66,6 +68,11 @@ pub fn analyze(uri: &Url, document: &Document, mut overlay: Overlay<'_>) -> Anal
             compilation.diagnostics,
         )
     };
+    let fixes = crate::actions::fixes(
+        &mut Locator::new(uri, &sources, &document.lines),
+        &sources,
+        &diagnostics,
+    );
     let mut diagnostics = convert_all(Locator::new(uri, &sources, &document.lines), &diagnostics);
     summarize_imports(uri, document, &name, &mut diagnostics);
     Analysis {
@@ -73,6 +80,7 @@ pub fn analyze(uri: &Url, document: &Document, mut overlay: Overlay<'_>) -> Anal
         index,
         diagnostics,
         loops,
+        fixes,
     }
 }
 
@@ -160,7 +168,7 @@ fn convert_all(
 
 /// The message as the terminal shows it, minus the drawing: the message, the label under
 /// the underline, and each hint as a `help:` line.
-fn message(diagnostic: &Diagnostic) -> String {
+pub(crate) fn message(diagnostic: &Diagnostic) -> String {
     let mut text = diagnostic.message.clone();
     if let Some(label) = &diagnostic.label {
         text.push_str(&format!(" ({label})"));

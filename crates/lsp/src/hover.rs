@@ -8,6 +8,9 @@ use whitted_lang::editor::{cursor, BlockKind, PropertyDoc};
 use crate::documents::Document;
 
 pub fn hover(document: &Document, offset: usize) -> Option<Hover> {
+    if let Some(name) = crate::names::hover(document, offset) {
+        return Some(name);
+    }
     let (block, property, span) =
         from_index(document, offset).or_else(|| from_text(document, offset))?;
     Some(Hover {

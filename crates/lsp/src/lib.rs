@@ -1,13 +1,15 @@
 //! whitted-lsp: the language server behind `whitted lsp`: diagnostics from the compiler
 //! (the scene language, and 6.837 `.txt` scenes), hover and completion from the property
-//! table, go to definition and the outline from the resolver, and the view features
-//! (semantic tokens, folding, colours, inlay hints: `view.rs`).
+//! table, go to definition, references, rename and the outline from the resolver, hover on
+//! names from what evaluation found, quick fixes from the diagnostics' suggestions, and the
+//! view features (semantic tokens, folding, colours, inlay hints: `view.rs`).
 //!
 //! The crate speaks the protocol over an lsp-server `Connection` the binary makes on stdio
 //! (`run.rs`); what each message does is [`Server`] (`server.rs`), which tests drive
 //! in-process. It reads no files itself: imports and meshes come from the editor's open
 //! documents first, then through [`Files`], which the binary implements.
 
+mod actions;
 mod analysis;
 mod colors;
 mod completion;
@@ -16,10 +18,14 @@ mod folding;
 mod hover;
 mod inlays;
 mod loader;
+mod names;
 mod navigation;
 pub mod position;
+mod references;
+mod rename;
 mod run;
 mod server;
+mod server_nav;
 mod tokens;
 mod view;
 
@@ -36,6 +42,8 @@ pub trait Files {
     }
 }
 
+#[cfg(test)]
+mod nav_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

@@ -43,6 +43,17 @@ pub fn capabilities() -> ServerCapabilities {
         folding_range_provider: Some(lsp_types::FoldingRangeProviderCapability::Simple(true)),
         color_provider: Some(lsp_types::ColorProviderCapability::Simple(true)),
         inlay_hint_provider: Some(OneOf::Left(true)),
+        references_provider: Some(OneOf::Left(true)),
+        rename_provider: Some(OneOf::Right(lsp_types::RenameOptions {
+            prepare_provider: Some(true),
+            work_done_progress_options: Default::default(),
+        })),
+        code_action_provider: Some(lsp_types::CodeActionProviderCapability::Options(
+            lsp_types::CodeActionOptions {
+                code_action_kinds: Some(vec![lsp_types::CodeActionKind::QUICKFIX]),
+                ..Default::default()
+            },
+        )),
         ..ServerCapabilities::default()
     }
 }
@@ -228,6 +239,9 @@ impl Server {
                     ),
                     None => Err(invalid_params()),
                 }
+            }
+            m if crate::server_nav::handles(m) => {
+                crate::server_nav::request(m, params, &self.documents, self.files.as_mut())
             }
             Formatting::METHOD => match parse::<lsp_types::DocumentFormattingParams>(params) {
                 Some(p) => to_value(self.documents.get(&p.text_document.uri).and_then(format)),

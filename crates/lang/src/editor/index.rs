@@ -4,10 +4,10 @@
 
 use whitted_ir::Span;
 
-use super::{BlockFacts, BlockKind, Index, Symbol, SymbolKind};
+use super::{BlockFacts, BlockKind, Definition, DefinitionKind, Index, Shown, Symbol, SymbolKind};
 use crate::ast::{Block, Else, Expr, ExprKind, Item, ItemKind, MaterialBody, Program};
 use crate::intern::Interner;
-use crate::resolve::Resolution;
+use crate::resolve::{DefKind, Resolution};
 use crate::schema::Context;
 
 pub(crate) fn build(program: &Program, interner: &Interner, resolution: &Resolution) -> Index {
@@ -15,6 +15,7 @@ pub(crate) fn build(program: &Program, interner: &Interner, resolution: &Resolut
         program,
         interner,
         blocks: Vec::new(),
+        signatures: std::collections::HashMap::new(),
     };
     let mut symbols = Vec::new();
     for file in &program.files {
@@ -22,10 +23,27 @@ pub(crate) fn build(program: &Program, interner: &Interner, resolution: &Resolut
             walker.item(item, &mut symbols);
         }
     }
+    let definitions = resolution
+        .definitions
+        .iter()
+        .map(|&(span, kind)| Definition {
+            span,
+            kind: match kind {
+                DefKind::Const => DefinitionKind::Constant,
+                DefKind::Let => DefinitionKind::Let,
+                DefKind::Material => DefinitionKind::Material,
+                DefKind::Function => DefinitionKind::Function,
+                DefKind::Parameter => DefinitionKind::Parameter,
+                DefKind::LoopVariable => DefinitionKind::LoopVariable,
+            },
+        })
+        .collect();
     Index {
         blocks: walker.blocks,
         links: resolution.links.clone(),
         symbols,
+        definitions,
+        shown: walker.signatures,
     }
 }
 
@@ -33,6 +51,8 @@ struct Walker<'a> {
     program: &'a Program,
     interner: &'a Interner,
     blocks: Vec<BlockFacts>,
+    /// Each function's signature, by its name's span.
+    signatures: std::collections::HashMap<Span, Shown>,
 }
 
 impl Walker<'_> {
@@ -93,6 +113,18 @@ impl Walker<'_> {
                     let mut children = Vec::new();
                     self.statements(&function.body, &mut children);
                     let name = self.interner.name(function.name.sym).to_string();
+                    let params: Vec<&str> = function
+                        .params
+                        .iter()
+                        .map(|p| self.interner.name(p.sym))
+                        .collect();
+                    self.signatures.insert(
+                        function.name.span,
+                        Shown {
+                            text: format!("fn {name}({})", params.join(", ")),
+                            others: 0,
+                        },
+                    );
                     symbols.push(symbol(
                         SymbolKind::Function,
                         name,

@@ -11,6 +11,8 @@ pub mod cursor;
 pub(crate) mod index;
 pub mod view;
 
+use std::collections::HashMap;
+
 use whitted_ir::setting_rows::SETTINGS;
 use whitted_ir::Span;
 
@@ -209,6 +211,71 @@ pub struct Index {
     pub links: Vec<(Span, Span)>,
     /// The outline: materials, lights, objects, functions, settings, camera, bindings.
     pub symbols: Vec<Symbol>,
+    /// Every definition of a name (used or not), by the span of its name.
+    pub definitions: Vec<Definition>,
+    /// What a definition is worth showing, by the span of its name: a function's signature
+    /// (`fn ring(n, r)`), and from evaluation a binding's value, a loop's range, a
+    /// material's properties (see [`Shown`]).
+    pub shown: HashMap<Span, Shown>,
+}
+
+/// A name's definition: where its name is written and what it defines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Definition {
+    pub span: Span,
+    pub kind: DefinitionKind,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DefinitionKind {
+    Constant,
+    Let,
+    Material,
+    Function,
+    Parameter,
+    LoopVariable,
+}
+
+impl DefinitionKind {
+    /// "a constant", "a `let` binding", ...: as the compiler's messages say it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            DefinitionKind::Constant => "a constant",
+            DefinitionKind::Let => "a `let` binding",
+            DefinitionKind::Material => "a material",
+            DefinitionKind::Function => "a function",
+            DefinitionKind::Parameter => "a parameter",
+            DefinitionKind::LoopVariable => "a loop variable",
+        }
+    }
+}
+
+/// What the compiler knows of a definition's value, as text.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Shown {
+    /// The first value (a loop's range, a material's properties one per line).
+    pub text: String,
+    /// How many times the definition ran with another value after the first (a `let` in a
+    /// loop or a function); 0 when it had one value.
+    pub others: u32,
+}
+
+/// Whether `word` can name a definition: a name as the grammar reads one (a letter or `_`,
+/// then letters, digits and `_`), and not a keyword. The error says why not, in words.
+pub fn check_name(word: &str) -> Result<(), String> {
+    let mut chars = word.chars();
+    let first_ok = chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_');
+    if !first_ok || !chars.all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(format!(
+            "`{word}` is not a name: a name starts with a letter or `_` and goes on with letters, digits and `_`"
+        ));
+    }
+    if crate::parser::is_keyword(word) {
+        return Err(format!("`{word}` is a keyword of the language, not a name"));
+    }
+    Ok(())
 }
 
 /// A block that takes properties.

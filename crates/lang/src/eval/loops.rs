@@ -11,8 +11,10 @@ use crate::value::Value;
 impl<'a> Evaluator<'a> {
     /// `for i in start..end step s` (or `..=`): `s` is a whole number other than zero; a
     /// negative step counts down, towards `end`.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn stepped_loop(
         &mut self,
+        var: crate::ast::Ident,
         slot: Slot,
         start: &Expr,
         end: &Expr,
@@ -41,6 +43,9 @@ impl<'a> Evaluator<'a> {
         } else {
             (span + by.abs() - 1) / by.abs()
         };
+        // The last value taken (one step before the first when there is none).
+        let shown_last = first + (count.max(0) - 1).saturating_mul(by);
+        self.show_range(var.span, first, shown_last, by);
         let count = u64::try_from(count).unwrap_or(u64::MAX);
         self.budget_loop(count, start.span.to(step.span))?;
         let mut value = first;

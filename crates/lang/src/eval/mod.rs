@@ -18,6 +18,7 @@ mod materials;
 mod objects;
 mod properties;
 mod provenance;
+mod shown;
 mod strings;
 mod written;
 
@@ -128,6 +129,8 @@ pub(crate) struct Evaluator<'a> {
     trail: provenance::Trail,
     /// Where settings and properties were written, for the scene's side table.
     written: written::WrittenRecorder,
+    /// What an editor's hover shows of each definition (`shown.rs`), when asked for.
+    pub(crate) shown: Option<std::collections::HashMap<Span, crate::editor::Shown>>,
 }
 
 /// What the command line adds to a scene: `-D` constants and `--set` settings.
@@ -185,6 +188,7 @@ impl<'a> Evaluator<'a> {
             settings_set: Vec::new(),
             trail: provenance::Trail::default(),
             written: written::WrittenRecorder::default(),
+            shown: None,
         }
     }
 
@@ -193,7 +197,16 @@ impl<'a> Evaluator<'a> {
     ///
     /// `root_items` are the root file's items, taken out of the program: each is dropped once
     /// it has run.
-    pub(crate) fn run(mut self, root_items: Vec<Item>) -> (Scene, Vec<Diagnostic>, bool) {
+    #[allow(clippy::type_complexity)]
+    pub(crate) fn run(
+        mut self,
+        root_items: Vec<Item>,
+    ) -> (
+        Scene,
+        Vec<Diagnostic>,
+        bool,
+        Option<std::collections::HashMap<Span, crate::editor::Shown>>,
+    ) {
         // A scene written by a program is mostly top-level objects: room for them at once,
         // rather than arenas that grow by copying a million objects several times.
         let literal_objects = self
@@ -221,7 +234,8 @@ impl<'a> Evaluator<'a> {
         if let Some(span) = self.camera_span {
             self.scene.camera_span = span;
         }
-        (self.scene, self.diagnostics, failed)
+        let shown = self.take_shown();
+        (self.scene, self.diagnostics, failed, shown)
     }
 
     /// Applies the command line's `--set NAME=VALUE`s to the settings the scene made.
@@ -382,11 +396,17 @@ impl<'a> Evaluator<'a> {
             }
             ItemKind::Const(binding) => {
                 let value = self.constant(binding);
+                if let Ok(shown) = &value {
+                    self.show_value(binding.name.span, *shown);
+                }
                 self.set_slot(binding.slot, *value.as_ref().unwrap_or(&Value::Poisoned));
                 value?;
             }
             ItemKind::Let(binding) => {
                 let value = self.eval(&binding.value);
+                if let Ok(shown) = &value {
+                    self.show_value(binding.name.span, *shown);
+                }
                 self.set_slot(binding.slot, *value.as_ref().unwrap_or(&Value::Poisoned));
                 value?;
             }
@@ -402,8 +422,10 @@ impl<'a> Evaluator<'a> {
             } => {
                 self.trail.enter_loop(var.sym, item.span);
                 let result = match step {
-                    Some(step) => self.stepped_loop(*slot, start, end, *inclusive, step, body),
-                    None => self.for_loop(*slot, start, end, *inclusive, body),
+                    Some(step) => {
+                        self.stepped_loop(*var, *slot, start, end, *inclusive, step, body)
+                    }
+                    None => self.for_loop(*var, *slot, start, end, *inclusive, body),
                 };
                 self.trail.leave();
                 return result;
@@ -455,6 +477,9 @@ impl<'a> Evaluator<'a> {
             ItemKind::Material { name, slot, body } => {
                 let text = self.name(name.sym).to_string();
                 let value = self.material(body, Some(text)).map(Value::Material);
+                if let Ok(shown) = &value {
+                    self.show_value(name.span, *shown);
+                }
                 self.set_slot(*slot, *value.as_ref().unwrap_or(&Value::Poisoned));
                 value?;
             }
@@ -512,6 +537,7 @@ impl<'a> Evaluator<'a> {
 
     fn for_loop(
         &mut self,
+        var: crate::ast::Ident,
         slot: Slot,
         start: &Expr,
         end: &Expr,
@@ -521,6 +547,7 @@ impl<'a> Evaluator<'a> {
         let first = self.whole_number(start, "a loop's start")?;
         let last = self.whole_number(end, "a loop's end")?;
         let stop = if inclusive { last + 1 } else { last };
+        self.show_range(var.span, first.into(), i128::from(stop) - 1, 1);
         let count = (stop - first).max(0) as u64;
         let limit = self.limits.max_evaluation_steps;
         if self.steps.saturating_add(count) > limit {

@@ -232,7 +232,7 @@ impl<'a> Evaluator<'a> {
         }
     }
 
-    fn value_text(&self, value: Value, depth: usize) -> String {
+    pub(super) fn value_text(&self, value: Value, depth: usize) -> String {
         match value {
             Value::Str(id) => format!(
                 "{:?}",

@@ -24,7 +24,7 @@ use crate::ast::*;
 const MAX_RECURSION: usize = 48;
 
 /// The grammar's `keyword` rule: words that are never names.
-fn is_keyword(word: &str) -> bool {
+pub(crate) fn is_keyword(word: &str) -> bool {
     matches!(
         word,
         "import"

@@ -66,6 +66,7 @@ impl Resolver<'_> {
             );
             return;
         }
+        self.link(target.ident.span, def);
         target.res = match slot {
             Slot::Local(slot) => Res::Local(slot),
             Slot::Global(slot) => Res::Global(slot),
