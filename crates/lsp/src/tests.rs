@@ -595,3 +595,31 @@ fn formatting_is_whitted_fmt_on_the_editors_text() {
     );
     assert_eq!(refused, Value::Null);
 }
+
+/// Go to definition on the string of an `import` or a mesh's `file` opens that file,
+/// relative to the document, even while the document does not parse.
+#[test]
+fn definition_of_an_import_or_a_mesh_file_is_the_file() {
+    let mut server = Server::new(Box::new(Memory::default()));
+    let text = "import \"lib/materials.scene\"\nmesh { file \"models/gem.obj\" }\nlet s = \"x.scene\"\nsphere {";
+    open(&mut server, "dir/a.scene", text);
+    let mut target = |needle: &str| {
+        let offset = text.find(needle).expect("in the text") + 2;
+        let answer = request(
+            &mut server,
+            "textDocument/definition",
+            position_params("dir/a.scene", text, offset),
+        );
+        answer["uri"].as_str().map(str::to_string)
+    };
+    assert_eq!(
+        target("lib/materials").as_deref(),
+        Some("file:///project/dir/lib/materials.scene")
+    );
+    assert_eq!(
+        target("models/gem").as_deref(),
+        Some("file:///project/dir/models/gem.obj")
+    );
+    // Any other string is not a file.
+    assert_eq!(target("x.scene"), None);
+}
