@@ -1,5 +1,6 @@
 //! `whitted lsp`: the language server on stdin and stdout; the protocol and every answer are
-//! whitted-lsp's, the binary only opens stdio and reads the files the server asks for.
+//! whitted-lsp's, the binary only opens stdio, reads the files the server asks for and
+//! renders the material thumbnails its hovers show (`material_thumbnail.rs`).
 
 use std::path::{Path, PathBuf};
 
@@ -21,7 +22,8 @@ impl whitted_lsp::Files for DiskFiles {
 
 pub fn lsp() -> Result<(), Failure> {
     let (connection, io_threads) = lsp_server::Connection::stdio();
-    let served = whitted_lsp::serve(&connection, Box::new(DiskFiles));
+    let thumbnails: Box<dyn whitted_lsp::Thumbnails> = Box::new(crate::material_thumbnail::Balls);
+    let served = whitted_lsp::serve_with(&connection, Box::new(DiskFiles), Some(thumbnails));
     // The writer thread ends once every sender is gone; then the threads can be joined.
     drop(connection);
     let joined = io_threads.join();

@@ -20,6 +20,7 @@ mod grade_cmd;
 mod image_output;
 mod interrupt;
 mod lsp_cmd;
+mod material_thumbnail;
 mod mit6837_cmd;
 mod mit6837_pictures;
 mod query_cmd;

@@ -28,6 +28,8 @@ pub struct Analysis {
     pub loops: Vec<(Span, usize)>,
     /// The quick fixes the diagnostics offer (`actions.rs`).
     pub fixes: Vec<crate::actions::Fix>,
+    /// The compiled scene's materials with where each was defined, for hover's pictures.
+    pub materials: Option<whitted_ir::Arena<whitted_ir::Material>>,
 }
 
 /// Whether the document is a 6.837 scene: named `.txt`, or starting with one of the
@@ -44,6 +46,7 @@ fn is_course_scene(document: &Document) -> bool {
 pub fn analyze(uri: &Url, document: &Document, mut overlay: Overlay<'_>) -> Analysis {
     let name = document.name(uri);
     let mut loops = Vec::new();
+    let mut materials = None;
     let (sources, index, diagnostics) = if is_course_scene(document) {
         let conversion = whitted_mit6837::convert(
             Path::new(&name),
@@ -61,6 +64,7 @@ pub fn analyze(uri: &Url, document: &Document, mut overlay: Overlay<'_>) -> Anal
             whitted_lang::compile_source(&name, &document.text, &mut overlay, &options);
         if let Some(scene) = &compilation.scene {
             loops = crate::inlays::loop_counts(scene);
+            materials = Some(scene.materials.clone());
         }
         (
             compilation.sources,
@@ -81,6 +85,7 @@ pub fn analyze(uri: &Url, document: &Document, mut overlay: Overlay<'_>) -> Anal
         diagnostics,
         loops,
         fixes,
+        materials,
     }
 }
 

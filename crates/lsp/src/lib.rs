@@ -29,8 +29,19 @@ mod server_nav;
 mod tokens;
 mod view;
 
-pub use run::serve;
+pub use run::{serve, serve_with};
 pub use server::{capabilities, Server};
+
+/// A material's picture for hover, made by whoever runs the server (the binary renders a
+/// ball of it with the tracer; this crate never renders): a URI a Markdown image can show,
+/// such as a PNG `data:` URI, or `None`.
+pub trait Thumbnails {
+    fn material(
+        &self,
+        materials: &whitted_ir::Arena<whitted_ir::Material>,
+        material: whitted_ir::Handle<whitted_ir::Material>,
+    ) -> Option<String>;
+}
 
 /// The files the server may read: imports and mesh files that are not open in the editor.
 pub trait Files {

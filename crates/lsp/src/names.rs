@@ -68,3 +68,42 @@ pub fn hover(document: &Document, offset: usize) -> Option<Hover> {
         range: Some(document.lines.range(&document.text, under.range())),
     })
 }
+
+/// The picture of the material whose name is under the cursor (its definition or a use),
+/// made by `thumbnails`; `None` for anything else, or a material the scene never used.
+pub fn material_picture(
+    document: &Document,
+    offset: usize,
+    thumbnails: &dyn crate::Thumbnails,
+) -> Option<String> {
+    let analysis = document.analysis.as_ref()?;
+    let index = analysis.index.as_ref()?;
+    let at = |span: &Span| {
+        span.file.0 == 0 && (span.start as usize) <= offset && offset <= span.end as usize
+    };
+    let definition = index
+        .links
+        .iter()
+        .find(|(from, _)| at(from))
+        .map(|(_, to)| *to)
+        .or_else(|| {
+            index
+                .definitions
+                .iter()
+                .find(|d| at(&d.span))
+                .map(|d| d.span)
+        })?;
+    let is_material = index
+        .definitions
+        .iter()
+        .any(|d| d.span == definition && d.kind == DefinitionKind::Material);
+    if !is_material {
+        return None;
+    }
+    // The IR material made from that definition: its span is the definition's header.
+    let materials = analysis.materials.as_ref()?;
+    let (handle, _, _) = materials.iter_with_spans().find(|(_, _, span)| {
+        span.file == definition.file && span.start <= definition.start && definition.end <= span.end
+    })?;
+    thumbnails.material(materials, handle)
+}

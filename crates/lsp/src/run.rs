@@ -14,11 +14,23 @@ use crate::Files;
 /// Serves one client until it asks the server to exit after `shutdown` (`Ok`), or the
 /// connection breaks or the client exits without `shutdown` (`Err`, saying which).
 pub fn serve(connection: &Connection, files: Box<dyn Files>) -> Result<(), String> {
+    serve_with(connection, files, None)
+}
+
+/// [`serve`], with material thumbnails in hovers.
+pub fn serve_with(
+    connection: &Connection,
+    files: Box<dyn Files>,
+    thumbnails: Option<Box<dyn crate::Thumbnails>>,
+) -> Result<(), String> {
     let capabilities = serde_json::to_value(capabilities()).map_err(|e| e.to_string())?;
     connection
         .initialize(capabilities)
         .map_err(|e| format!("no `initialize` request from the client ({e})"))?;
     let mut server = Server::new(files);
+    if let Some(thumbnails) = thumbnails {
+        server.set_thumbnails(thumbnails);
+    }
     let mut queue = VecDeque::new();
     while let Ok(first) = connection.receiver.recv() {
         // Everything already waiting is read before any analysis, so that a burst of edits

@@ -64,6 +64,8 @@ pub struct Server {
     /// For each analysed document, the other files it published diagnostics to (its
     /// imports), so that they are cleared when they have none any more.
     published: HashMap<Url, Vec<Url>>,
+    /// Pictures of materials for hover, when the runner gives a renderer.
+    thumbnails: Option<Box<dyn crate::Thumbnails>>,
 }
 
 impl Server {
@@ -72,7 +74,13 @@ impl Server {
             files,
             documents: HashMap::new(),
             published: HashMap::new(),
+            thumbnails: None,
         }
+    }
+
+    /// Material hovers show a picture made by `thumbnails`.
+    pub fn set_thumbnails(&mut self, thumbnails: Box<dyn crate::Thumbnails>) {
+        self.thumbnails = Some(thumbnails);
     }
 
     /// A notification from the client. Unknown ones are ignored, as the protocol asks;
@@ -207,12 +215,28 @@ impl Server {
     ) -> (Result<Value, ResponseError>, Vec<Notification>) {
         let published = self.analyze_changed();
         let result = match method {
-            HoverRequest::METHOD => self
-                .at::<lsp_types::HoverParams>(params, |p| p.text_document_position_params)
-                .map(|found| {
-                    found.and_then(|(document, _, offset)| crate::hover::hover(document, offset))
-                })
-                .and_then(to_value),
+            HoverRequest::METHOD => {
+                let thumbnails = self.thumbnails.as_deref();
+                self.at::<lsp_types::HoverParams>(params, |p| p.text_document_position_params)
+                    .map(|found| {
+                        found.and_then(|(document, _, offset)| {
+                            let mut hover = crate::hover::hover(document, offset)?;
+                            if let Some(picture) = thumbnails
+                                .and_then(|t| crate::names::material_picture(document, offset, t))
+                            {
+                                if let lsp_types::HoverContents::Markup(markup) =
+                                    &mut hover.contents
+                                {
+                                    markup.value.push_str(&format!(
+                                        "\n\n![the material on a ball]({picture})"
+                                    ));
+                                }
+                            }
+                            Some(hover)
+                        })
+                    })
+                    .and_then(to_value)
+            }
             Completion::METHOD => self
                 .at::<lsp_types::CompletionParams>(params, |p| p.text_document_position)
                 .map(|found| {

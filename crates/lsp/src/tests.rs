@@ -623,3 +623,45 @@ fn definition_of_an_import_or_a_mesh_file_is_the_file() {
     // Any other string is not a file.
     assert_eq!(target("x.scene"), None);
 }
+
+/// A material's hover shows the picture the runner's renderer makes of that material (here
+/// a stand-in that names the material's diffuse colour); other names get none.
+#[test]
+fn a_material_hover_shows_its_picture_from_the_runner() {
+    struct Named;
+    impl crate::Thumbnails for Named {
+        fn material(
+            &self,
+            materials: &whitted_ir::Arena<whitted_ir::Material>,
+            material: whitted_ir::Handle<whitted_ir::Material>,
+        ) -> Option<String> {
+            let m = materials.get(material)?;
+            Some(format!("picture:{}", m.diffuse.r))
+        }
+    }
+    let mut server = Server::new(Box::new(Memory::default()));
+    server.set_thumbnails(Box::new(Named));
+    let text = "material other { diffuse 0.2 }\nmaterial red { diffuse 0.7 }\nlet n = 2;\nsphere { radius n material red }\nsphere { material other }\n";
+    open(&mut server, "m.scene", text);
+    let hover_at = |server: &mut Server, needle: &str| {
+        let offset = text.rfind(needle).expect("in the text") + 1;
+        let answer = request(
+            server,
+            "textDocument/hover",
+            position_params("m.scene", text, offset),
+        );
+        answer["contents"]["value"]
+            .as_str()
+            .unwrap_or("")
+            .to_string()
+    };
+    let red = hover_at(&mut server, "red }");
+    assert!(
+        red.contains("![the material on a ball](picture:0.7)"),
+        "{red}"
+    );
+    let at_definition = hover_at(&mut server, "red {");
+    assert!(at_definition.contains("(picture:0.7)"), "{at_definition}");
+    let name = hover_at(&mut server, "n material");
+    assert!(!name.contains("picture:"), "{name}");
+}

@@ -1,5 +1,6 @@
-//! Scene building in Rust, for tests and benchmarks that cannot (or should not) go through
-//! the scene language: a small builder over `whitted_ir::Scene`, and the benchmark scenes.
+//! Scene building in Rust, for tests, benchmarks and small fixed renders (the language
+//! server's material thumbnails) that cannot (or should not) go through the scene language:
+//! a small builder over `whitted_ir::Scene`, and the benchmark scenes.
 
 use glam::{DMat4, DVec3};
 use whitted_ir::{
