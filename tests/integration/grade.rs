@@ -430,3 +430,24 @@ fn a_scene_in_whitted_s_language_is_graded_in_srgb() {
     assert_eq!(document["encoding"], "srgb");
     assert_eq!(top(&document), "no-shadows", "{document}");
 }
+
+#[test]
+fn images_written_upside_down_or_with_red_and_blue_swapped_are_diagnosed() {
+    let dir = tempfile::tempdir().unwrap();
+    for line in [LINE_A, REFLECT] {
+        let right = dir.path().join("right.tga");
+        student_image(line, &[], &right);
+        let image = image::open(&right).unwrap().to_rgb8();
+        let flipped = image::imageops::flip_vertical(&image);
+        let mut swapped = image.clone();
+        for pixel in swapped.pixels_mut() {
+            pixel.0.swap(0, 2);
+        }
+        for (model, picture) in [("upside-down", flipped), ("red-blue-swapped", swapped)] {
+            let path = dir.path().join(format!("{model}.png"));
+            picture.save(&path).unwrap();
+            let document = grade(line, &path);
+            assert_eq!(top(&document), model, "{line}: {document}");
+        }
+    }
+}

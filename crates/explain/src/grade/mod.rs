@@ -198,10 +198,13 @@ impl<'a> Grader<'a> {
         let settings = &self.scene.scene().settings;
         let mut assignments: Vec<(&'static str, String)> = Vec::new();
         let mut encoding = self.encoding;
+        let (mut flipped, mut swapped) = (false, false);
         for bug in bugs {
             match (bug.change)(settings) {
                 None => return Ok(None),
                 Some(Change::OtherEncoding) => encoding = encoding.other(),
+                Some(Change::UpsideDown) => flipped = true,
+                Some(Change::RedBlueSwapped) => swapped = true,
                 Some(Change::Set(set)) => {
                     for (name, value) in set {
                         if assignments.iter().any(|(n, _)| *n == name) {
@@ -213,7 +216,17 @@ impl<'a> Grader<'a> {
             }
         }
         let pixels = self.render(&assignments)?;
-        Ok(Some(encoding.encode(&pixels)))
+        let mut bytes = encoding.encode(&pixels);
+        let row = self.scene.scene().settings.width as usize * 3;
+        if flipped && row > 0 {
+            bytes = bytes.chunks_exact(row).rev().flatten().copied().collect();
+        }
+        if swapped {
+            for pixel in bytes.chunks_exact_mut(3) {
+                pixel.swap(0, 2);
+            }
+        }
+        Ok(Some(bytes))
     }
 
     /// Grades the student's 8-bit image (in the grader's encoding, the scene's size).

@@ -11,6 +11,10 @@ pub enum Change {
     Set(Vec<(&'static str, String)>),
     /// The reference image written in the other 8-bit encoding (sRGB for linear, or back).
     OtherEncoding,
+    /// The reference image with its rows in the opposite order (a file origin mistaken).
+    UpsideDown,
+    /// The reference image with red and blue exchanged (TGA's BGR order written as RGB).
+    RedBlueSwapped,
 }
 
 /// One classic bug.
@@ -172,6 +176,20 @@ pub const BUGS: &[StudentBug] = &[
         handout: "assignment 1, Image: a colour channel times 255 is written as it is",
         fix: "write each channel clamped to [0, 1] times 255, without a gamma curve",
         change: |_| Some(Change::OtherEncoding),
+    },
+    StudentBug {
+        id: "upside-down",
+        words: "writes the image upside down (rows from the top where the file's origin is the bottom, or back)",
+        handout: "assignment 1, Image::SaveTGA: rows are written bottom first, as the format's origin is the lower left",
+        fix: "write rows in the order the file format expects (TGA: the bottom row first), or map j to height - 1 - j",
+        change: |_| Some(Change::UpsideDown),
+    },
+    StudentBug {
+        id: "red-blue-swapped",
+        words: "writes red and blue exchanged (TGA stores blue, green, red)",
+        handout: "assignment 1, Image::SaveTGA: each pixel is written as blue, green, red",
+        fix: "write each pixel's bytes in the file format's order (TGA: B, G, R)",
+        change: |_| Some(Change::RedBlueSwapped),
     },
     StudentBug {
         id: "pixel-corner",
