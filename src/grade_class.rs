@@ -15,7 +15,7 @@ use whitted_explain::grade::{Grader, Verdict};
 use whitted_ir::ValidScene;
 
 use crate::cli::{GradeArgs, SceneArgs};
-use crate::grade_cmd::{encoding_of, entry, verdict_word, write_picture, ExplanationEntry};
+use crate::grade_cmd::{entry, verdict_word, write_picture, ExplanationEntry};
 use crate::mit6837_cmd::{self, Request};
 use crate::scene_input::{load_scene_with, write_stdout};
 use crate::student_image::{self, Space};
@@ -354,7 +354,7 @@ pub fn grade_class(args: &GradeArgs, class: &Path) -> Result<(), Failure> {
     }
     let mut graders: Vec<Grader<'_>> = assignments
         .iter()
-        .map(|a| Grader::new(&a.scene, encoding_of(a.space)))
+        .map(|a| Grader::new(&a.scene, a.space))
         .collect();
     let mut records = Vec::new();
     let (mut graded_now, mut reused) = (0, 0);

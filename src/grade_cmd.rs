@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use serde::Serialize;
-use whitted_explain::grade::{side_by_side, Candidate, Encoding, Grade, Grader, Verdict};
+use whitted_explain::grade::{side_by_side, Candidate, Grade, Grader, Verdict};
 
 use crate::cli::{GradeArgs, SceneArgs};
 use crate::image_output::{write_image, Pixels};
@@ -75,13 +75,6 @@ pub fn entry(candidate: &Candidate, differing: u64) -> ExplanationEntry {
     }
 }
 
-pub fn encoding_of(space: Space) -> Encoding {
-    match space {
-        Space::Linear => Encoding::Linear,
-        Space::Srgb => Encoding::Srgb,
-    }
-}
-
 /// `whitted grade SCENE IMAGE` (or `--class`).
 pub fn grade(args: &GradeArgs) -> Result<(), Failure> {
     if let Some(class) = &args.class {
@@ -136,7 +129,7 @@ pub fn grade(args: &GradeArgs) -> Result<(), Failure> {
         Space::Srgb
     };
     let theirs = student.bytes_in(space);
-    let mut grader = Grader::new(&loaded.scene, encoding_of(space));
+    let mut grader = Grader::new(&loaded.scene, space);
     let grade = grader
         .grade(&theirs, args.tolerance)
         .map_err(Failure::Message)?;

@@ -5,7 +5,6 @@ use std::path::Path;
 
 use image::{DynamicImage, ImageFormat, ImageReader};
 
-use crate::image_output::{to_linear8, to_srgb8};
 use crate::Failure;
 
 /// What a student's image holds.
@@ -22,44 +21,9 @@ pub struct StudentImage {
     pub pixels: StudentPixels,
 }
 
-/// How 8-bit values encode light.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Space {
-    /// Colour times 255, clamped: the MIT 6.837 course's images (`whitted mit6837`).
-    Linear,
-    /// The sRGB curve: `whitted render`'s PNG, TGA and PPM.
-    Srgb,
-}
-
-impl Space {
-    pub fn name(self) -> &'static str {
-        match self {
-            Space::Linear => "linear",
-            Space::Srgb => "srgb",
-        }
-    }
-
-    pub fn other(self) -> Space {
-        match self {
-            Space::Linear => Space::Srgb,
-            Space::Srgb => Space::Linear,
-        }
-    }
-
-    /// `pixels` in this space's 8 bits, three bytes a pixel.
-    pub fn encode(self, pixels: &[[f32; 3]]) -> Vec<u8> {
-        match self {
-            Space::Linear => to_linear8(pixels),
-            Space::Srgb => to_srgb8(pixels),
-        }
-    }
-
-    /// One pixel in this space's 8 bits.
-    pub fn encode_one(self, pixel: [f32; 3]) -> [u8; 3] {
-        let bytes = self.encode(&[pixel]);
-        [bytes[0], bytes[1], bytes[2]]
-    }
-}
+/// How 8-bit values encode light: the grader's encoding (colour times 255, as the MIT 6.837
+/// course wrote images, or the sRGB curve, as `whitted render` writes PNG, TGA and PPM).
+pub use whitted_explain::grade::Encoding as Space;
 
 impl StudentImage {
     /// The student's pixels as 8-bit values in `space`.

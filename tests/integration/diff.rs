@@ -3,19 +3,8 @@
 //! only (and the divergences account for the whole change of the pixel), and
 //! `--against-image` finds regions planted in a render and explains a pixel of each.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
+use crate::support::run;
 use serde_json::Value;
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_whitted"))
-        .current_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")))
-        .env("NO_COLOR", "1")
-        .args(args)
-        .output()
-        .expect("the whitted binary runs")
-}
 
 fn json(args: &[&str]) -> Value {
     let output = run(args);

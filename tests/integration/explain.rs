@@ -2,22 +2,11 @@
 //! oracle), each finding kind fires on its scene in tests/explain/ with the right location
 //! and fix, the JSON has the documented fields, and bad input is a usage error.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
 use serde_json::Value;
 use whitted_tracer::{render, NoObserver, RenderOptions};
 
 use crate::ray_trees::{feature_scenes, load};
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_whitted"))
-        .current_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")))
-        .env("NO_COLOR", "1")
-        .args(args)
-        .output()
-        .expect("the whitted binary runs")
-}
+use crate::support::run;
 
 fn explain_json(scene: &str, pixel: &str) -> Value {
     let output = run(&["explain", scene, "--pixel", pixel, "--json"]);

@@ -28,6 +28,7 @@ mod ray_trees;
 mod report_browser;
 mod reshade;
 mod sampling;
+mod support;
 mod tidy;
 mod trace_cli;
 mod traversal_paths;

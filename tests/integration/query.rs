@@ -3,23 +3,12 @@
 //! each predicate fires; known pixels are in or out; the mask and list agree; and a query
 //! that cannot be read is a located usage error.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
 use whitted_explain::query::{run as run_query, Query};
 use whitted_tracer::ray_tree::{trace_pixel, SampleChoice};
 use whitted_tracer::RenderOptions;
 
 use crate::ray_trees::load;
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_whitted"))
-        .current_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")))
-        .env("NO_COLOR", "1")
-        .args(args)
-        .output()
-        .expect("the whitted binary runs")
-}
+use crate::support::run;
 
 /// Each scene with the predicates to try on it (a name per scene for the named ones).
 const CASES: &[(&str, &[&str])] = &[

@@ -5,21 +5,10 @@
 //! cut; a scene under the budget gets no report. Time is not asserted (see the limit's doc
 //! comment for the figures).
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
+use crate::support::run;
 use serde_json::Value;
 
 const SCENE: &str = "scenes/ray-explosion.scene";
-
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_whitted"))
-        .current_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")))
-        .env("NO_COLOR", "1")
-        .args(args)
-        .output()
-        .expect("the whitted binary runs")
-}
 
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()

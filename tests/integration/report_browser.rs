@@ -6,18 +6,7 @@
 use std::path::PathBuf;
 use std::process::Command;
 
-fn whitted(args: &[&str]) {
-    let output = Command::new(env!("CARGO_BIN_EXE_whitted"))
-        .current_dir(PathBuf::from(env!("CARGO_MANIFEST_DIR")))
-        .args(args)
-        .output()
-        .expect("the whitted binary runs");
-    assert!(
-        output.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-}
+use crate::support::ok;
 
 #[test]
 fn the_class_report_shows_its_pictures_in_chromium() {
@@ -51,10 +40,10 @@ fn the_class_report_shows_its_pictures_in_chromium() {
             });
         }
         args.extend(["--set", set]);
-        whitted(&args);
+        ok(&args);
     }
     let report = dir.path().join("report");
-    whitted(&[
+    ok(&[
         "grade",
         "--class",
         class.to_str().unwrap(),

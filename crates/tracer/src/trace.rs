@@ -807,16 +807,14 @@ impl<'a> Tracer<'a> {
     ) -> Vec3A {
         let scene = self.scene;
         let back_face = !front_face && !scene.settings.shade_back;
-        // `back_ambient off` (MIT 6.837's handout): a back face's own colour is black.
-        let own = if back_face && !scene.settings.back_ambient {
-            0.0
+        // `back_ambient off` (MIT 6.837's handout): a back face's own colour is black. A
+        // self-lit surface's emission counts whatever the lights and shadows.
+        let (ambient, emission) = if back_face && !scene.settings.back_ambient {
+            (Vec3A::ZERO, Vec3A::ZERO)
         } else {
-            1.0
+            (m.ambient * scene.ambient * m.diffuse, m.emission)
         };
-        let ambient = m.ambient * scene.ambient * m.diffuse * own;
         rec.ambient(ambient);
-        // A self-lit surface: its emission counts whatever the lights and shadows.
-        let emission = m.emission * own;
         rec.emission(emission);
         let mut color = ambient + emission;
         // With no diffuse and no specular colour a light adds nothing whatever its shadow

@@ -57,6 +57,12 @@ impl Encoding {
         };
         pixels.iter().flatten().map(|&c| one(c)).collect()
     }
+
+    /// One pixel in this encoding's 8 bits.
+    pub fn encode_one(self, pixel: [f32; 3]) -> [u8; 3] {
+        let bytes = self.encode(&[pixel]);
+        [bytes[0], bytes[1], bytes[2]]
+    }
 }
 
 /// One explanation tried: one model or a pair, and how well it matches the student.
@@ -265,7 +271,7 @@ impl<'a> Grader<'a> {
                 None => {}
             }
         }
-        let mut singles = scored(&baseline, student, &reference, images);
+        let mut singles = scored(&baseline, student, images);
         // Pairs: each of the best singles with every other model that shows in this scene.
         // A pair stays when it explains clearly more than either of its models alone.
         let best: Vec<&'static StudentBug> = singles
@@ -304,7 +310,7 @@ impl<'a> Grader<'a> {
                 .find(|c| c.0.bugs[0].id == bug.id)
                 .map_or(0, |c| c.0.score.net())
         };
-        let pairs: Vec<(Candidate, Vec<u8>)> = scored(&baseline, student, &reference, pair_images)
+        let pairs: Vec<(Candidate, Vec<u8>)> = scored(&baseline, student, pair_images)
             .into_iter()
             .filter(|(pair, _)| {
                 let alone = single_net(pair.bugs[0]).max(single_net(pair.bugs[1]));
@@ -339,7 +345,6 @@ fn catalogue_index(bug: &StudentBug) -> usize {
 fn scored(
     baseline: &score::Baseline,
     student: &[u8],
-    reference: &[u8],
     images: Vec<(Vec<&'static StudentBug>, Vec<u8>)>,
 ) -> Vec<(Candidate, Vec<u8>)> {
     let mut out: Vec<(Candidate, Vec<u8>)> = Vec::new();
@@ -350,7 +355,7 @@ fn scored(
             }
             continue;
         }
-        let score = baseline.score(student, reference, &image);
+        let score = baseline.score(student, &image);
         out.push((
             Candidate {
                 bugs,
