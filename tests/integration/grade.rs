@@ -53,7 +53,7 @@ fn top(document: &Value) -> String {
 
 /// Each model, the settings that make it, and two command lines where it shows.
 const MODELS: &[(&str, &[&str], [&str; 2])] = &[
-    ("no-shadow-offset", &["epsilon=0"], [LINE_A, REFLECT]),
+    ("no-shadow-offset", &["epsilon=0"], [LINE_B, REFLECT]),
     ("no-shadows", &["shadows=none"], [LINE_A, REFLECT]),
     (
         "opaque-shadows",
@@ -163,19 +163,28 @@ fn gamma_written_where_linear_is_expected_is_diagnosed() {
 #[test]
 fn a_planted_pair_of_bugs_is_diagnosed_as_that_pair() {
     let dir = tempfile::tempdir().unwrap();
-    for (sets, expected) in [
+    for (sets, expected, line) in [
         (
             &["epsilon=0", "ambient=0"][..],
             ["no-ambient", "no-shadow-offset"],
+            LINE_A,
         ),
         (
             &["light_falloff=off", "sample_position=corner"][..],
             ["no-attenuation", "pixel-corner"],
+            LINE_A,
+        ),
+        // The second bug matches nothing alone here (the missing ambient changes every
+        // pixel the corner sample does): found only by pairing the best with every model.
+        (
+            &["ambient=0", "sample_position=corner"][..],
+            ["no-ambient", "pixel-corner"],
+            HALL,
         ),
     ] {
         let image = dir.path().join("pair.tga");
-        student_image(LINE_A, sets, &image);
-        let document = grade(LINE_A, &image);
+        student_image(line, sets, &image);
+        let document = grade(line, &image);
         let mut ids: Vec<String> = top(&document).split('+').map(str::to_string).collect();
         ids.sort();
         let mut expected = expected.map(str::to_string).to_vec();

@@ -334,6 +334,11 @@ fn reflective_and_transparent_are_added_as_given() {
     let said = stderr(&output);
     assert_eq!(said.matches("more than 1").count(), 1, "{said}");
     assert!(said.contains("as given"), "{said}");
+    // One sentence, not one broken by the source's line continuation.
+    assert!(
+        said.contains("is more than 1: the course adds reflective·trace + transparent·trace as given, so it returns more light than arrives"),
+        "{said}"
+    );
 
     // The same material in whitted's language, where the default scales it down.
     let own = dir.path().join("bright.scene");
