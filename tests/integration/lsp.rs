@@ -299,6 +299,33 @@ fn a_whole_session_over_stdio() {
         "renaming `glass` to `mirror` would clash with another definition: `mirror` is already defined here (defined a second time)"
     );
 
+    // The sphere's name (wide characters counted in UTF-16 units): its only object, and
+    // a rename between its quotes.
+    let mut params = at(&main, 4, 10);
+    params["context"] = json!({"includeDeclaration": true});
+    assert_eq!(
+        session.request("textDocument/references", params),
+        json!([{"uri": main, "range": range((4, 7), (4, 16))}])
+    );
+    assert_eq!(
+        session.request("textDocument/prepareRename", at(&main, 4, 10)),
+        json!({"range": range((4, 8), (4, 15)), "placeholder": "ballé😀"})
+    );
+    let mut params = at(&main, 4, 10);
+    params["newName"] = json!("ball");
+    assert_eq!(
+        session.request("textDocument/rename", params)["changes"],
+        json!({main.as_str(): [{"range": range((4, 8), (4, 15)), "newText": "ball"}]})
+    );
+    // The import's string: every string naming lib.scene (here one) and the file.
+    let mut params = at(&main, 0, 10);
+    params["context"] = json!({"includeDeclaration": true});
+    assert_eq!(
+        session.request("textDocument/references", params),
+        json!([{"uri": lib, "range": range((0, 0), (0, 0))},
+               {"uri": main, "range": range((0, 7), (0, 18))}])
+    );
+
     let outline = session.request(
         "textDocument/documentSymbol",
         json!({"textDocument": {"uri": main}}),
@@ -345,6 +372,13 @@ fn a_whole_session_over_stdio() {
             .as_array()
             .expect("numbers")[..]
     );
+    // One line's tokens, by range: the same numbers, the first relative to the start.
+    assert_eq!(capabilities["semanticTokensProvider"]["range"], json!(true));
+    let tokens = session.request(
+        "textDocument/semanticTokens/range",
+        json!({"textDocument": {"uri": view}, "range": range((2, 0), (3, 0))}),
+    );
+    assert_eq!(tokens["data"], json!([2, 0, 8, 0, 0, 0, 9, 3, 3, 1]));
     let folds = session.request("textDocument/foldingRange", document.clone());
     assert_eq!(
         folds,

@@ -26,6 +26,7 @@ mod rename;
 mod run;
 mod server;
 mod server_nav;
+mod strings;
 mod tokens;
 mod view;
 

@@ -1,6 +1,7 @@
 //! The requests of references, rename and quick fixes (`references`, `prepareRename`,
 //! `rename` and `codeAction`), read and answered apart from `server.rs` so that its
-//! dispatch grows by one arm.
+//! dispatch grows by one arm. Strings (objects' names, files) are asked first
+//! (`strings.rs`), then the resolver's names (`references.rs`, `rename.rs`).
 
 use std::collections::HashMap;
 
@@ -36,6 +37,16 @@ pub fn request(
             let p: lsp_types::ReferenceParams = parse(params)?;
             let (uri, offset) = at(documents, &p.text_document_position);
             let found = offset.and_then(|offset| {
+                // An object's name or a file's string; else a name the resolver linked.
+                if let Some(found) = crate::strings::references(
+                    documents,
+                    files,
+                    &uri,
+                    offset,
+                    p.context.include_declaration,
+                ) {
+                    return Some(found);
+                }
                 crate::references::references(
                     documents,
                     &uri,
@@ -48,19 +59,27 @@ pub fn request(
         PrepareRenameRequest::METHOD => {
             let p: TextDocumentPositionParams = parse(params)?;
             let (uri, offset) = at(documents, &p);
-            to_value(offset.and_then(|offset| crate::rename::prepare(documents, &uri, offset)))
+            to_value(offset.and_then(|offset| {
+                crate::strings::prepare(documents, files, &uri, offset)
+                    .unwrap_or_else(|| crate::rename::prepare(documents, &uri, offset))
+            }))
         }
         Rename::METHOD => {
             let p: lsp_types::RenameParams = parse(params)?;
             let (uri, offset) = at(documents, &p.text_document_position);
             match offset {
-                Some(offset) => to_value(crate::rename::rename(
-                    documents,
-                    files,
-                    &uri,
-                    offset,
-                    &p.new_name,
-                )?),
+                Some(offset) => {
+                    match crate::strings::rename(documents, files, &uri, offset, &p.new_name) {
+                        Some(answer) => to_value(answer?),
+                        None => to_value(crate::rename::rename(
+                            documents,
+                            files,
+                            &uri,
+                            offset,
+                            &p.new_name,
+                        )?),
+                    }
+                }
                 None => to_value(None::<()>),
             }
         }

@@ -434,8 +434,10 @@ fn random_edits_and_requests_never_fail() {
         "import",
         "\"lib.scene\"",
         "#ff0000",
+        "\"ball\"",
+        "/*",
     ];
-    const START: &str = "import \"lib.scene\"\nsettings { shadows filtered }\nmaterial glass { ior 1.5 diffuse <1, 0, 0> }\nfn ring(n) { for i in 0..n { sphere { center <i, 0, 0> radius 0.5 material glass } } }\nring(3) { translate <0, 1, 0> }\n";
+    const START: &str = "import \"lib.scene\"\nsettings { shadows filtered }\nmaterial glass { ior 1.5 diffuse <1, 0, 0> }\nfn ring(n) {\n  for i in 0..n {\n    sphere { center <i, 0, 0> radius 0.5 material glass }\n  }\n}\n/* a\n b */\nring(3) { translate <0, 1, 0> }\nsphere \"ball\" { }\nmesh { file \"bunny.obj\" }\n";
     let mut disk = Memory::default();
     disk.0.insert(
         PathBuf::from("/project/lib.scene"),
@@ -508,6 +510,7 @@ fn random_edits_and_requests_never_fail() {
                 "textDocument/definition",
                 "textDocument/documentSymbol",
                 "textDocument/semanticTokens/full",
+                "textDocument/semanticTokens/range",
                 "textDocument/foldingRange",
                 "textDocument/documentColor",
                 "textDocument/colorPresentation",
@@ -533,7 +536,22 @@ fn random_edits_and_requests_never_fail() {
                 "textDocument/codeAction" => params["context"] = json!({"diagnostics": []}),
                 _ => {}
             }
-            let (result, _) = server.request(method, params);
+            let (result, _) = server.request(method, params.clone());
+            if method == "textDocument/semanticTokens/range" {
+                // A range's tokens are the pieces of the whole document's that overlap it.
+                let (whole, _) = server.request("textDocument/semanticTokens/full", params);
+                let clamp = |p: Position| lines.position(&text, lines.offset(&text, p));
+                let from = clamp(position);
+                let to = clamp(end).max(from);
+                let (from, to) = ((from.line, from.character), (to.line, to.character));
+                let expected: Vec<[u64; 5]> = absolute(&whole.expect("the whole document's"))
+                    .into_iter()
+                    .filter(|t| (t[0], t[1] + t[2]) > (from.0 as u64, from.1 as u64))
+                    .filter(|t| (t[0], t[1]) < (to.0 as u64, to.1 as u64))
+                    .collect();
+                let found = absolute(result.as_ref().expect("the range's"));
+                assert_eq!(found, expected, "{position:?}..{end:?} of {text:?}");
+            }
             if result
                 .as_ref()
                 .is_ok_and(|v| !v.is_null() && *v != json!([]))
@@ -550,7 +568,7 @@ fn random_edits_and_requests_never_fail() {
     }
     // Every kind of request was asked where it has an answer, some of the time (quick
     // fixes need a diagnostic that offers one, which random edits seldom make).
-    assert!(answered.len() >= 12, "{answered:?}");
+    assert!(answered.len() >= 13, "{answered:?}");
     // The server's text is the text the edits make.
     server.notify(
         "textDocument/didChange",
@@ -664,4 +682,20 @@ fn a_material_hover_shows_its_picture_from_the_runner() {
     assert!(at_definition.contains("(picture:0.7)"), "{at_definition}");
     let name = hover_at(&mut server, "n material");
     assert!(!name.contains("picture:"), "{name}");
+}
+
+/// Semantic tokens as (line, column, length, type, modifiers), absolute.
+fn absolute(tokens: &Value) -> Vec<[u64; 5]> {
+    let data: Vec<u64> = tokens["data"]
+        .as_array()
+        .map(|d| d.iter().filter_map(Value::as_u64).collect())
+        .unwrap_or_default();
+    let (mut line, mut column) = (0, 0);
+    data.chunks_exact(5)
+        .map(|t| {
+            line += t[0];
+            column = if t[0] == 0 { column + t[1] } else { t[1] };
+            [line, column, t[2], t[3], t[4]]
+        })
+        .collect()
 }
