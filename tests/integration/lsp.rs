@@ -1,7 +1,8 @@
 //! `whitted lsp` as an editor runs it: the real binary over stdio, one whole session with
 //! exact answers (diagnostics appearing at their range and going away, hover, completion in a
 //! material block, go to definition here and into an import, the outline, a quick fix,
-//! references and rename across an import), and exit status 0
+//! references and rename across an import, of an object's name and of an import's file,
+//! semantic tokens of a range), and exit status 0
 //! after `shutdown` and `exit`. The Content-Length framing is written here by hand: it is the
 //! protocol, not the server under test.
 

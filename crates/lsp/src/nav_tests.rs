@@ -1,6 +1,7 @@
 //! References, rename, quick fixes and hover on names, in-process with exact answers: across
-//! an import read from the disk, every refusal of rename, and every request at every place of
-//! a scene (and of one that does not parse) answering without failing.
+//! an import read from the disk, objects' names and files' strings, every refusal of rename,
+//! and every request at every place of a scene (and of one that does not parse) answering
+//! without failing.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};

@@ -1,6 +1,7 @@
 //! The server in-process: completion in every kind of place (the cursor marked `|` in the
 //! text), hover on text that does not parse, diagnostics across an open import and for a
-//! 6.837 scene, and a fixed-seed run of random edits and requests that must never fail.
+//! 6.837 scene, and a fixed-seed run of random edits and requests that must never fail (and
+//! whose every semantic tokens range must be the whole document's tokens there).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};

@@ -1,6 +1,6 @@
 //! The editor's index, read off the resolved syntax tree of every file: the blocks that take
 //! properties with what is written in them, the resolver's links from names to definitions,
-//! and the outline.
+//! the outline, objects' names and the file strings of imports and meshes.
 
 use whitted_ir::Span;
 
