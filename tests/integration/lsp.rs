@@ -375,6 +375,21 @@ fn a_whole_session_over_stdio() {
     );
     // One line's tokens, by range: the same numbers, the first relative to the start.
     assert_eq!(capabilities["semanticTokensProvider"]["range"], json!(true));
+    assert_eq!(
+        capabilities["semanticTokensProvider"]["full"],
+        json!({"delta": true})
+    );
+    // A delta from the tokens just sent, with nothing changed since: no edit.
+    let id = tokens["resultId"]
+        .as_str()
+        .expect("a result id")
+        .to_string();
+    let delta = session.request(
+        "textDocument/semanticTokens/full/delta",
+        json!({"textDocument": {"uri": view}, "previousResultId": id}),
+    );
+    assert_eq!(delta["edits"], json!([]));
+    assert_ne!(delta["resultId"], json!(id));
     let tokens = session.request(
         "textDocument/semanticTokens/range",
         json!({"textDocument": {"uri": view}, "range": range((2, 0), (3, 0))}),

@@ -449,6 +449,8 @@ fn random_edits_and_requests_never_fail() {
     let mut text = START.to_string();
     let mut rng = Rng(29);
     let mut answered: HashMap<&str, usize> = HashMap::new();
+    // The id and data of the last whole-document semantic tokens, for deltas.
+    let mut sent: Option<(String, Vec<Value>)> = None;
     for version in 2..600 {
         let lines = LineIndex::new(&text);
         let at = |rng: &mut Rng, text: &str| {
@@ -512,6 +514,7 @@ fn random_edits_and_requests_never_fail() {
                 "textDocument/documentSymbol",
                 "textDocument/semanticTokens/full",
                 "textDocument/semanticTokens/range",
+                "textDocument/semanticTokens/full/delta",
                 "textDocument/foldingRange",
                 "textDocument/documentColor",
                 "textDocument/colorPresentation",
@@ -535,9 +538,42 @@ fn random_edits_and_requests_never_fail() {
                     params["context"] = json!({"includeDeclaration": rng.below(2) == 0});
                 }
                 "textDocument/codeAction" => params["context"] = json!({"diagnostics": []}),
+                "textDocument/semanticTokens/full/delta" => {
+                    // The last id sent, or an old one, which gets the whole document's.
+                    let id = match &sent {
+                        Some((id, _)) if rng.below(4) != 0 => id.clone(),
+                        _ => "0".to_string(),
+                    };
+                    params["previousResultId"] = json!(id);
+                }
                 _ => {}
             }
             let (result, _) = server.request(method, params.clone());
+            if method.starts_with("textDocument/semanticTokens/full") {
+                let answer = result.clone().expect("tokens");
+                let data: Vec<Value> = match answer.get("edits") {
+                    // A delta: its edits applied to the tokens last sent.
+                    Some(edits) => {
+                        let mut data = sent.clone().expect("tokens were sent").1;
+                        for edit in edits.as_array().expect("edits").iter().rev() {
+                            let start = edit["start"].as_u64().expect("start") as usize;
+                            let deleted = edit["deleteCount"].as_u64().expect("count") as usize;
+                            let inserted = edit["data"].as_array().cloned().unwrap_or_default();
+                            data.splice(start..start + deleted, inserted);
+                        }
+                        data
+                    }
+                    None => answer["data"].as_array().cloned().unwrap_or_default(),
+                };
+                let (whole, _) = server.request(
+                    "textDocument/semanticTokens/full",
+                    json!({"textDocument": {"uri": uri("a.scene")}}),
+                );
+                let whole = whole.expect("the whole document's");
+                assert_eq!(data, whole["data"].as_array().cloned().unwrap_or_default());
+                let id = whole["resultId"].as_str().unwrap_or_default().to_string();
+                sent = Some((id, data));
+            }
             if method == "textDocument/semanticTokens/range" {
                 // A range's tokens are the pieces of the whole document's that overlap it.
                 let (whole, _) = server.request("textDocument/semanticTokens/full", params);
@@ -569,7 +605,7 @@ fn random_edits_and_requests_never_fail() {
     }
     // Every kind of request was asked where it has an answer, some of the time (quick
     // fixes need a diagnostic that offers one, which random edits seldom make).
-    assert!(answered.len() >= 13, "{answered:?}");
+    assert!(answered.len() >= 14, "{answered:?}");
     // The server's text is the text the edits make.
     server.notify(
         "textDocument/didChange",

@@ -10,8 +10,9 @@
 //! the range's tokens are the whole document's (a test compares them at every range).
 
 use lsp_types::{
-    SemanticToken, SemanticTokenModifier, SemanticTokenType, SemanticTokens,
-    SemanticTokensFullOptions, SemanticTokensLegend, SemanticTokensOptions,
+    SemanticToken, SemanticTokenModifier, SemanticTokenType, SemanticTokens, SemanticTokensDelta,
+    SemanticTokensEdit, SemanticTokensFullDeltaResult, SemanticTokensFullOptions,
+    SemanticTokensLegend, SemanticTokensOptions,
 };
 use whitted_lang::editor::view::{highlight, Class};
 
@@ -49,14 +50,14 @@ fn type_index(class: Class) -> u32 {
     }
 }
 
-/// The capability: the legend, whole documents and ranges.
+/// The capability: the legend, whole documents (and their changes) and ranges.
 pub fn options() -> SemanticTokensOptions {
     SemanticTokensOptions {
         legend: SemanticTokensLegend {
             token_types: TYPES.to_vec(),
             token_modifiers: vec![SemanticTokenModifier::DEFINITION],
         },
-        full: Some(SemanticTokensFullOptions::Bool(true)),
+        full: Some(SemanticTokensFullOptions::Delta { delta: Some(true) }),
         range: Some(true),
         ..SemanticTokensOptions::default()
     }
@@ -65,6 +66,58 @@ pub fn options() -> SemanticTokensOptions {
 /// Every token of the document, encoded.
 pub fn tokens(document: &Document) -> SemanticTokens {
     encode(document, highlight(&document.text), 0..document.text.len())
+}
+
+/// The whole document's tokens with a result id, kept as the last sent (for
+/// [`tokens_delta`]).
+pub fn tokens_sent(document: &Document) -> SemanticTokens {
+    let mut found = tokens(document);
+    let mut sent = document.sent_tokens.borrow_mut();
+    let id = sent
+        .as_ref()
+        .and_then(|s| s.result_id.as_deref()?.parse::<u64>().ok())
+        .map_or(1, |n| n + 1);
+    found.result_id = Some(id.to_string());
+    *sent = Some(found.clone());
+    found
+}
+
+/// `semanticTokens/full/delta`: the change from the tokens last sent, when `previous` is
+/// their id (one edit: the tokens between the common start and the common end), else the
+/// whole document's.
+pub fn tokens_delta(document: &Document, previous: &str) -> SemanticTokensFullDeltaResult {
+    let old = document
+        .sent_tokens
+        .borrow()
+        .clone()
+        .filter(|s| s.result_id.as_deref() == Some(previous));
+    let new = tokens_sent(document);
+    let Some(old) = old else {
+        return SemanticTokensFullDeltaResult::Tokens(new);
+    };
+    let (old, data) = (&old.data, &new.data);
+    let same = old.iter().zip(data).take_while(|(a, b)| a == b).count();
+    let rest = old.len().min(data.len()) - same;
+    let tail = old
+        .iter()
+        .rev()
+        .zip(data.iter().rev())
+        .take(rest)
+        .take_while(|(a, b)| a == b)
+        .count();
+    let edits = if old.len() == data.len() && same == old.len() {
+        Vec::new()
+    } else {
+        vec![SemanticTokensEdit {
+            start: (same * 5) as u32,
+            delete_count: ((old.len() - same - tail) * 5) as u32,
+            data: Some(data[same..data.len() - tail].to_vec()),
+        }]
+    };
+    SemanticTokensFullDeltaResult::TokensDelta(SemanticTokensDelta {
+        result_id: new.result_id,
+        edits,
+    })
 }
 
 /// The tokens that are in the bytes `range` of the document (wholly or in part), encoded
@@ -309,5 +362,42 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A delta from the tokens last sent, applied to them, gives the new text's tokens; an
+    /// unknown previous id gets the whole document's.
+    #[test]
+    fn a_delta_applied_to_the_last_tokens_gives_the_new_ones() {
+        let uri = Url::parse("file:///a.scene").expect("a URI");
+        let text = "let a = 1;\nsphere { radius a }\nplane { }\n";
+        let mut document = Document::new(&uri, text.to_string(), 1);
+        let first = tokens_sent(&document);
+        assert_eq!(first.result_id.as_deref(), Some("1"));
+        // `a` becomes `a + 2` on line 1: the tokens from there to the end of the line.
+        document.apply(lsp_types::TextDocumentContentChangeEvent {
+            range: Some(lsp_types::Range::new(
+                lsp_types::Position::new(1, 17),
+                lsp_types::Position::new(1, 17),
+            )),
+            range_length: None,
+            text: " + 2".to_string(),
+        });
+        let SemanticTokensFullDeltaResult::TokensDelta(delta) = tokens_delta(&document, "1") else {
+            panic!("a delta");
+        };
+        assert_eq!(delta.result_id.as_deref(), Some("2"));
+        assert_eq!(delta.edits.len(), 1);
+        let edit = &delta.edits[0];
+        // Kept: `let a = 1`, `sphere radius a` (7 tokens); inserted: `+ 2`.
+        assert_eq!((edit.start, edit.delete_count), (35, 0));
+        let mut data = first.data.clone();
+        let at = edit.start as usize / 5;
+        let deleted = edit.delete_count as usize / 5;
+        data.splice(at..at + deleted, edit.data.clone().unwrap_or_default());
+        assert_eq!(data, tokens(&document).data);
+        assert!(matches!(
+            tokens_delta(&document, "1"),
+            SemanticTokensFullDeltaResult::Tokens(_)
+        ));
     }
 }

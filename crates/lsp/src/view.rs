@@ -9,7 +9,7 @@ use std::collections::HashMap;
 use lsp_server::ResponseError;
 use lsp_types::request::{
     ColorPresentationRequest, DocumentColor, FoldingRangeRequest, InlayHintRequest, Request as _,
-    SemanticTokensFullRequest, SemanticTokensRangeRequest,
+    SemanticTokensFullDeltaRequest, SemanticTokensFullRequest, SemanticTokensRangeRequest,
 };
 use lsp_types::{SemanticTokensRangeResult, SemanticTokensResult, Url};
 use serde_json::Value;
@@ -18,8 +18,9 @@ use crate::documents::Document;
 use crate::server::{invalid_params, parse, to_value};
 
 /// The methods answered here.
-pub const METHODS: [&str; 6] = [
+pub const METHODS: [&str; 7] = [
     SemanticTokensFullRequest::METHOD,
+    SemanticTokensFullDeltaRequest::METHOD,
     SemanticTokensRangeRequest::METHOD,
     FoldingRangeRequest::METHOD,
     DocumentColor::METHOD,
@@ -39,7 +40,16 @@ pub fn answer(
             to_value(
                 documents
                     .get(&p.text_document.uri)
-                    .map(|d| SemanticTokensResult::Tokens(crate::tokens::tokens(d))),
+                    .map(|d| SemanticTokensResult::Tokens(crate::tokens::tokens_sent(d))),
+            )
+        }
+        SemanticTokensFullDeltaRequest::METHOD => {
+            let p =
+                parse::<lsp_types::SemanticTokensDeltaParams>(params).ok_or_else(invalid_params)?;
+            to_value(
+                documents
+                    .get(&p.text_document.uri)
+                    .map(|d| crate::tokens::tokens_delta(d, &p.previous_result_id)),
             )
         }
         SemanticTokensRangeRequest::METHOD => {
