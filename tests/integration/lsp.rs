@@ -326,6 +326,20 @@ fn a_whole_session_over_stdio() {
         json!([{"uri": lib, "range": range((0, 0), (0, 0))},
                {"uri": main, "range": range((0, 7), (0, 18))}])
     );
+    // Moving lib.scene into a folder rewrites the import.
+    assert_eq!(
+        capabilities["workspace"]["fileOperations"]["willRename"]["filters"][0]["scheme"],
+        json!("file")
+    );
+    let moved = Url::from_file_path(dir.path().join("parts/lib.scene")).expect("a file URI");
+    let edit = session.request(
+        "workspace/willRenameFiles",
+        json!({"files": [{"oldUri": lib, "newUri": moved}]}),
+    );
+    assert_eq!(
+        edit["changes"],
+        json!({main.as_str(): [{"range": range((0, 8), (0, 17)), "newText": "parts/lib.scene"}]})
+    );
 
     let outline = session.request(
         "textDocument/documentSymbol",

@@ -493,3 +493,51 @@ fn a_files_string_finds_every_string_naming_that_file() {
     params["newName"] = json!("x");
     assert!(ask(&mut server, "textDocument/rename", params).is_err());
 }
+
+fn will_rename(server: &mut Server, old: &str, new: &str) -> Vec<String> {
+    let edit = ask(
+        server,
+        "workspace/willRenameFiles",
+        json!({"files": [{"oldUri": uri(old), "newUri": uri(new)}]}),
+    )
+    .expect("an answer");
+    if edit.is_null() {
+        return Vec::new();
+    }
+    edits(&edit)
+}
+
+/// Moving a file or a folder rewrites the strings that name it, relative to their own file;
+/// a string that moves with what it names is left alone.
+#[test]
+fn moving_a_file_rewrites_the_strings_naming_it() {
+    let mut server = server_with(
+        &[("parts/lib.scene", PARTS)],
+        &[("main.scene", SCENE), ("other.scene", OTHER)],
+    );
+    assert_eq!(
+        will_rename(&mut server, "parts/lib.scene", "lib/base.scene"),
+        [
+            "main.scene:0:8-0:23=lib/base.scene",
+            "other.scene:0:8-0:32=lib/base.scene"
+        ]
+    );
+    assert_eq!(
+        will_rename(&mut server, "bunny.obj", "meshes/bunny.obj"),
+        [
+            "lib.scene:1:21-1:33=../meshes/bunny.obj",
+            "main.scene:4:13-4:22=meshes/bunny.obj"
+        ]
+    );
+    assert_eq!(
+        will_rename(&mut server, "parts", "pieces"),
+        [
+            "main.scene:0:8-0:23=pieces/lib.scene",
+            "other.scene:0:8-0:32=pieces/lib.scene"
+        ]
+    );
+    assert_eq!(
+        will_rename(&mut server, "unused.scene", "x.scene"),
+        Vec::<String>::new()
+    );
+}

@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 use lsp_server::{ErrorCode, ResponseError};
 use lsp_types::request::{
-    CodeActionRequest, PrepareRenameRequest, References, Rename, Request as _,
+    CodeActionRequest, PrepareRenameRequest, References, Rename, Request as _, WillRenameFiles,
 };
 use lsp_types::{TextDocumentPositionParams, Url};
 use serde::de::DeserializeOwned;
@@ -22,6 +22,7 @@ pub fn handles(method: &str) -> bool {
         PrepareRenameRequest::METHOD,
         Rename::METHOD,
         CodeActionRequest::METHOD,
+        WillRenameFiles::METHOD,
     ]
     .contains(&method)
 }
@@ -91,6 +92,10 @@ pub fn request(
                     .get(&uri)
                     .map(|d| crate::actions::code_actions(&uri, d, p.range)),
             )
+        }
+        WillRenameFiles::METHOD => {
+            let p: lsp_types::RenameFilesParams = parse(params)?;
+            to_value(crate::strings::will_rename(documents, files, &p.files))
         }
         _ => Err(ResponseError {
             code: ErrorCode::MethodNotFound as i32,

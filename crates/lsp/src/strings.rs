@@ -324,3 +324,101 @@ fn refuse(message: String) -> ResponseError {
         data: None,
     }
 }
+
+/// `workspace/willRenameFiles`: before the editor renames or moves files or folders, the
+/// edits that keep every `import` and mesh `file` string in the open documents' compiles
+/// naming them, each written relative to its own file as before. A string in a file that
+/// moves with what it names (both in a moved folder) is left alone; the relative strings
+/// of a scene file that moves away from what it names are not rewritten.
+pub fn will_rename(
+    documents: &HashMap<Url, Document>,
+    files: &mut dyn Files,
+    renames: &[lsp_types::FileRename],
+) -> Option<WorkspaceEdit> {
+    let moves: Vec<(PathBuf, PathBuf, PathBuf)> = renames
+        .iter()
+        .filter_map(|rename| {
+            let old = Url::parse(&rename.old_uri).ok()?.to_file_path().ok()?;
+            let new = Url::parse(&rename.new_uri).ok()?.to_file_path().ok()?;
+            Some((files.identify(&old), old, new))
+        })
+        .collect();
+    let mut edits: HashMap<Place, Location> = HashMap::new();
+    let mut texts: HashMap<Place, String> = HashMap::new();
+    let mut places: BTreeSet<Place> = BTreeSet::new();
+    for (uri, document) in documents {
+        let Some(analysis) = document.analysis.as_ref() else {
+            continue;
+        };
+        let Some(index) = analysis.index.as_ref() else {
+            continue;
+        };
+        let mut locator = Locator::new(uri, &analysis.sources, &document.lines);
+        for (span, written) in &index.paths {
+            let (Some(target), Some(source)) = (
+                resolve(analysis, *span, written),
+                analysis.sources.get(span.file),
+            ) else {
+                continue;
+            };
+            let from = Path::new(&source.path);
+            for (identity, old, new) in &moves {
+                let moved = if target == *old || files.identify(&target) == *identity {
+                    new.clone()
+                } else if let Ok(rest) = target.strip_prefix(old) {
+                    new.join(rest)
+                } else {
+                    continue;
+                };
+                if from.starts_with(old) {
+                    break;
+                }
+                let Some(location) = locator.location(*span) else {
+                    break;
+                };
+                let place = Place {
+                    uri: location.uri.clone(),
+                    start: span.start as usize,
+                    end: span.end as usize,
+                };
+                let folder = from.parent().unwrap_or(Path::new("/"));
+                texts.insert(place.clone(), relative(folder, &moved));
+                edits.insert(place.clone(), inside(location));
+                places.insert(place);
+                break;
+            }
+        }
+    }
+    if places.is_empty() {
+        return None;
+    }
+    let mut changes: HashMap<Url, Vec<TextEdit>> = HashMap::new();
+    for place in places {
+        let (Some(location), Some(text)) = (edits.remove(&place), texts.remove(&place)) else {
+            continue;
+        };
+        changes.entry(location.uri).or_default().push(TextEdit {
+            range: location.range,
+            new_text: text,
+        });
+    }
+    Some(WorkspaceEdit {
+        changes: Some(changes),
+        ..WorkspaceEdit::default()
+    })
+}
+
+/// `to` as written from the folder `from` (both absolute): `..` up to their common folder,
+/// then down, with `/` between the parts.
+fn relative(from: &Path, to: &Path) -> String {
+    let from: Vec<_> = from.components().collect();
+    let to: Vec<_> = to.components().collect();
+    let common = from.iter().zip(&to).take_while(|(a, b)| a == b).count();
+    let mut parts: Vec<String> = vec!["..".to_string(); from.len() - common];
+    parts.extend(
+        to[common..]
+            .iter()
+            .map(|c| c.as_os_str().to_string_lossy().into_owned()),
+    );
+    parts.join("/")
+}

@@ -523,6 +523,7 @@ fn random_edits_and_requests_never_fail() {
                 "textDocument/prepareRename",
                 "textDocument/codeAction",
                 "textDocument/rename",
+                "workspace/willRenameFiles",
             ];
             let method = methods[rng.below(methods.len())];
             let end = Position::new(position.line + rng.below(4) as u32, rng.below(80) as u32);
@@ -538,6 +539,14 @@ fn random_edits_and_requests_never_fail() {
                     params["context"] = json!({"includeDeclaration": rng.below(2) == 0});
                 }
                 "textDocument/codeAction" => params["context"] = json!({"diagnostics": []}),
+                "workspace/willRenameFiles" => {
+                    let (old, new) = [
+                        ("lib.scene", "l2.scene"),
+                        ("bunny.obj", "m/b.obj"),
+                        ("", "x"),
+                    ][rng.below(3)];
+                    params["files"] = json!([{"oldUri": uri(old), "newUri": uri(new)}]);
+                }
                 "textDocument/semanticTokens/full/delta" => {
                     // The last id sent, or an old one, which gets the whole document's.
                     let id = match &sent {
@@ -605,7 +614,7 @@ fn random_edits_and_requests_never_fail() {
     }
     // Every kind of request was asked where it has an answer, some of the time (quick
     // fixes need a diagnostic that offers one, which random edits seldom make).
-    assert!(answered.len() >= 14, "{answered:?}");
+    assert!(answered.len() >= 15, "{answered:?}");
     // The server's text is the text the edits make.
     server.notify(
         "textDocument/didChange",
