@@ -1,6 +1,7 @@
 //! Navigation on what a string names: an object's name (`sphere "ball" { ... }`) and the
 //! file of an `import` or a mesh's `file`. Definition, references and rename of an object's
-//! name; references of a file (the go to definition of a file is `navigation.rs`'s).
+//! name; references of a file, and the edits that follow a file's move
+//! (`workspace/willRenameFiles`); the go to definition of a file is `navigation.rs`'s.
 //!
 //! Nothing in the language refers to an object by its name: the name is what explain's
 //! queries (`hit("ball")`), `whitted trace` and the debugger call it by, and many objects

@@ -1,7 +1,8 @@
-//! Semantic tokens for a whole document or a range of it: the compiler's classes (`editor::view::highlight`,
-//! read by the formatter's tokenizer, so a file that does not parse is highlighted as far
-//! as it lexes) in the protocol's relative encoding, columns in UTF-16 units, a token that
-//! spans lines (a block comment, a string) cut at each line break.
+//! Semantic tokens for a whole document (or its change since the last answer) or a range
+//! of it: the compiler's classes (`editor::view::highlight`, read by the formatter's
+//! tokenizer, so a file that does not parse is highlighted as far as it lexes) in the
+//! protocol's relative encoding, columns in UTF-16 units, a token that spans lines (a block
+//! comment, a string) cut at each line break.
 //!
 //! A range is highlighted from the last top-level statement that starts before it to the
 //! first that starts after it (found by a scan of the bytes for braces, comments and strings,
