@@ -1,5 +1,5 @@
 //! The requests of references, rename and quick fixes (`references`, `prepareRename`,
-//! `rename`, `codeAction` and `workspace/willRenameFiles`), read and answered apart from `server.rs` so that its
+//! `rename`, `codeAction` and `willRenameFiles`), read and answered apart from `server.rs` so that its
 //! dispatch grows by one arm. Strings (objects' names, files) are asked first
 //! (`strings.rs`), then the resolver's names (`references.rs`, `rename.rs`).
 
