@@ -231,78 +231,73 @@ impl Server {
         params: Value,
     ) -> (Result<Value, ResponseError>, Vec<Notification>) {
         let published = self.analyze_changed();
-        let result =
-            match method {
-                HoverRequest::METHOD => {
-                    let thumbnails = self.thumbnails.as_deref();
-                    self.at::<lsp_types::HoverParams>(params, |p| p.text_document_position_params)
-                        .map(|found| {
-                            found.and_then(|(document, _, offset)| {
-                                let mut hover = crate::hover::hover(document, offset)?;
-                                if let Some(picture) = thumbnails.and_then(|t| {
-                                    crate::names::material_picture(document, offset, t)
-                                }) {
-                                    if let lsp_types::HoverContents::Markup(markup) =
-                                        &mut hover.contents
-                                    {
-                                        markup.value.push_str(&format!(
-                                            "\n\n![the material on a ball]({picture})"
-                                        ));
-                                    }
-                                }
-                                Some(hover)
-                            })
-                        })
-                        .and_then(to_value)
-                }
-                Completion::METHOD => self
-                    .at::<lsp_types::CompletionParams>(params, |p| p.text_document_position)
+        let result = match method {
+            HoverRequest::METHOD => {
+                let thumbnails = self.thumbnails.as_deref();
+                self.at::<lsp_types::HoverParams>(params, |p| p.text_document_position_params)
                     .map(|found| {
-                        found.map(|(document, _, offset)| {
-                            CompletionResponse::Array(crate::completion::complete(document, offset))
+                        found.and_then(|(document, _, offset)| {
+                            let mut hover = crate::hover::hover(document, offset)?;
+                            if let Some(picture) = thumbnails
+                                .and_then(|t| crate::names::material_picture(document, offset, t))
+                            {
+                                if let lsp_types::HoverContents::Markup(markup) =
+                                    &mut hover.contents
+                                {
+                                    markup.value.push_str(&format!(
+                                        "\n\n![the material on a ball]({picture})"
+                                    ));
+                                }
+                            }
+                            Some(hover)
                         })
                     })
-                    .and_then(to_value),
-                GotoDefinition::METHOD => match parse::<lsp_types::GotoDefinitionParams>(params) {
-                    Some(p) => {
-                        let p = p.text_document_position_params;
-                        let files = self.files.as_mut();
-                        let found = self.documents.get_key_value(&p.text_document.uri).and_then(
-                            |(uri, document)| {
-                                let offset = document.lines.offset(&document.text, p.position);
-                                crate::navigation::definition(uri, document, offset).or_else(|| {
-                                    crate::strings::definition(uri, document, offset, files)
-                                })
-                            },
-                        );
-                        to_value(found.map(GotoDefinitionResponse::Scalar))
-                    }
+                    .and_then(to_value)
+            }
+            Completion::METHOD => self
+                .at::<lsp_types::CompletionParams>(params, |p| p.text_document_position)
+                .map(|found| {
+                    found.map(|(document, _, offset)| {
+                        CompletionResponse::Array(crate::completion::complete(document, offset))
+                    })
+                })
+                .and_then(to_value),
+            GotoDefinition::METHOD => self
+                .at::<lsp_types::GotoDefinitionParams>(params, |p| p.text_document_position_params)
+                .map(|found| {
+                    found.and_then(|(document, uri, offset)| {
+                        crate::navigation::definition(uri, document, offset)
+                            .or_else(|| crate::strings::definition(uri, document, offset))
+                            .map(GotoDefinitionResponse::Scalar)
+                    })
+                })
+                .and_then(to_value),
+            DocumentSymbolRequest::METHOD => {
+                match parse::<lsp_types::DocumentSymbolParams>(params) {
+                    Some(p) => to_value(
+                        self.documents
+                            .get(&p.text_document.uri)
+                            .map(|d| DocumentSymbolResponse::Nested(crate::navigation::symbols(d))),
+                    ),
                     None => Err(invalid_params()),
-                },
-                DocumentSymbolRequest::METHOD => {
-                    match parse::<lsp_types::DocumentSymbolParams>(params) {
-                        Some(p) => to_value(self.documents.get(&p.text_document.uri).map(|d| {
-                            DocumentSymbolResponse::Nested(crate::navigation::symbols(d))
-                        })),
-                        None => Err(invalid_params()),
-                    }
                 }
-                m if crate::server_nav::handles(m) => {
-                    crate::server_nav::request(m, params, &self.documents, self.files.as_mut())
-                }
-                Formatting::METHOD => match parse::<lsp_types::DocumentFormattingParams>(params) {
-                    Some(p) => to_value(self.documents.get(&p.text_document.uri).and_then(format)),
-                    None => Err(invalid_params()),
-                },
-                method if crate::view::METHODS.contains(&method) => {
-                    crate::view::answer(&self.documents, method, params)
-                }
-                _ => Err(ResponseError {
-                    code: ErrorCode::MethodNotFound as i32,
-                    message: format!("whitted lsp does not handle `{method}`"),
-                    data: None,
-                }),
-            };
+            }
+            m if crate::server_nav::handles(m) => {
+                crate::server_nav::request(m, params, &self.documents, self.files.as_mut())
+            }
+            Formatting::METHOD => match parse::<lsp_types::DocumentFormattingParams>(params) {
+                Some(p) => to_value(self.documents.get(&p.text_document.uri).and_then(format)),
+                None => Err(invalid_params()),
+            },
+            method if crate::view::METHODS.contains(&method) => {
+                crate::view::answer(&self.documents, method, params)
+            }
+            _ => Err(ResponseError {
+                code: ErrorCode::MethodNotFound as i32,
+                message: format!("whitted lsp does not handle `{method}`"),
+                data: None,
+            }),
+        };
         (result, published)
     }
 

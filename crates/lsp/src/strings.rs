@@ -143,16 +143,10 @@ fn first_named(uri: &Url, document: &Document, name: &str) -> Option<Location> {
 
 /// Go to definition on an object's name: the first object of that name (itself, when the
 /// name is its own).
-pub fn definition(
-    uri: &Url,
-    document: &Document,
-    offset: usize,
-    files: &mut dyn Files,
-) -> Option<Location> {
-    match named(document, offset, files)? {
-        Named::Object(name) => first_named(uri, document, &name),
-        Named::File { .. } => None,
-    }
+pub fn definition(uri: &Url, document: &Document, offset: usize) -> Option<Location> {
+    let index = document.analysis.as_ref()?.index.as_ref()?;
+    let (_, name) = index.object_names.iter().find(|(s, _)| covers(s, offset))?;
+    first_named(uri, document, name)
 }
 
 /// `textDocument/references` on an object's name or a file's string; `None` when the cursor
