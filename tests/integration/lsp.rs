@@ -1,7 +1,8 @@
 //! `whitted lsp` as an editor runs it: the real binary over stdio, one whole session with
 //! exact answers (diagnostics appearing at their range and going away, hover, completion in a
 //! material block, go to definition here and into an import, the outline, a quick fix,
-//! references and rename across an import), and exit status 0
+//! references and rename across an import, of an object's name and of an import's file,
+//! semantic tokens of a range), and exit status 0
 //! after `shutdown` and `exit`. The Content-Length framing is written here by hand: it is the
 //! protocol, not the server under test.
 
@@ -299,6 +300,47 @@ fn a_whole_session_over_stdio() {
         "renaming `glass` to `mirror` would clash with another definition: `mirror` is already defined here (defined a second time)"
     );
 
+    // The sphere's name (wide characters counted in UTF-16 units): its only object, and
+    // a rename between its quotes.
+    let mut params = at(&main, 4, 10);
+    params["context"] = json!({"includeDeclaration": true});
+    assert_eq!(
+        session.request("textDocument/references", params),
+        json!([{"uri": main, "range": range((4, 7), (4, 16))}])
+    );
+    assert_eq!(
+        session.request("textDocument/prepareRename", at(&main, 4, 10)),
+        json!({"range": range((4, 8), (4, 15)), "placeholder": "ballé😀"})
+    );
+    let mut params = at(&main, 4, 10);
+    params["newName"] = json!("ball");
+    assert_eq!(
+        session.request("textDocument/rename", params)["changes"],
+        json!({main.as_str(): [{"range": range((4, 8), (4, 15)), "newText": "ball"}]})
+    );
+    // The import's string: every string naming lib.scene (here one) and the file.
+    let mut params = at(&main, 0, 10);
+    params["context"] = json!({"includeDeclaration": true});
+    assert_eq!(
+        session.request("textDocument/references", params),
+        json!([{"uri": lib, "range": range((0, 0), (0, 0))},
+               {"uri": main, "range": range((0, 7), (0, 18))}])
+    );
+    // Moving lib.scene into a folder rewrites the import.
+    assert_eq!(
+        capabilities["workspace"]["fileOperations"]["willRename"]["filters"][0]["scheme"],
+        json!("file")
+    );
+    let moved = Url::from_file_path(dir.path().join("parts/lib.scene")).expect("a file URI");
+    let edit = session.request(
+        "workspace/willRenameFiles",
+        json!({"files": [{"oldUri": lib, "newUri": moved}]}),
+    );
+    assert_eq!(
+        edit["changes"],
+        json!({main.as_str(): [{"range": range((0, 8), (0, 17)), "newText": "parts/lib.scene"}]})
+    );
+
     let outline = session.request(
         "textDocument/documentSymbol",
         json!({"textDocument": {"uri": main}}),
@@ -345,6 +387,28 @@ fn a_whole_session_over_stdio() {
             .as_array()
             .expect("numbers")[..]
     );
+    // One line's tokens, by range: the same numbers, the first relative to the start.
+    assert_eq!(capabilities["semanticTokensProvider"]["range"], json!(true));
+    assert_eq!(
+        capabilities["semanticTokensProvider"]["full"],
+        json!({"delta": true})
+    );
+    // A delta from the tokens just sent, with nothing changed since: no edit.
+    let id = tokens["resultId"]
+        .as_str()
+        .expect("a result id")
+        .to_string();
+    let delta = session.request(
+        "textDocument/semanticTokens/full/delta",
+        json!({"textDocument": {"uri": view}, "previousResultId": id}),
+    );
+    assert_eq!(delta["edits"], json!([]));
+    assert_ne!(delta["resultId"], json!(id));
+    let tokens = session.request(
+        "textDocument/semanticTokens/range",
+        json!({"textDocument": {"uri": view}, "range": range((2, 0), (3, 0))}),
+    );
+    assert_eq!(tokens["data"], json!([2, 0, 8, 0, 0, 0, 9, 3, 3, 1]));
     let folds = session.request("textDocument/foldingRange", document.clone());
     assert_eq!(
         folds,

@@ -1,7 +1,8 @@
 //! What the server's answers cost on a big scene (issue 29): a generated scene of 100,000
 //! literal sphere statements (the bench's "scenes written by programs" form), then the time
 //! from a one-character `didChange` to its diagnostics, and the time of a hover, a
-//! completion and a definition near its end, and of the whole document's semantic tokens,
+//! completion and a definition near its end, of the semantic tokens of one screen (60
+//! lines) in its middle and at its end, and of the whole document's semantic tokens,
 //! folding ranges, colours and inlay hints. Prints the figures; measures, asserts nothing.
 //! `cargo xtask bench` runs it in a release build.
 #![allow(clippy::print_stdout)]
@@ -109,6 +110,22 @@ fn main() {
         );
         println!(
             "{what}: {:.1} ms (answered: {})",
+            ms(started),
+            result.is_ok_and(|v| !v.is_null())
+        );
+    }
+    // One screen: the semantic tokens of 60 lines in the middle and at the end.
+    let line_count = lines.position(&text, text.len()).line;
+    for (what, first) in [("middle", line_count / 2), ("end", line_count - 60)] {
+        let range = json!({"start": {"line": first, "character": 0},
+                           "end": {"line": first + 60, "character": 0}});
+        let started = Instant::now();
+        let (result, _) = server.request(
+            "textDocument/semanticTokens/range",
+            json!({"textDocument": {"uri": uri}, "range": range}),
+        );
+        println!(
+            "semantic tokens of 60 lines at the {what}: {:.1} ms (answered: {})",
             ms(started),
             result.is_ok_and(|v| !v.is_null())
         );

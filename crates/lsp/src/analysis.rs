@@ -193,6 +193,17 @@ fn summarize_imports(
     name: &str,
     by_file: &mut [(Url, Vec<LspDiagnostic>)],
 ) {
+    let errors_elsewhere = by_file.iter().any(|(file, diagnostics)| {
+        file != root
+            && diagnostics
+                .iter()
+                .any(|d| d.severity == Some(DiagnosticSeverity::ERROR))
+    });
+    if !errors_elsewhere {
+        // Reading the document's imports lexes all of it (a tenth of a big scene's
+        // keystroke-to-diagnostics): only when there is an error to point to.
+        return;
+    }
     let imports = whitted_lang::editor::cursor::imports(&document.text);
     let mut summaries = Vec::new();
     for (file, diagnostics) in by_file.iter().filter(|(file, _)| file != root) {

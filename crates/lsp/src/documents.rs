@@ -20,6 +20,9 @@ pub struct Document {
     /// The analysis of `text`; `None` until the text has been analysed since its last
     /// change.
     pub analysis: Option<Analysis>,
+    /// The last whole-document semantic tokens sent, with their result id, for
+    /// `semanticTokens/full/delta` (`tokens.rs`).
+    pub sent_tokens: std::cell::RefCell<Option<lsp_types::SemanticTokens>>,
 }
 
 impl Document {
@@ -31,6 +34,7 @@ impl Document {
             path: uri.to_file_path().ok(),
             identity: None,
             analysis: None,
+            sent_tokens: std::cell::RefCell::new(None),
         }
     }
 

@@ -3,21 +3,23 @@
 //! lines that hold only a `//` comment.
 
 use lsp_types::{FoldingRange, FoldingRangeKind, Position};
-use whitted_lang::editor::view::{brace_pairs, highlight, Class};
+use whitted_lang::editor::view::outline_parts;
 
 use crate::documents::Document;
 
 pub fn folding_ranges(document: &Document) -> Vec<FoldingRange> {
     let text = &document.text;
     let lines = &document.lines;
-    let line_of = |offset: usize| lines.position(text, offset).line;
+    let line_of = |offset: usize| lines.line(offset);
     // Whether only whitespace comes before `offset` on its line.
     let starts_line = |offset: usize| {
         let start = lines.offset(text, Position::new(line_of(offset), 0));
         text.get(start..offset).is_some_and(|s| s.trim().is_empty())
     };
     let mut out = Vec::new();
-    for (open, close) in brace_pairs(text) {
+    // One reading of the tokens gives the braces and the comments.
+    let parts = outline_parts(text);
+    for &(open, close) in &parts.braces {
         let start = line_of(open);
         let end = line_of(close).saturating_sub(u32::from(starts_line(close)));
         if end > start {
@@ -27,18 +29,15 @@ pub fn folding_ranges(document: &Document) -> Vec<FoldingRange> {
     // The run of line comments being read: its first and last lines.
     let mut run: Option<(u32, u32)> = None;
     let mut comments = Vec::new();
-    for token in highlight(text)
-        .into_iter()
-        .filter(|t| t.class == Class::Comment)
-    {
-        let (start, end) = (line_of(token.range.start), line_of(token.range.end));
-        if !text[token.range.clone()].starts_with("//") {
+    for comment in &parts.comments {
+        let (start, end) = (line_of(comment.start), line_of(comment.end));
+        if !text[comment.clone()].starts_with("//") {
             if end > start {
                 comments.push(range(start, end, Some(FoldingRangeKind::Comment)));
             }
             continue;
         }
-        if !starts_line(token.range.start) {
+        if !starts_line(comment.start) {
             continue;
         }
         run = match run {

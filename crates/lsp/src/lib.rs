@@ -1,6 +1,7 @@
 //! whitted-lsp: the language server behind `whitted lsp`: diagnostics from the compiler
 //! (the scene language, and 6.837 `.txt` scenes), hover and completion from the property
-//! table, go to definition, references, rename and the outline from the resolver, hover on
+//! table, go to definition, references, rename and the outline from the resolver (and for
+//! objects' names and files' strings, `strings.rs`), hover on
 //! names from what evaluation found, quick fixes from the diagnostics' suggestions, and the
 //! view features (semantic tokens, folding, colours, inlay hints: `view.rs`).
 //!
@@ -26,6 +27,7 @@ mod rename;
 mod run;
 mod server;
 mod server_nav;
+mod strings;
 mod tokens;
 mod view;
 

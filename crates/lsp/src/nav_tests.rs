@@ -1,6 +1,7 @@
 //! References, rename, quick fixes and hover on names, in-process with exact answers: across
-//! an import read from the disk, every refusal of rename, and every request at every place of
-//! a scene (and of one that does not parse) answering without failing.
+//! an import read from the disk, objects' names and files' strings, every refusal of rename,
+//! and every request at every place of a scene (and of one that does not parse) answering
+//! without failing.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -357,4 +358,186 @@ fn every_request_anywhere_answers() {
             );
         }
     }
+}
+
+const PARTS: &str = "sphere \"ball\" { radius 1 }\nmesh \"bunny\" { file \"../bunny.obj\" }\n";
+const SCENE: &str = "import \"parts/lib.scene\"\nsphere \"ball\" { center <0, 2, 0> }\nplane \"floor\" { }\nfor i in 0..2 { sphere \"ball {i}\" { } }\nmesh { file \"bunny.obj\" }\n";
+const OTHER: &str = "import \"parts/../parts/lib.scene\"\nsphere \"ball\" { }\n";
+
+fn references_at(
+    server: &mut Server,
+    name: &str,
+    text: &str,
+    word: &str,
+    nth: usize,
+    declaration: bool,
+) -> Vec<String> {
+    let mut params = at(name, text, word, nth, 1);
+    params["context"] = json!({"includeDeclaration": declaration});
+    places(&ask(server, "textDocument/references", params).expect("an answer"))
+}
+
+/// An object's name: the objects of that name in the scene (across its import), not the
+/// other scene's, and not a name with a hole.
+#[test]
+fn an_objects_name_finds_the_objects_of_that_name() {
+    let mut server = server_with(&[("parts/lib.scene", PARTS)], &[("main.scene", SCENE)]);
+    assert_eq!(
+        references_at(&mut server, "main.scene", SCENE, "\"ball\"", 0, true),
+        ["lib.scene:0:7-13", "main.scene:1:7-13"]
+    );
+    // The first in the compile is the definition, left out when the client asks so.
+    let definition = ask(
+        &mut server,
+        "textDocument/definition",
+        at("main.scene", SCENE, "\"ball\"", 0, 2),
+    )
+    .expect("an answer");
+    assert_eq!(places(&json!([definition])), ["main.scene:1:7-13"]);
+    assert_eq!(
+        references_at(&mut server, "main.scene", SCENE, "\"ball\"", 0, false),
+        ["lib.scene:0:7-13"]
+    );
+    assert_eq!(
+        references_at(&mut server, "main.scene", SCENE, "\"floor\"", 0, true),
+        ["main.scene:2:6-13"]
+    );
+    // With the other scene open, the import's ball is in both scenes, so it finds both
+    // scenes' balls; each scene's own ball finds its scene's only.
+    let mut server = server_with(
+        &[],
+        &[
+            ("main.scene", SCENE),
+            ("parts/lib.scene", PARTS),
+            ("other.scene", OTHER),
+        ],
+    );
+    assert_eq!(
+        references_at(&mut server, "parts/lib.scene", PARTS, "\"ball\"", 0, true),
+        [
+            "lib.scene:0:7-13",
+            "main.scene:1:7-13",
+            "other.scene:1:7-13"
+        ]
+    );
+    assert_eq!(
+        references_at(&mut server, "other.scene", OTHER, "\"ball\"", 0, true),
+        ["lib.scene:0:7-13", "other.scene:1:7-13"]
+    );
+}
+
+#[test]
+fn rename_of_an_objects_name_renames_its_objects() {
+    let mut server = server_with(&[("parts/lib.scene", PARTS)], &[("main.scene", SCENE)]);
+    let prepared = ask(
+        &mut server,
+        "textDocument/prepareRename",
+        at("main.scene", SCENE, "\"ball\"", 0, 3),
+    )
+    .expect("an answer");
+    assert_eq!(
+        prepared,
+        json!({"range": {"start": {"line": 1, "character": 8}, "end": {"line": 1, "character": 12}},
+               "placeholder": "ball"})
+    );
+    // A name with a hole is not plain text: nothing to rename.
+    let prepared = ask(
+        &mut server,
+        "textDocument/prepareRename",
+        at("main.scene", SCENE, "\"ball {", 0, 2),
+    )
+    .expect("an answer");
+    assert_eq!(prepared, Value::Null);
+    let mut params = at("main.scene", SCENE, "\"ball\"", 0, 1);
+    params["newName"] = json!("glass ball");
+    let edit = ask(&mut server, "textDocument/rename", params.clone()).expect("an edit");
+    assert_eq!(
+        edits(&edit),
+        [
+            "lib.scene:0:8-0:12=glass ball",
+            "main.scene:1:8-1:12=glass ball"
+        ]
+    );
+    params["newName"] = json!("floor");
+    assert_eq!(
+        ask(&mut server, "textDocument/rename", params.clone()).map_err(|e| e.message),
+        Err("renaming \"ball\" to \"floor\" would merge its objects with the ones already named so (main.scene line 3)".to_string())
+    );
+    params["newName"] = json!("a{b");
+    assert_eq!(
+        ask(&mut server, "textDocument/rename", params).map_err(|e| e.message),
+        Err(
+            "an object's new name is plain text: `{` would need an escape or make a `{name}` hole"
+                .to_string()
+        )
+    );
+}
+
+/// A file's strings: every `import` and mesh `file` naming it, however written, from every
+/// open scene; the file itself is the declaration.
+#[test]
+fn a_files_string_finds_every_string_naming_that_file() {
+    let mut server = server_with(
+        &[("parts/lib.scene", PARTS)],
+        &[("main.scene", SCENE), ("other.scene", OTHER)],
+    );
+    assert_eq!(
+        references_at(&mut server, "main.scene", SCENE, "\"bunny.obj\"", 0, true),
+        ["bunny.obj:0:0-0", "lib.scene:1:20-34", "main.scene:4:12-23"]
+    );
+    assert_eq!(
+        references_at(&mut server, "main.scene", SCENE, "\"parts", 0, false),
+        ["main.scene:0:7-24", "other.scene:0:7-33"]
+    );
+    let mut params = at("main.scene", SCENE, "\"parts", 0, 1);
+    params["newName"] = json!("x");
+    assert!(ask(&mut server, "textDocument/rename", params).is_err());
+}
+
+fn will_rename(server: &mut Server, old: &str, new: &str) -> Vec<String> {
+    let edit = ask(
+        server,
+        "workspace/willRenameFiles",
+        json!({"files": [{"oldUri": uri(old), "newUri": uri(new)}]}),
+    )
+    .expect("an answer");
+    if edit.is_null() {
+        return Vec::new();
+    }
+    edits(&edit)
+}
+
+/// Moving a file or a folder rewrites the strings that name it, relative to their own file;
+/// a string that moves with what it names is left alone.
+#[test]
+fn moving_a_file_rewrites_the_strings_naming_it() {
+    let mut server = server_with(
+        &[("parts/lib.scene", PARTS)],
+        &[("main.scene", SCENE), ("other.scene", OTHER)],
+    );
+    assert_eq!(
+        will_rename(&mut server, "parts/lib.scene", "lib/base.scene"),
+        [
+            "main.scene:0:8-0:23=lib/base.scene",
+            "other.scene:0:8-0:32=lib/base.scene"
+        ]
+    );
+    assert_eq!(
+        will_rename(&mut server, "bunny.obj", "meshes/bunny.obj"),
+        [
+            "lib.scene:1:21-1:33=../meshes/bunny.obj",
+            "main.scene:4:13-4:22=meshes/bunny.obj"
+        ]
+    );
+    assert_eq!(
+        will_rename(&mut server, "parts", "pieces"),
+        [
+            "main.scene:0:8-0:23=pieces/lib.scene",
+            "other.scene:0:8-0:32=pieces/lib.scene"
+        ]
+    );
+    assert_eq!(
+        will_rename(&mut server, "unused.scene", "x.scene"),
+        Vec::<String>::new()
+    );
 }

@@ -24,6 +24,12 @@ impl LineIndex {
 
     /// The position of byte `offset` (clamped to the text, and to the start of the
     /// character it falls inside).
+    /// The line (from 0) of a byte offset: [`Self::position`]'s line without counting the
+    /// column.
+    pub fn line(&self, offset: usize) -> u32 {
+        saturate(self.starts.partition_point(|&start| start <= offset).max(1) - 1)
+    }
+
     pub fn position(&self, text: &str, offset: usize) -> Position {
         let mut offset = offset.min(text.len());
         while !text.is_char_boundary(offset) {

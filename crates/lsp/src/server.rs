@@ -48,6 +48,23 @@ pub fn capabilities() -> ServerCapabilities {
             prepare_provider: Some(true),
             work_done_progress_options: Default::default(),
         })),
+        // Moving a file or folder rewrites the `import` and `file` strings naming it.
+        workspace: Some(lsp_types::WorkspaceServerCapabilities {
+            workspace_folders: None,
+            file_operations: Some(lsp_types::WorkspaceFileOperationsServerCapabilities {
+                will_rename: Some(lsp_types::FileOperationRegistrationOptions {
+                    filters: vec![lsp_types::FileOperationFilter {
+                        scheme: Some("file".to_string()),
+                        pattern: lsp_types::FileOperationPattern {
+                            glob: "**/*".to_string(),
+                            matches: None,
+                            options: None,
+                        },
+                    }],
+                }),
+                ..Default::default()
+            }),
+        }),
         code_action_provider: Some(lsp_types::CodeActionProviderCapability::Options(
             lsp_types::CodeActionOptions {
                 code_action_kinds: Some(vec![lsp_types::CodeActionKind::QUICKFIX]),
@@ -250,6 +267,7 @@ impl Server {
                 .map(|found| {
                     found.and_then(|(document, uri, offset)| {
                         crate::navigation::definition(uri, document, offset)
+                            .or_else(|| crate::strings::definition(uri, document, offset))
                             .map(GotoDefinitionResponse::Scalar)
                     })
                 })

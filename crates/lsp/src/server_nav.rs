@@ -1,12 +1,13 @@
 //! The requests of references, rename and quick fixes (`references`, `prepareRename`,
-//! `rename` and `codeAction`), read and answered apart from `server.rs` so that its
-//! dispatch grows by one arm.
+//! `rename`, `codeAction` and `willRenameFiles`), read and answered apart from `server.rs` so that its
+//! dispatch grows by one arm. Strings (objects' names, files) are asked first
+//! (`strings.rs`), then the resolver's names (`references.rs`, `rename.rs`).
 
 use std::collections::HashMap;
 
 use lsp_server::{ErrorCode, ResponseError};
 use lsp_types::request::{
-    CodeActionRequest, PrepareRenameRequest, References, Rename, Request as _,
+    CodeActionRequest, PrepareRenameRequest, References, Rename, Request as _, WillRenameFiles,
 };
 use lsp_types::{TextDocumentPositionParams, Url};
 use serde::de::DeserializeOwned;
@@ -21,6 +22,7 @@ pub fn handles(method: &str) -> bool {
         PrepareRenameRequest::METHOD,
         Rename::METHOD,
         CodeActionRequest::METHOD,
+        WillRenameFiles::METHOD,
     ]
     .contains(&method)
 }
@@ -36,6 +38,16 @@ pub fn request(
             let p: lsp_types::ReferenceParams = parse(params)?;
             let (uri, offset) = at(documents, &p.text_document_position);
             let found = offset.and_then(|offset| {
+                // An object's name or a file's string; else a name the resolver linked.
+                if let Some(found) = crate::strings::references(
+                    documents,
+                    files,
+                    &uri,
+                    offset,
+                    p.context.include_declaration,
+                ) {
+                    return Some(found);
+                }
                 crate::references::references(
                     documents,
                     &uri,
@@ -48,19 +60,27 @@ pub fn request(
         PrepareRenameRequest::METHOD => {
             let p: TextDocumentPositionParams = parse(params)?;
             let (uri, offset) = at(documents, &p);
-            to_value(offset.and_then(|offset| crate::rename::prepare(documents, &uri, offset)))
+            to_value(offset.and_then(|offset| {
+                crate::strings::prepare(documents, files, &uri, offset)
+                    .unwrap_or_else(|| crate::rename::prepare(documents, &uri, offset))
+            }))
         }
         Rename::METHOD => {
             let p: lsp_types::RenameParams = parse(params)?;
             let (uri, offset) = at(documents, &p.text_document_position);
             match offset {
-                Some(offset) => to_value(crate::rename::rename(
-                    documents,
-                    files,
-                    &uri,
-                    offset,
-                    &p.new_name,
-                )?),
+                Some(offset) => {
+                    match crate::strings::rename(documents, files, &uri, offset, &p.new_name) {
+                        Some(answer) => to_value(answer?),
+                        None => to_value(crate::rename::rename(
+                            documents,
+                            files,
+                            &uri,
+                            offset,
+                            &p.new_name,
+                        )?),
+                    }
+                }
                 None => to_value(None::<()>),
             }
         }
@@ -72,6 +92,10 @@ pub fn request(
                     .get(&uri)
                     .map(|d| crate::actions::code_actions(&uri, d, p.range)),
             )
+        }
+        WillRenameFiles::METHOD => {
+            let p: lsp_types::RenameFilesParams = parse(params)?;
+            to_value(crate::strings::will_rename(documents, files, &p.files))
         }
         _ => Err(ResponseError {
             code: ErrorCode::MethodNotFound as i32,

@@ -1,6 +1,7 @@
 //! The server in-process: completion in every kind of place (the cursor marked `|` in the
 //! text), hover on text that does not parse, diagnostics across an open import and for a
-//! 6.837 scene, and a fixed-seed run of random edits and requests that must never fail.
+//! 6.837 scene, and a fixed-seed run of random edits and requests that must never fail (and
+//! whose every semantic tokens range must be the whole document's tokens there).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -434,8 +435,10 @@ fn random_edits_and_requests_never_fail() {
         "import",
         "\"lib.scene\"",
         "#ff0000",
+        "\"ball\"",
+        "/*",
     ];
-    const START: &str = "import \"lib.scene\"\nsettings { shadows filtered }\nmaterial glass { ior 1.5 diffuse <1, 0, 0> }\nfn ring(n) { for i in 0..n { sphere { center <i, 0, 0> radius 0.5 material glass } } }\nring(3) { translate <0, 1, 0> }\n";
+    const START: &str = "import \"lib.scene\"\nsettings { shadows filtered }\nmaterial glass { ior 1.5 diffuse <1, 0, 0> }\nfn ring(n) {\n  for i in 0..n {\n    sphere { center <i, 0, 0> radius 0.5 material glass }\n  }\n}\n/* a\n b */\nring(3) { translate <0, 1, 0> }\nsphere \"ball\" { }\nmesh { file \"bunny.obj\" }\n";
     let mut disk = Memory::default();
     disk.0.insert(
         PathBuf::from("/project/lib.scene"),
@@ -446,6 +449,8 @@ fn random_edits_and_requests_never_fail() {
     let mut text = START.to_string();
     let mut rng = Rng(29);
     let mut answered: HashMap<&str, usize> = HashMap::new();
+    // The id and data of the last whole-document semantic tokens, for deltas.
+    let mut sent: Option<(String, Vec<Value>)> = None;
     for version in 2..600 {
         let lines = LineIndex::new(&text);
         let at = |rng: &mut Rng, text: &str| {
@@ -508,6 +513,8 @@ fn random_edits_and_requests_never_fail() {
                 "textDocument/definition",
                 "textDocument/documentSymbol",
                 "textDocument/semanticTokens/full",
+                "textDocument/semanticTokens/range",
+                "textDocument/semanticTokens/full/delta",
                 "textDocument/foldingRange",
                 "textDocument/documentColor",
                 "textDocument/colorPresentation",
@@ -516,6 +523,7 @@ fn random_edits_and_requests_never_fail() {
                 "textDocument/prepareRename",
                 "textDocument/codeAction",
                 "textDocument/rename",
+                "workspace/willRenameFiles",
             ];
             let method = methods[rng.below(methods.len())];
             let end = Position::new(position.line + rng.below(4) as u32, rng.below(80) as u32);
@@ -531,9 +539,65 @@ fn random_edits_and_requests_never_fail() {
                     params["context"] = json!({"includeDeclaration": rng.below(2) == 0});
                 }
                 "textDocument/codeAction" => params["context"] = json!({"diagnostics": []}),
+                "workspace/willRenameFiles" => {
+                    let (old, new) = [
+                        ("lib.scene", "l2.scene"),
+                        ("bunny.obj", "m/b.obj"),
+                        ("", "x"),
+                    ][rng.below(3)];
+                    params["files"] = json!([{"oldUri": uri(old), "newUri": uri(new)}]);
+                }
+                "textDocument/semanticTokens/full/delta" => {
+                    // The last id sent, or an old one, which gets the whole document's.
+                    let id = match &sent {
+                        Some((id, _)) if rng.below(4) != 0 => id.clone(),
+                        _ => "0".to_string(),
+                    };
+                    params["previousResultId"] = json!(id);
+                }
                 _ => {}
             }
-            let (result, _) = server.request(method, params);
+            let (result, _) = server.request(method, params.clone());
+            if method.starts_with("textDocument/semanticTokens/full") {
+                let answer = result.clone().expect("tokens");
+                let data: Vec<Value> = match answer.get("edits") {
+                    // A delta: its edits applied to the tokens last sent.
+                    Some(edits) => {
+                        let mut data = sent.clone().expect("tokens were sent").1;
+                        for edit in edits.as_array().expect("edits").iter().rev() {
+                            let start = edit["start"].as_u64().expect("start") as usize;
+                            let deleted = edit["deleteCount"].as_u64().expect("count") as usize;
+                            let inserted = edit["data"].as_array().cloned().unwrap_or_default();
+                            data.splice(start..start + deleted, inserted);
+                        }
+                        data
+                    }
+                    None => answer["data"].as_array().cloned().unwrap_or_default(),
+                };
+                let (whole, _) = server.request(
+                    "textDocument/semanticTokens/full",
+                    json!({"textDocument": {"uri": uri("a.scene")}}),
+                );
+                let whole = whole.expect("the whole document's");
+                assert_eq!(data, whole["data"].as_array().cloned().unwrap_or_default());
+                let id = whole["resultId"].as_str().unwrap_or_default().to_string();
+                sent = Some((id, data));
+            }
+            if method == "textDocument/semanticTokens/range" {
+                // A range's tokens are the pieces of the whole document's that overlap it.
+                let (whole, _) = server.request("textDocument/semanticTokens/full", params);
+                let clamp = |p: Position| lines.position(&text, lines.offset(&text, p));
+                let from = clamp(position);
+                let to = clamp(end).max(from);
+                let (from, to) = ((from.line, from.character), (to.line, to.character));
+                let expected: Vec<[u64; 5]> = absolute(&whole.expect("the whole document's"))
+                    .into_iter()
+                    .filter(|t| (t[0], t[1] + t[2]) > (from.0 as u64, from.1 as u64))
+                    .filter(|t| (t[0], t[1]) < (to.0 as u64, to.1 as u64))
+                    .collect();
+                let found = absolute(result.as_ref().expect("the range's"));
+                assert_eq!(found, expected, "{position:?}..{end:?} of {text:?}");
+            }
             if result
                 .as_ref()
                 .is_ok_and(|v| !v.is_null() && *v != json!([]))
@@ -550,7 +614,7 @@ fn random_edits_and_requests_never_fail() {
     }
     // Every kind of request was asked where it has an answer, some of the time (quick
     // fixes need a diagnostic that offers one, which random edits seldom make).
-    assert!(answered.len() >= 12, "{answered:?}");
+    assert!(answered.len() >= 15, "{answered:?}");
     // The server's text is the text the edits make.
     server.notify(
         "textDocument/didChange",
@@ -664,4 +728,20 @@ fn a_material_hover_shows_its_picture_from_the_runner() {
     assert!(at_definition.contains("(picture:0.7)"), "{at_definition}");
     let name = hover_at(&mut server, "n material");
     assert!(!name.contains("picture:"), "{name}");
+}
+
+/// Semantic tokens as (line, column, length, type, modifiers), absolute.
+fn absolute(tokens: &Value) -> Vec<[u64; 5]> {
+    let data: Vec<u64> = tokens["data"]
+        .as_array()
+        .map(|d| d.iter().filter_map(Value::as_u64).collect())
+        .unwrap_or_default();
+    let (mut line, mut column) = (0, 0);
+    data.chunks_exact(5)
+        .map(|t| {
+            line += t[0];
+            column = if t[0] == 0 { column + t[1] } else { t[1] };
+            [line, column, t[2], t[3], t[4]]
+        })
+        .collect()
 }

@@ -9,17 +9,19 @@ use std::collections::HashMap;
 use lsp_server::ResponseError;
 use lsp_types::request::{
     ColorPresentationRequest, DocumentColor, FoldingRangeRequest, InlayHintRequest, Request as _,
-    SemanticTokensFullRequest,
+    SemanticTokensFullDeltaRequest, SemanticTokensFullRequest, SemanticTokensRangeRequest,
 };
-use lsp_types::{SemanticTokensResult, Url};
+use lsp_types::{SemanticTokensRangeResult, SemanticTokensResult, Url};
 use serde_json::Value;
 
 use crate::documents::Document;
 use crate::server::{invalid_params, parse, to_value};
 
 /// The methods answered here.
-pub const METHODS: [&str; 5] = [
+pub const METHODS: [&str; 7] = [
     SemanticTokensFullRequest::METHOD,
+    SemanticTokensFullDeltaRequest::METHOD,
+    SemanticTokensRangeRequest::METHOD,
     FoldingRangeRequest::METHOD,
     DocumentColor::METHOD,
     ColorPresentationRequest::METHOD,
@@ -38,8 +40,26 @@ pub fn answer(
             to_value(
                 documents
                     .get(&p.text_document.uri)
-                    .map(|d| SemanticTokensResult::Tokens(crate::tokens::tokens(d))),
+                    .map(|d| SemanticTokensResult::Tokens(crate::tokens::tokens_sent(d))),
             )
+        }
+        SemanticTokensFullDeltaRequest::METHOD => {
+            let p =
+                parse::<lsp_types::SemanticTokensDeltaParams>(params).ok_or_else(invalid_params)?;
+            to_value(
+                documents
+                    .get(&p.text_document.uri)
+                    .map(|d| crate::tokens::tokens_delta(d, &p.previous_result_id)),
+            )
+        }
+        SemanticTokensRangeRequest::METHOD => {
+            let p =
+                parse::<lsp_types::SemanticTokensRangeParams>(params).ok_or_else(invalid_params)?;
+            to_value(documents.get(&p.text_document.uri).map(|d| {
+                let start = d.lines.offset(&d.text, p.range.start);
+                let end = d.lines.offset(&d.text, p.range.end).max(start);
+                SemanticTokensRangeResult::Tokens(crate::tokens::tokens_in(d, start..end))
+            }))
         }
         FoldingRangeRequest::METHOD => {
             let p = parse::<lsp_types::FoldingRangeParams>(params).ok_or_else(invalid_params)?;

@@ -1,11 +1,13 @@
 //! The editor's index, read off the resolved syntax tree of every file: the blocks that take
 //! properties with what is written in them, the resolver's links from names to definitions,
-//! and the outline.
+//! the outline, objects' names and the file strings of imports and meshes.
 
 use whitted_ir::Span;
 
 use super::{BlockFacts, BlockKind, Definition, DefinitionKind, Index, Shown, Symbol, SymbolKind};
-use crate::ast::{Block, Else, Expr, ExprKind, Item, ItemKind, MaterialBody, Program};
+use crate::ast::{
+    Block, Else, Expr, ExprKind, Item, ItemKind, MaterialBody, Program, StrLit, StrPart,
+};
 use crate::intern::Interner;
 use crate::resolve::{DefKind, Resolution};
 use crate::schema::Context;
@@ -16,6 +18,8 @@ pub(crate) fn build(program: &Program, interner: &Interner, resolution: &Resolut
         interner,
         blocks: Vec::new(),
         signatures: std::collections::HashMap::new(),
+        object_names: Vec::new(),
+        paths: Vec::new(),
     };
     let mut symbols = Vec::new();
     for file in &program.files {
@@ -44,6 +48,8 @@ pub(crate) fn build(program: &Program, interner: &Interner, resolution: &Resolut
         symbols,
         definitions,
         shown: walker.signatures,
+        object_names: walker.object_names,
+        paths: walker.paths,
     }
 }
 
@@ -53,6 +59,20 @@ struct Walker<'a> {
     blocks: Vec<BlockFacts>,
     /// Each function's signature, by its name's span.
     signatures: std::collections::HashMap<Span, Shown>,
+    object_names: Vec<(Span, String)>,
+    paths: Vec<(Span, String)>,
+}
+
+/// The text of a string literal that is plain text: no `{name}` holes and no escapes (each
+/// escape is two bytes of the literal for one of its value), so the name is exactly the
+/// bytes between its quotes and an editor can replace them.
+fn plain(literal: &StrLit) -> Option<&str> {
+    let holes = literal
+        .parts
+        .iter()
+        .any(|part| matches!(part, StrPart::Hole(_)));
+    let exact = (literal.span.end - literal.span.start) as usize == literal.value.len() + 2;
+    (!holes && exact && !literal.value.is_empty()).then_some(literal.value.as_str())
 }
 
 impl Walker<'_> {
@@ -97,7 +117,12 @@ impl Walker<'_> {
             children,
         };
         match &item.kind {
-            ItemKind::Import { .. } | ItemKind::Return(_) | ItemKind::Assign { .. } => {}
+            ItemKind::Import { path, .. } => {
+                if let Some(text) = plain(path) {
+                    self.paths.push((path.span, text.to_string()));
+                }
+            }
+            ItemKind::Return(_) | ItemKind::Assign { .. } => {}
             ItemKind::Const(binding) | ItemKind::Let(binding) => {
                 let kind = if matches!(item.kind, ItemKind::Const(_)) {
                     SymbolKind::Constant
@@ -206,6 +231,9 @@ impl Walker<'_> {
                 let mut text = self.interner.name(kind.sym).to_string();
                 if let Some(name) = name {
                     text.push_str(&format!(" \"{}\"", name.value));
+                    if let Some(plain) = plain(name) {
+                        self.object_names.push((name.span, plain.to_string()));
+                    }
                 }
                 symbols.push(symbol(SymbolKind::Object, text, kind.span, children));
             }
@@ -218,6 +246,17 @@ impl Walker<'_> {
                 }
             }
             ItemKind::Property(property) => {
+                if property.prop.is_some_and(|p| p.name() == "file") {
+                    if let [Expr {
+                        kind: ExprKind::Str(literal),
+                        ..
+                    }] = property.values.as_slice()
+                    {
+                        if let Some(text) = plain(literal) {
+                            self.paths.push((literal.span, text.to_string()));
+                        }
+                    }
+                }
                 for value in &property.values {
                     self.expr(value);
                 }

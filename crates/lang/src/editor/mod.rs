@@ -217,6 +217,16 @@ pub struct Index {
     /// (`fn ring(n, r)`), and from evaluation a binding's value, a loop's range, a
     /// material's properties (see [`Shown`]).
     pub shown: HashMap<Span, Shown>,
+    /// Each object's name written as plain text (`sphere "ball" { ... }`: no `{name}` holes,
+    /// no escapes), in the order the files' statements are written: the span of its string
+    /// literal (with the quotes) and the name. Nothing in the language refers to an object by
+    /// its name; the objects that share one are what explain's queries (`hit("ball")`) and
+    /// the debugger call by it.
+    pub object_names: Vec<(Span, String)>,
+    /// Each file a string names: an `import`'s path and a mesh's `file` written as a plain
+    /// string: the span of the literal (with the quotes) and the path as written (relative
+    /// to the file the literal is in, as the compiler reads it: see [`import_target`]).
+    pub paths: Vec<(Span, String)>,
 }
 
 /// A name's definition: where its name is written and what it defines.

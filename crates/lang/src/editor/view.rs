@@ -206,21 +206,41 @@ fn is_word_value(word: &str) -> bool {
 /// Every `{ ... }` of `text` (outside strings and comments) with its `}`: byte offsets of
 /// the two braces. A brace left open has none.
 pub fn brace_pairs(text: &str) -> Vec<(usize, usize)> {
+    outline_parts(text).braces
+}
+
+/// What folds in a text: its brace pairs ([`brace_pairs`]) and its comments, from one
+/// reading of its tokens.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct OutlineParts {
+    pub braces: Vec<(usize, usize)>,
+    /// Each comment's bytes, `//` and `/* */` alike, in text order.
+    pub comments: Vec<Range<usize>>,
+}
+
+/// [`OutlineParts`] of `text`, read by the tokenizer alone (no highlighting).
+pub fn outline_parts(text: &str) -> OutlineParts {
     let mut open = Vec::new();
-    let mut pairs = Vec::new();
+    let mut parts = OutlineParts::default();
     for token in lex(text) {
+        if token.is_comment() {
+            parts
+                .comments
+                .push(token.start as usize..token.end as usize);
+            continue;
+        }
         match (token.kind, text_of(text, &token)) {
             (TokenKind::Punct, "{") => open.push(token.start as usize),
             (TokenKind::Punct, "}") => {
                 if let Some(start) = open.pop() {
-                    pairs.push((start, token.start as usize));
+                    parts.braces.push((start, token.start as usize));
                 }
             }
             _ => {}
         }
     }
-    pairs.sort_unstable();
-    pairs
+    parts.braces.sort_unstable();
+    parts
 }
 
 /// A colour written as a literal for a colour-valued property: `<r, g, b>` or
