@@ -175,11 +175,19 @@ pub fn write_part(
     let bytes = encode_pixels(manifest.region.width, manifest.region.height, pixels);
     manifest.pixels_file = format!("{stem}.f32");
     manifest.checksum = checksum(&bytes);
+    // An old manifest goes first: a task killed from here on leaves its part missing,
+    // rather than an old manifest over new pixels (which would read as corrupt).
+    let manifest_file = manifest_path(parts, manifest.task, manifest.tasks);
+    match std::fs::remove_file(&manifest_file) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(format!("cannot replace {}: {e}", manifest_file.display())),
+    }
     write_atomically(&parts.join(&manifest.pixels_file), &bytes)?;
     drop(bytes);
     let mut json = serde_json::to_vec_pretty(&manifest).map_err(|e| e.to_string())?;
     json.push(b'\n');
-    write_atomically(&manifest_path(parts, manifest.task, manifest.tasks), &json)?;
+    write_atomically(&manifest_file, &json)?;
     Ok(manifest)
 }
 

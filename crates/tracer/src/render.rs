@@ -309,6 +309,8 @@ pub fn render_film(
     if filter.is_own_pixel() {
         return Some((film, image, stats));
     }
+    // The filtered image replaces the sample pass's: one image in memory at a time.
+    drop(image);
     let (image, stats) = filter_image(&film, whole, &filter, (options, whole), stats, observer)?;
     Some((film, image, stats))
 }

@@ -136,3 +136,34 @@ fn a_region_outside_the_image_is_empty() {
     assert_eq!((part.width, part.height, part.pixels.len()), (0, 4, 0));
     assert_eq!(stats.camera_rays, 0);
 }
+
+/// The task plan is the same on any thread count (every task works it out alone and all
+/// must agree), and its bands cover the image's rows once, in order.
+#[test]
+fn the_task_plan_is_the_same_on_any_thread_count() {
+    let mut builder = whitted_classic();
+    builder.settings().width = 40;
+    builder.settings().height = 30;
+    let scene = builder.build().expect("a valid test scene");
+    let prepared = PreparedScene::new(&scene);
+    let options = RenderOptions::from_settings(&scene.settings);
+    let plan_on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a pool")
+            .install(|| whitted_tracer::task_plan::plan_regions(&prepared, &options, 7))
+            .expect("7 tasks fit 30 rows")
+    };
+    let plan = plan_on(1);
+    assert_eq!(plan, plan_on(2));
+    assert_eq!(plan, plan_on(3));
+    assert_eq!(plan.len(), 7);
+    let mut next_row = 0;
+    for band in &plan {
+        assert_eq!((band.x, band.width, band.y), (0, 40, next_row));
+        assert!(band.height > 0);
+        next_row += band.height;
+    }
+    assert_eq!(next_row, 30);
+}
