@@ -250,13 +250,13 @@ pub struct RenderArgs {
     /// Render only task I of N, I counted from 0 (0/4, 1/4, 2/4, 3/4): a band of rows of
     /// about 1/N of the cost, written with its manifest into --parts (docs/farm.md).
     #[arg(long, value_name = "I/N", value_parser = crate::farm::task::parse_task,
-          conflicts_with_all = ["task_from_env", "output", "stats_image"])]
+          conflicts_with_all = ["task_from_env", "output", "stats_image", "stats"])]
     pub task: Option<crate::farm::task::TaskIndex>,
     /// Take the task from the job array's environment: SLURM_ARRAY_TASK_ID,
     /// AWS_BATCH_JOB_ARRAY_INDEX or JOB_COMPLETION_INDEX, the count from --tasks, the
     /// array's own count variable, or WHITTED_TASKS. Without this flag, a render inside an
     /// array job renders the whole image.
-    #[arg(long, conflicts_with_all = ["output", "stats_image"])]
+    #[arg(long, conflicts_with_all = ["output", "stats_image", "stats"])]
     pub task_from_env: bool,
     /// With --task-from-env: the number of tasks.
     #[arg(long, value_name = "N", requires = "task_from_env",

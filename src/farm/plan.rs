@@ -494,7 +494,8 @@ fn k8s_job(plan: &Plan, name: &str, args: &FarmPlanArgs, estimate: &Estimate) ->
             "completionMode": "Indexed",
             "completions": plan.tasks,
             "parallelism": parallelism,
-            "backoffLimitPerIndex": 2,
+            // Two retries a task on average; `backoffLimitPerIndex` would say it per task,
+            // but needs Kubernetes 1.29 or later.
             "backoffLimit": plan.tasks.saturating_mul(2),
             "template": {
                 "metadata": { "labels": { "app": "whitted-farm" } },
