@@ -50,6 +50,112 @@ pub enum Command {
     /// Run the language server on stdin and stdout, for editors (docs/editors.md):
     /// diagnostics, hover, completion, go to definition and the outline.
     Lsp,
+    /// Split a render into tasks for a laptop, Slurm or Kubernetes, follow them, and merge
+    /// their parts into the image a single render makes, byte for byte (docs/farm.md).
+    Farm(FarmArgs),
+}
+
+#[derive(Args)]
+pub struct FarmArgs {
+    #[command(subcommand)]
+    pub command: FarmCommand,
+}
+
+#[derive(Subcommand)]
+pub enum FarmCommand {
+    /// Plan a render as N tasks: write DIR/plan.json and the engine's job files (shell:
+    /// run.sh; slurm: task.sbatch, merge.sbatch, submit.sh; k8s: job.yaml).
+    Plan(FarmPlanArgs),
+    /// Run a shell plan here (DIR/run.sh): the tasks not yet done, then the merge.
+    Run(FarmDirArgs),
+    /// List each task as done, missing, stale (the scene or settings changed) or corrupt;
+    /// exit 1 unless every task is done.
+    Status(FarmDirArgs),
+    /// Assemble the parts into one image, byte-identical to `whitted render`'s; refuses
+    /// parts of another scene, settings or whitted, and missing or overlapping pixels.
+    Merge(FarmMergeArgs),
+}
+
+/// Where a farm's tasks run.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Engine {
+    /// run.sh on this machine, `--jobs` tasks at a time (xargs -P).
+    Shell,
+    /// A Slurm array job and a merge job that waits for it (sbatch).
+    Slurm,
+    /// A Kubernetes Indexed Job (batch/v1).
+    K8s,
+}
+
+impl Engine {
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Shell => "shell",
+            Engine::Slurm => "slurm",
+            Engine::K8s => "k8s",
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct FarmPlanArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub overrides: RenderOverrides,
+    /// How many tasks to split the render into (at most one per row of the image).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub tasks: u32,
+    /// Where the tasks run.
+    #[arg(long, value_enum, default_value_t = Engine::Shell)]
+    pub engine: Engine,
+    /// The farm folder: plan.json, the job files, parts/ and logs/ go here.
+    #[arg(short = 'o', long = "output", value_name = "DIR")]
+    pub dir: PathBuf,
+    /// The merged image (shell and slurm; default DIR/SCENE.png).
+    #[arg(long, value_name = "OUT", value_parser = parse_output)]
+    pub merged: Option<PathBuf>,
+    /// shell: tasks run at once (default: one per core).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub jobs: Option<u32>,
+    /// slurm, k8s: at most this many tasks at once (Slurm's `--array=0-N%C`, the Job's
+    /// parallelism).
+    #[arg(long, value_name = "C", value_parser = clap::value_parser!(u32).range(1..))]
+    pub max_concurrent: Option<u32>,
+    /// Worker threads per task (slurm: its --cpus-per-task; default 1 there, and one per
+    /// core elsewhere).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// k8s: the container image with `whitted` on its PATH.
+    #[arg(long, value_name = "IMAGE", default_value = "whitted:latest")]
+    pub container_image: String,
+    /// k8s: the PersistentVolumeClaim mounted at /farm, holding the scene and the parts.
+    #[arg(long, value_name = "NAME", default_value = "whitted-farm")]
+    pub pvc: String,
+    /// k8s: the scene's path inside the container (default /farm/ and its file name).
+    #[arg(long, value_name = "PATH")]
+    pub container_scene: Option<String>,
+}
+
+#[derive(Args)]
+pub struct FarmDirArgs {
+    /// The farm folder made by `whitted farm plan`.
+    pub dir: PathBuf,
+}
+
+#[derive(Args)]
+pub struct FarmMergeArgs {
+    /// The farm folder made by `whitted farm plan`.
+    pub dir: PathBuf,
+    /// The image to write; the extension picks the format, as for `whitted render`.
+    #[arg(short = 'o', long = "output", value_name = "OUT", value_parser = parse_output)]
+    pub output: PathBuf,
+    /// Render a sample of pixels again and compare them with the parts bit for bit.
+    #[arg(long)]
+    pub verify: bool,
+    /// With --verify: how many pixels (a fixed pseudo-random sample).
+    #[arg(long, value_name = "K", default_value_t = 64, requires = "verify")]
+    pub samples: u32,
 }
 
 #[derive(Args)]
@@ -141,6 +247,27 @@ pub struct RenderArgs {
     /// Skip the lints `whitted check` also prints (docs/explain.md, "Lints").
     #[arg(long)]
     pub no_lint: bool,
+    /// Render only task I of N, I counted from 0 (0/4, 1/4, 2/4, 3/4): a band of rows of
+    /// about 1/N of the cost, written with its manifest into --parts (docs/farm.md).
+    #[arg(long, value_name = "I/N", value_parser = crate::farm::task::parse_task,
+          conflicts_with_all = ["task_from_env", "output", "stats_image", "stats"])]
+    pub task: Option<crate::farm::task::TaskIndex>,
+    /// Take the task from the job array's environment: SLURM_ARRAY_TASK_ID,
+    /// AWS_BATCH_JOB_ARRAY_INDEX or JOB_COMPLETION_INDEX, the count from --tasks, the
+    /// array's own count variable, or WHITTED_TASKS. Without this flag, a render inside an
+    /// array job renders the whole image.
+    #[arg(long, conflicts_with_all = ["output", "stats_image", "stats"])]
+    pub task_from_env: bool,
+    /// With --task-from-env: the number of tasks.
+    #[arg(long, value_name = "N", requires = "task_from_env",
+          value_parser = clap::value_parser!(u32).range(1..))]
+    pub tasks: Option<u32>,
+    /// With --task: the folder the part and its manifest go to.
+    #[arg(long, value_name = "DIR", default_value = "parts")]
+    pub parts: PathBuf,
+    /// With --task: render even when a complete, fresh part is already there.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// The scene settings that `render` and `trace` may override, so that a trace can follow a

@@ -13,6 +13,7 @@ mod debug_cmd;
 mod diff_cmd;
 mod explain_cmd;
 mod failure;
+mod farm;
 mod fmt_cmd;
 mod front_end;
 mod grade_class;
@@ -81,6 +82,7 @@ fn main() -> ExitCode {
         Command::Fmt(args) => fmt_cmd::fmt(&args),
         Command::Mit6837(args) => mit6837_cmd::mit6837(&args.args),
         Command::Lsp => lsp_cmd::lsp(),
+        Command::Farm(args) => farm::farm(&args),
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -197,6 +197,9 @@ fn canonical_location(path: &Path) -> Option<PathBuf> {
 }
 
 pub fn render(args: &RenderArgs) -> Result<(), Failure> {
+    if args.task.is_some() || args.task_from_env {
+        return crate::farm::task::render_task(args);
+    }
     let started = Instant::now();
     let output = args
         .output

@@ -12,6 +12,7 @@ mod diff_student;
 mod exit_codes;
 mod explain;
 mod extremes;
+mod farm;
 mod farm_slurm;
 mod fmt;
 mod front_end_oracles;

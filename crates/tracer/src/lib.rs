@@ -26,6 +26,7 @@ mod sampling;
 mod scene;
 mod shapes;
 mod solve;
+pub mod task_plan;
 pub mod testing;
 mod torus;
 mod trace;
@@ -42,9 +43,9 @@ pub use recorder::{
     TerminationSet,
 };
 pub use render::{
-    render, render_film, render_from, render_with_pixel_stats, trace_pixel_preferring,
-    trace_pixel_with, Image, NoObserver, PixelAccumulator, RenderObserver, RenderOptions,
-    RenderStats, TileResult, TILE_SIZE,
+    render, render_film, render_from, render_region, render_with_pixel_stats,
+    trace_pixel_preferring, trace_pixel_with, Image, NoObserver, PixelAccumulator, PixelRect,
+    RenderObserver, RenderOptions, RenderStats, TileResult, TILE_SIZE,
 };
 pub use scene::PreparedScene;
 pub use whitted_bvh::{force_traversal_path, PathUnavailable, TraversalPath};

@@ -31,6 +31,79 @@ use whitted_bvh::PACKET;
 /// Side of the square tiles that workers take one at a time.
 pub const TILE_SIZE: u32 = 16;
 
+/// A rectangle of pixels: columns `x..x + width`, rows `y..y + height`, counted from the
+/// image's top-left corner.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct PixelRect {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl PixelRect {
+    /// The whole `width` x `height` image.
+    pub fn whole(width: u32, height: u32) -> Self {
+        PixelRect {
+            x: 0,
+            y: 0,
+            width,
+            height,
+        }
+    }
+
+    /// Rows `rows` of a `width`-wide image.
+    pub fn rows(width: u32, rows: std::ops::Range<u32>) -> Self {
+        PixelRect {
+            x: 0,
+            y: rows.start,
+            width,
+            height: rows.end.saturating_sub(rows.start),
+        }
+    }
+
+    pub fn pixel_count(&self) -> u64 {
+        u64::from(self.width) * u64::from(self.height)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.width == 0 || self.height == 0
+    }
+
+    /// The part of this rectangle inside a `width` x `height` image (empty if none).
+    pub fn clipped(&self, width: u32, height: u32) -> Self {
+        let x = self.x.min(width);
+        let y = self.y.min(height);
+        PixelRect {
+            x,
+            y,
+            width: self.x.saturating_add(self.width).min(width) - x,
+            height: self.y.saturating_add(self.height).min(height) - y,
+        }
+    }
+
+    /// This rectangle grown by `margin` pixels on every side, then clipped to the image.
+    pub fn grown(&self, margin: u32, width: u32, height: u32) -> Self {
+        let x = self.x.saturating_sub(margin);
+        let y = self.y.saturating_sub(margin);
+        PixelRect {
+            x,
+            y,
+            width: self.x.saturating_add(self.width).saturating_add(margin) - x,
+            height: self.y.saturating_add(self.height).saturating_add(margin) - y,
+        }
+        .clipped(width, height)
+    }
+
+    /// Whether pixel `(x, y)` lies inside.
+    pub fn contains(&self, x: u32, y: u32) -> bool {
+        x >= self.x
+            && y >= self.y
+            && u64::from(x) < u64::from(self.x) + u64::from(self.width)
+            && u64::from(y) < u64::from(self.y) + u64::from(self.height)
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderOptions {
     pub width: u32,
@@ -229,14 +302,33 @@ pub fn render_film(
     observer: &dyn RenderObserver,
 ) -> Option<(Film, Image, RenderStats)> {
     let filter = PixelFilter::from_settings(scene.settings());
+    let whole = PixelRect::whole(options.width, options.height);
     let (image, stats, _, film) =
-        render_recorded::<NoRecord>(scene, &scene.camera, options, observer, true)?;
+        render_recorded::<NoRecord>(scene, &scene.camera, options, observer, true, whole)?;
     let film = film?;
     if filter.is_own_pixel() {
         return Some((film, image, stats));
     }
-    let (image, stats) = filter_image(&film, &filter, image, stats, observer)?;
+    // The filtered image replaces the sample pass's: one image in memory at a time.
+    drop(image);
+    let (image, stats) = filter_image(&film, whole, &filter, (options, whole), stats, observer)?;
     Some((film, image, stats))
+}
+
+/// [`render`] of only the pixels of `region` (clipped to the image): an image of the
+/// region's size whose pixels are those of the whole render at the same places, bit for
+/// bit, whatever the filter. A filter that reaches past the pixel takes samples from a
+/// margin of [`PixelFilter::reach`] pixels around the region (inside the image), as the whole
+/// render does. Tiles shown to the observer are placed in the whole image's coordinates.
+pub fn render_region(
+    scene: &PreparedScene,
+    options: &RenderOptions,
+    region: PixelRect,
+    observer: &dyn RenderObserver,
+) -> Option<(Image, RenderStats)> {
+    let region = region.clipped(options.width, options.height);
+    render_region_filtered::<NoRecord>(scene, &scene.camera, options, observer, region)
+        .map(|(image, stats, _)| (image, stats))
 }
 
 /// The render, then, for a filter that reaches past the pixel, the filtering pass over the
@@ -247,48 +339,82 @@ fn render_filtered<R: Recorder + Default + Send>(
     options: &RenderOptions,
     observer: &dyn RenderObserver,
 ) -> Option<(Image, RenderStats, Vec<R>)> {
-    let filter = PixelFilter::from_settings(scene.settings());
-    let keep = !filter.is_own_pixel();
-    let (image, stats, recorders, film) =
-        render_recorded::<R>(scene, camera, options, observer, keep)?;
-    match film {
-        Some(film) => {
-            let (image, stats) = filter_image(&film, &filter, image, stats, observer)?;
-            Some((image, stats, recorders))
-        }
-        None => Some((image, stats, recorders)),
-    }
+    let whole = PixelRect::whole(options.width, options.height);
+    render_region_filtered(scene, camera, options, observer, whole)
 }
 
-/// The filtering pass: every pixel of `image` made again from `film` by `filter`, rows in
-/// parallel (each pixel a pure function of the film, so the thread count changes nothing),
-/// then shown to the observer whole. The render's time includes it.
+/// [`render_filtered`] of the pixels of `region` (inside the image): the whole render is
+/// the region of the whole image. With a filter that reaches past the pixel, the sample
+/// pass covers the region and a margin of the filter's reach (the recorders are then
+/// those of the margin's pixels too, so only the whole image asks for them).
+fn render_region_filtered<R: Recorder + Default + Send>(
+    scene: &PreparedScene,
+    camera: &PreparedCamera,
+    options: &RenderOptions,
+    observer: &dyn RenderObserver,
+    region: PixelRect,
+) -> Option<(Image, RenderStats, Vec<R>)> {
+    let filter = PixelFilter::from_settings(scene.settings());
+    if filter.is_own_pixel() {
+        let (image, stats, recorders, _) =
+            render_recorded::<R>(scene, camera, options, observer, false, region)?;
+        return Some((image, stats, recorders));
+    }
+    let sampled = region.grown(filter.reach(), options.width, options.height);
+    let (_, stats, recorders, film) =
+        render_recorded::<R>(scene, camera, options, observer, true, sampled)?;
+    let film = film?;
+    let (image, stats) = filter_image(&film, sampled, &filter, (options, region), stats, observer)?;
+    Some((image, stats, recorders))
+}
+
+/// The filtering pass: every pixel of `region` made from `film` (the samples of the pixels
+/// of `sampled`, which holds the region and the filter's reach around it inside the
+/// image) by `filter`, rows in parallel (each pixel a pure function of the film, so the
+/// thread count changes nothing), then shown to the observer whole. The render's time
+/// includes it.
 fn filter_image(
     film: &Film,
+    sampled: PixelRect,
     filter: &PixelFilter,
-    mut image: Image,
+    (options, region): (&RenderOptions, PixelRect),
     mut stats: RenderStats,
     observer: &dyn RenderObserver,
 ) -> Option<(Image, RenderStats)> {
     let started = Instant::now();
+    let mut image = Image {
+        width: region.width,
+        height: region.height,
+        pixels: vec![[0.0f32; 3]; region.pixel_count() as usize],
+    };
     let width = image.width as usize;
     image
         .pixels
         .par_chunks_mut(width.max(1))
         .enumerate()
-        .try_for_each(|(y, row)| {
+        .try_for_each(|(row_index, row)| {
             if observer.should_stop() {
                 return None;
             }
-            for (x, pixel) in row.iter_mut().enumerate() {
-                *pixel = film.filter_pixel(filter, x as u32, y as u32);
+            let y = region.y + row_index as u32;
+            for (column, pixel) in row.iter_mut().enumerate() {
+                let x = region.x + column as u32;
+                // The film's pixel (0, 0) is the image's (sampled.x, sampled.y); the
+                // filter sees whole-image coordinates and sizes, so its neighbourhood is
+                // clipped at the image's borders, never the region's.
+                *pixel = filter.filter_pixel(
+                    (x, y),
+                    (options.width, options.height),
+                    (film.samples_per_pixel, film.sampling),
+                    |nx, ny, k| film.color(nx - sampled.x, ny - sampled.y, k),
+                );
             }
             Some(())
         })?;
     stats.render_seconds += started.elapsed().as_secs_f64();
     let tile = TileResult {
-        x: 0,
-        y: 0,
+        x: region.x,
+        y: region.y,
         width: image.width,
         height: image.height,
         pixels: std::mem::take(&mut image.pixels),
@@ -403,8 +529,11 @@ struct Band<'i, R> {
     samples: &'i mut [[f32; 3]],
 }
 
-/// The sample pass: every pixel the mean of its own samples, and, when `keep_samples`, the
-/// film of every sample.
+/// The sample pass over the pixels of `region` (inside the image): every pixel the mean of
+/// its own samples, and, when `keep_samples`, the film of every sample. The image, the
+/// recorders and the film are the region's size (the film's pixel (0, 0) is the region's
+/// corner); tiles are laid from the region's corner, which changes no pixel (tiles only
+/// decide who computes a pixel).
 #[allow(clippy::type_complexity)]
 fn render_recorded<R: Recorder + Default + Send>(
     scene: &PreparedScene,
@@ -412,9 +541,10 @@ fn render_recorded<R: Recorder + Default + Send>(
     options: &RenderOptions,
     observer: &dyn RenderObserver,
     keep_samples: bool,
+    region: PixelRect,
 ) -> Option<(Image, RenderStats, Vec<R>, Option<Film>)> {
     let started = Instant::now();
-    let (width, height) = (options.width, options.height);
+    let (width, height) = (region.width, region.height);
     let tiles_x = width.div_ceil(TILE_SIZE);
     let tiles_y = height.div_ceil(TILE_SIZE);
     let tile_count = tiles_x as usize * tiles_y as usize;
@@ -459,7 +589,16 @@ fn render_recorded<R: Recorder + Default + Send>(
                 let band = bands.get((y0 / TILE_SIZE) as usize)?;
                 let view = (camera, scene.settings().sampling);
                 let keep = keep_samples;
-                render_tile::<R>(worker, view, options, observer, band, (x0, y0), keep)
+                let corner = (region.x + x0, region.y + y0);
+                render_tile::<R>(
+                    worker,
+                    view,
+                    (options, region),
+                    observer,
+                    band,
+                    corner,
+                    keep,
+                )
             },
         )
         .try_reduce(RayCounters::default, |mut a, b| {
@@ -494,19 +633,20 @@ fn render_recorded<R: Recorder + Default + Send>(
     Some((image, stats, recorders, film))
 }
 
-/// Renders the tile at `(x0, y0)`, shows it to the observer, and copies it into its band
-/// of the image. Returns the tile's ray counts, or `None` when the observer cancels.
+/// Renders the tile at `(x0, y0)` (image coordinates), shows it to the observer, and copies
+/// it into its band of the region's image. Returns the tile's ray counts, or `None` when
+/// the observer cancels.
 fn render_tile<R: Recorder + Default>(
     worker: &mut Worker<'_, R>,
     (camera, sampling): (&PreparedCamera, Sampling),
-    options: &RenderOptions,
+    (options, region): (&RenderOptions, PixelRect),
     observer: &dyn RenderObserver,
     band: &Mutex<Band<'_, R>>,
     (x0, y0): (u32, u32),
     keep_samples: bool,
 ) -> Option<RayCounters> {
-    let width = TILE_SIZE.min(options.width - x0);
-    let height = TILE_SIZE.min(options.height - y0);
+    let width = TILE_SIZE.min(region.x + region.width - x0);
+    let height = TILE_SIZE.min(region.y + region.height - y0);
     let samples = options.samples();
     let tracer = &mut worker.tracer;
     let mut pixels = std::mem::take(&mut worker.pixels);
@@ -575,11 +715,11 @@ fn render_tile<R: Recorder + Default>(
         // way that matters: the render is lost either way, so a poisoned lock is used as is.
         let mut band = band.lock().unwrap_or_else(PoisonError::into_inner);
         let band = &mut *band;
-        let row_len = options.width as usize;
+        let row_len = region.width as usize;
         let tile_width = width as usize;
         let mut recorders = worker.recorders.drain(..);
         for (row, tile_row) in tile.pixels.chunks(tile_width.max(1)).enumerate() {
-            let start = row * row_len + x0 as usize;
+            let start = row * row_len + (x0 - region.x) as usize;
             let end = start + tile_row.len();
             if let Some(target) = band.pixels.get_mut(start..end) {
                 target.copy_from_slice(tile_row);
