@@ -11,6 +11,8 @@ use std::time::{Duration, Instant};
 /// [`SlurmCluster::command`], which sets `SLURM_CONF`.
 pub struct SlurmCluster {
     dir: tempfile::TempDir,
+    /// The one node's name: this machine's short host name.
+    node: String,
 }
 
 /// Why a cluster could not be started here (the test then says so and runs the shell engine).
@@ -82,7 +84,10 @@ impl SlurmCluster {
             .prefix("whitted-slurm-")
             .tempdir()
             .expect("a temporary folder");
-        let cluster = SlurmCluster { dir };
+        let cluster = SlurmCluster {
+            dir,
+            node: short_hostname(),
+        };
         cluster.start_munge();
         cluster.write_config();
         let conf = cluster.conf();
@@ -137,7 +142,7 @@ impl SlurmCluster {
     /// documented single-node setup: `proctrack/linuxproc`, `task/none`).
     fn write_config(&self) {
         let dir = self.path().display();
-        let host = short_hostname();
+        let host = &self.node;
         let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
         let config = format!(
             "ClusterName=whittedtest
@@ -216,6 +221,23 @@ PartitionName=debug Nodes={host} Default=YES MaxTime=INFINITE State=UP
         }
     }
 
+    /// Stops the node taking new jobs (jobs submitted meanwhile stay pending), or lets it
+    /// take them again.
+    pub fn hold_node(&self, hold: bool) {
+        let node = format!("nodename={}", self.node);
+        let args: &[&str] = if hold {
+            &["update", &node, "state=drain", "reason=test"]
+        } else {
+            &["update", &node, "state=resume"]
+        };
+        let output = self.run("scontrol", args);
+        assert!(
+            output.status.success(),
+            "scontrol {args:?}: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+
     /// The daemons' logs, for a failing assertion's message.
     pub fn logs(&self) -> String {
         ["slurmctld.log", "slurmd.log", "munge/munged.log"]
@@ -245,6 +267,11 @@ PartitionName=debug Nodes={host} Default=YES MaxTime=INFINITE State=UP
         let started = Instant::now();
         loop {
             let output = self.run("squeue", &["-h", "-o", "%i", "-j", job]);
+            assert!(
+                output.status.success(),
+                "squeue -j {job}: {}",
+                String::from_utf8_lossy(&output.stderr)
+            );
             if String::from_utf8_lossy(&output.stdout).trim().is_empty() {
                 return;
             }
