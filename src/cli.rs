@@ -250,23 +250,24 @@ pub struct RenderArgs {
     /// Render only task I of N, I counted from 0 (0/4, 1/4, 2/4, 3/4): a band of rows of
     /// about 1/N of the cost, written with its manifest into --parts (docs/farm.md).
     #[arg(long, value_name = "I/N", value_parser = crate::farm::task::parse_task,
-          conflicts_with_all = ["task_from_env", "output", "stats_image", "stats"])]
+          conflicts_with_all = ["task_from_env", "output", "stats_image", "stats"],
+          group = "one_task")]
     pub task: Option<crate::farm::task::TaskIndex>,
     /// Take the task from the job array's environment: SLURM_ARRAY_TASK_ID,
     /// AWS_BATCH_JOB_ARRAY_INDEX or JOB_COMPLETION_INDEX, the count from --tasks, the
     /// array's own count variable, or WHITTED_TASKS. Without this flag, a render inside an
     /// array job renders the whole image.
-    #[arg(long, conflicts_with_all = ["output", "stats_image", "stats"])]
+    #[arg(long, conflicts_with_all = ["output", "stats_image", "stats"], group = "one_task")]
     pub task_from_env: bool,
     /// With --task-from-env: the number of tasks.
     #[arg(long, value_name = "N", requires = "task_from_env",
           value_parser = clap::value_parser!(u32).range(1..))]
     pub tasks: Option<u32>,
     /// With --task: the folder the part and its manifest go to.
-    #[arg(long, value_name = "DIR", default_value = "parts")]
+    #[arg(long, value_name = "DIR", default_value = "parts", requires = "one_task")]
     pub parts: PathBuf,
     /// With --task: render even when a complete, fresh part is already there.
-    #[arg(long)]
+    #[arg(long, requires = "one_task")]
     pub force: bool,
 }
 
