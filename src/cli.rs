@@ -190,6 +190,10 @@ pub struct SceneArgs {
     /// scene's own).
     #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_setting)]
     pub set: Vec<(String, String)>,
+    /// Compile this frame of an animation: the scene's `frame` is N and `clock` its place
+    /// in the scene's frame range (docs/language.md, "Animation"). Default: the first frame.
+    #[arg(long, value_name = "N")]
+    pub frame: Option<u32>,
 }
 
 #[derive(Args)]
@@ -227,8 +231,15 @@ pub struct RenderArgs {
     pub scene: SceneArgs,
     /// Output image; the extension picks the format: .png (8-bit sRGB), .exr and .hdr
     /// (linear float), .ppm and .tga (8-bit sRGB). Default: the scene's name with .png, here.
-    #[arg(short = 'o', long = "output", value_name = "OUT", value_parser = parse_output)]
+    /// An animation writes one image per frame through a pattern (`out/frame-{frame:04}.png`;
+    /// an existing folder: NAME-{frame:04}.png in it), or one animated .apng or .gif, or a
+    /// video (.mp4, .webm; needs ffmpeg).
+    #[arg(short = 'o', long = "output", value_name = "OUT", value_parser = parse_render_output)]
     pub output: Option<PathBuf>,
+    /// Render these frames of an animation, A..=B (or A..B, B excluded; or one frame N),
+    /// rather than the scene's whole range; `clock` stays that of the scene's range.
+    #[arg(long, value_name = "A..=B", value_parser = parse_frames, conflicts_with = "frame")]
+    pub frames: Option<std::ops::RangeInclusive<u32>>,
     #[command(flatten)]
     pub overrides: RenderOverrides,
     /// Worker threads (default: one per core). The image is identical for any count.
@@ -524,6 +535,61 @@ impl ImageFormat {
     }
 }
 
+/// `render -o`: an image, an animation's container (.apng, .gif, .mp4, .webm), a pattern
+/// with `{frame}` (its extension an image's), or an existing folder.
+fn parse_render_output(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    if path.is_dir() || crate::animation::AnimationFormat::from_path(&path).is_some() {
+        return Ok(path);
+    }
+    match ImageFormat::from_path(&path) {
+        Some(_) => Ok(path),
+        None => Err(format!(
+            "cannot tell the image format of `{text}`: use a .png, .exr, .hdr, .ppm or .tga \
+             extension, .apng, .gif, .mp4 or .webm for an animation, or an existing folder"
+        )),
+    }
+}
+
+/// `--frames A..=B`, `A..B` or `N`: a range of frame numbers, not empty.
+pub fn parse_frames(text: &str) -> Result<std::ops::RangeInclusive<u32>, String> {
+    let usage = || {
+        format!(
+            "`{text}` is not a frame range: write A..=B (both included), A..B (B excluded) or \
+             one frame N, with whole numbers from 0 to {}",
+            u32::MAX
+        )
+    };
+    let number = |t: &str| t.trim().parse::<u32>().map_err(|_| usage());
+    let (first, last) = if let Some((a, b)) = text.split_once("..=") {
+        (number(a)?, number(b)?)
+    } else if let Some((a, b)) = text.split_once("..") {
+        let (a, b) = (number(a)?, number(b)?);
+        if b <= a {
+            return Err(format!(
+                "--frames {text} is empty: the last frame {b} is excluded and not after the first {a}"
+            ));
+        }
+        (a, b - 1)
+    } else {
+        let n = number(text)?;
+        (n, n)
+    };
+    if last < first {
+        return Err(format!(
+            "--frames {text} runs backwards: the first frame ({first}) must not be after the last ({last})"
+        ));
+    }
+    let count = u64::from(last - first) + 1;
+    if count > u64::from(limits::MAX_FRAMES) {
+        return Err(format!(
+            "--frames {text} has {count} frames, more than the frames limit ({})",
+            limits::MAX_FRAMES
+        ));
+    }
+    Ok(first..=last)
+}
+
 fn parse_output(text: &str) -> Result<PathBuf, String> {
     let path = PathBuf::from(text);
     match ImageFormat::from_path(&path) {
@@ -548,6 +614,22 @@ mod tests {
         assert!(parse_define("N").is_err());
         assert!(parse_define("1N=3").is_err());
         assert!(parse_define("N=").is_err());
+    }
+
+    #[test]
+    fn frame_ranges_are_read_by_hand() {
+        assert_eq!(parse_frames("2..=4"), Ok(2..=4));
+        assert_eq!(parse_frames("2..5"), Ok(2..=4));
+        assert_eq!(parse_frames("7"), Ok(7..=7));
+        assert_eq!(parse_frames(" 0 ..= 0 "), Ok(0..=0));
+        let backwards = parse_frames("5..=2").unwrap_err();
+        assert!(backwards.contains("runs backwards"), "{backwards}");
+        assert!(parse_frames("3..3").unwrap_err().contains("is empty"));
+        assert!(parse_frames("0..=4294967296").is_err());
+        assert!(parse_frames("-1..=3").is_err());
+        assert!(parse_frames("a..=b").is_err());
+        let too_many = parse_frames("0..=100000").unwrap_err();
+        assert!(too_many.contains("frames limit (100000)"), "{too_many}");
     }
 
     #[test]

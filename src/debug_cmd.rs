@@ -32,7 +32,8 @@ pub fn debug(args: &DebugArgs) -> Result<(), Failure> {
     let scene_args = args.scene.clone();
     let overrides = args.overrides.clone();
     let course = CourseOptions::default();
-    let recompile: Recompile = Box::new(move || compile(&scene_args, &overrides, &course));
+    let recompile: Recompile =
+        Box::new(move |frame| compile(&scene_args, frame, &overrides, &course));
     run_debugger(
         &args.scene,
         loaded,
@@ -51,7 +52,8 @@ pub fn debug_course(
 ) -> Result<(), Failure> {
     let (scene_args, course) = (scene.clone(), course.clone());
     let overrides = RenderOverrides::default();
-    let recompile: Recompile = Box::new(move || compile(&scene_args, &overrides, &course));
+    let recompile: Recompile =
+        Box::new(move |frame| compile(&scene_args, frame, &overrides, &course));
     run_debugger(scene, loaded, recompile, None)
 }
 
@@ -77,6 +79,7 @@ fn run_debugger(
         scene: loaded.scene,
         watch,
         recompile,
+        frame: scene.frame,
         pixel,
         export_dir: export_dir(&scene.scene),
     };
@@ -98,9 +101,19 @@ fn export_dir(scene: &Path) -> PathBuf {
 }
 
 /// Compiles the scene again (with the front end its content calls for, and the same `-D`,
-/// `--set` and course switches as the first compile), silently: the debugger shows the
-/// diagnostics itself.
-fn compile(args: &SceneArgs, overrides: &RenderOverrides, course: &CourseOptions) -> Compiled {
+/// `--set` and course switches as the first compile) at `frame` (`None`: the command
+/// line's `--frame`), silently: the debugger shows the diagnostics itself.
+fn compile(
+    args: &SceneArgs,
+    frame: Option<u32>,
+    overrides: &RenderOverrides,
+    course: &CourseOptions,
+) -> Compiled {
+    let args = SceneArgs {
+        frame: frame.or(args.frame),
+        ..args.clone()
+    };
+    let args = &args;
     let mut compilation = crate::front_end::compile(args, course);
     if let Some(scene) = compilation.scene.take() {
         match crate::setting_flags::apply_to_scene(scene, overrides) {

@@ -71,6 +71,7 @@ pub fn compile(args: &SceneArgs, course: &CourseOptions) -> Compiled {
         let options = CompileOptions {
             defines: args.define.clone(),
             settings: args.set.clone(),
+            frame: args.frame,
             ..CompileOptions::default()
         };
         let compilation = compile_file(&args.scene, &mut DiskLoader, &options);

@@ -131,6 +131,7 @@ pub fn course_line(
         scene: base.join(&run.input),
         define: Vec::new(),
         set: run.sets.clone(),
+        frame: None,
     };
     Ok((scene_args, run.options))
 }
@@ -164,6 +165,7 @@ fn read_commands(path: &Path) -> Result<Vec<Assignment>, Failure> {
             scene: base.join(&run.input),
             define: Vec::new(),
             set: run.sets.clone(),
+            frame: None,
         };
         let loaded = load_scene_with(&scene_args, true, &run.options)?;
         out.push(Assignment {

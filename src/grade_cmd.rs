@@ -103,6 +103,7 @@ pub fn grade(args: &GradeArgs) -> Result<(), Failure> {
                 scene: scene.clone(),
                 define: args.define.clone(),
                 set: args.set.clone(),
+                frame: None,
             };
             (scene.clone(), image, load_scene(&scene_args, true)?)
         }

@@ -47,6 +47,15 @@ pub fn write_image(
     height: u32,
     pixels: Pixels<'_>,
 ) -> Result<(), String> {
+    write_atomically(path, |file| encode(file, format, width, height, pixels))
+}
+
+/// Writes a file through `write`, atomically as [`write_image`] does: into a temporary file
+/// beside `path`, renamed over it only when complete.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut std::fs::File) -> Result<(), String>,
+) -> Result<(), String> {
     let dir = match path.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
@@ -64,7 +73,7 @@ pub fn write_image(
     let mut temp = builder.tempfile_in(dir).map_err(|e| describe(&e))?;
     // Dropped after the rename or the temporary file's own removal, both below.
     let _registered = crate::interrupt::register(temp.path());
-    encode(temp.as_file_mut(), format, width, height, pixels).map_err(|e| describe(&e))?;
+    write(temp.as_file_mut()).map_err(|e| describe(&e))?;
     temp.as_file().sync_all().map_err(|e| describe(&e))?;
     temp.persist(path).map_err(|e| describe(&e.error))?;
     Ok(())

@@ -7,6 +7,7 @@
 
 mod against_image;
 mod allocator;
+mod animation;
 mod cli;
 mod cpu_time;
 mod debug_cmd;

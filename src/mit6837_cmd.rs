@@ -424,6 +424,7 @@ pub fn mit6837(args: &[OsString]) -> Result<(), Failure> {
         scene: run.input.clone(),
         define: Vec::new(),
         set: run.sets.clone(),
+        frame: None,
     };
     let loaded = load_scene_with(&scene_args, false, &run.options)?;
     let options = RenderOptions::from_settings(&loaded.scene.settings);

@@ -223,6 +223,9 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
     crate::interrupt::install();
 
     let loaded = load_scene(&args.scene, args.quiet)?;
+    if crate::animation::is_animation_job(args, &loaded) {
+        return crate::animation::render_animation(args, loaded);
+    }
     let (loaded, options) = apply_render_flags(loaded, &args.overrides)?;
     let compile_seconds = started.elapsed().as_secs_f64();
     refuse_outputs_over_sources(&args.scene.scene, &loaded.scene.sources, &output)?;

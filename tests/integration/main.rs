@@ -3,6 +3,7 @@
 // A program, not a library: it prints its results and sets its exit status.
 #![allow(clippy::print_stdout, clippy::print_stderr, clippy::exit)]
 
+mod animation;
 mod cli;
 mod conventions;
 mod debug_cli;

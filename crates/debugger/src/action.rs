@@ -40,6 +40,10 @@ impl Focus {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Action {
     Quit,
+    /// `<` `>`: compiles the previous or next frame of an animated scene.
+    StepFrame {
+        forward: bool,
+    },
     /// Esc: cancels the trace under way, else leaves the zoomed pane, else ends the search.
     /// It never quits (q does).
     Cancel,
@@ -183,6 +187,7 @@ pub const KEY_HELP: &[(&str, &str, &str)] = &[
     ("Anywhere", "w", "what-if: change a value"),
     ("Anywhere", ":", "query: mark matching pixels"),
     ("Anywhere", "r", "reload (automatic on save)"),
+    ("Anywhere", "< >", "previous / next animation frame"),
     ("Anywhere", "e", "export the tree (JSON, by scene)"),
     ("Anywhere", "?", "this help"),
     ("Anywhere", "Esc", "close, leave a mode, cancel"),
@@ -229,6 +234,8 @@ pub fn action_for_key(
         KeyCode::Tab => Some(Action::FocusNext),
         KeyCode::BackTab => Some(Action::FocusPrevious),
         KeyCode::Char('r') => Some(Action::Reload),
+        KeyCode::Char('>') => Some(Action::StepFrame { forward: true }),
+        KeyCode::Char('<') => Some(Action::StepFrame { forward: false }),
         KeyCode::Char('e') => Some(Action::Export),
         KeyCode::Char('o') => Some(Action::ToggleOverlay(HeatMapKind::RaysPerPixel)),
         KeyCode::Char('d') => Some(Action::ToggleOverlay(HeatMapKind::DeepestLevel)),

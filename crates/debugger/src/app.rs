@@ -203,6 +203,9 @@ pub struct App {
     /// Set after a failed reload, cleared by a good one.
     pub errors: Option<SceneErrors>,
     pub reloading: bool,
+    /// The animation frame the scene is compiled at (`None`: the scene's first); `<` and
+    /// `>` step it.
+    pub frame: Option<u32>,
     pub message: Option<Message>,
     /// The terminal's area, for layout.
     pub area: Rect,
@@ -263,6 +266,7 @@ impl App {
             search: None,
             errors: None,
             reloading: false,
+            frame: None,
             message: None,
             area,
             color_depth: ColorDepth::TrueColor,

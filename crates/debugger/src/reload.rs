@@ -12,21 +12,24 @@ use crate::event::{Event, Reloaded};
 use crate::session::{Compiled, Recompile};
 
 pub struct Reloader {
-    requests: Sender<()>,
+    requests: Sender<Option<u32>>,
 }
 
 impl Reloader {
     pub fn start(mut recompile: Recompile, events: Sender<Event>) -> std::io::Result<Reloader> {
-        let (requests, pending) = mpsc::channel::<()>();
+        let (requests, pending) = mpsc::channel::<Option<u32>>();
         std::thread::Builder::new()
             .name("reload".into())
             .spawn(move || {
-                while pending.recv().is_ok() {
-                    while pending.try_recv().is_ok() {}
+                while let Ok(mut frame) = pending.recv() {
+                    // Requests merge into one, at the frame asked for last.
+                    while let Ok(later) = pending.try_recv() {
+                        frame = later;
+                    }
                     // A panic in the compiler or the BVH build is a bug, but it must not
                     // take the debugger down with it (nor leave it "reloading" forever):
                     // report it as an error of the scene.
-                    let reloaded = match catch_unwind(AssertUnwindSafe(|| load(recompile()))) {
+                    let reloaded = match catch_unwind(AssertUnwindSafe(|| load(recompile(frame)))) {
                         Ok(reloaded) => reloaded,
                         Err(payload) => Reloaded {
                             result: Err(SceneErrors {
@@ -53,8 +56,9 @@ impl Reloader {
         Ok(Reloader { requests })
     }
 
-    pub fn request(&self) {
-        let _ = self.requests.send(());
+    /// Compiles the scene again at `frame` (see [`crate::Recompile`]).
+    pub fn request(&self, frame: Option<u32>) {
+        let _ = self.requests.send(frame);
     }
 }
 
@@ -108,7 +112,7 @@ mod tests {
     #[test]
     fn each_request_compiles_once_and_failures_carry_their_diagnostics() {
         let mut calls = 0;
-        let recompile: Recompile = Box::new(move || {
+        let recompile: Recompile = Box::new(move |_frame| {
             calls += 1;
             if calls == 1 {
                 Compiled {
@@ -132,11 +136,11 @@ mod tests {
             Ok(Event::Reloaded(reloaded)) => reloaded,
             _ => panic!("expected a reload result"),
         };
-        reloader.request();
+        reloader.request(None);
         let first = next();
         assert!(first.result.is_ok());
         assert_eq!(first.watch, vec![std::path::PathBuf::from("a.scene")]);
-        reloader.request();
+        reloader.request(None);
         let second = next();
         let errors = second.result.err().expect("the second compile fails");
         assert_eq!(errors.diagnostics[0].message, "broken");
@@ -144,7 +148,7 @@ mod tests {
     }
 
     fn answer(reloader: &Reloader, receiver: &mpsc::Receiver<Event>) -> Reloaded {
-        reloader.request();
+        reloader.request(None);
         match receiver.recv_timeout(Duration::from_secs(60)) {
             Ok(Event::Reloaded(reloaded)) => reloaded,
             _ => panic!("the reload worker did not answer"),
@@ -163,7 +167,7 @@ mod tests {
     #[test]
     fn an_image_too_big_on_reload_is_an_error_and_the_worker_goes_on() {
         let mut calls = 0;
-        let recompile: Recompile = Box::new(move || {
+        let recompile: Recompile = Box::new(move |_frame| {
             calls += 1;
             let mut scene = whitted_scene().into_inner();
             if calls == 1 {
@@ -207,7 +211,7 @@ mod tests {
         // A sphere of radius 1e19 next to a unit sphere made the BVH build panic (issue 10);
         // whether or not it still does, the worker must answer every request.
         let mut calls = 0;
-        let recompile: Recompile = Box::new(move || {
+        let recompile: Recompile = Box::new(move |_frame| {
             calls += 1;
             if calls == 2 {
                 panic!("a compiler bug");

@@ -79,6 +79,7 @@ pub fn run(session: Session) -> Result<(), DebugError> {
         Rect::new(0, 0, size.width, size.height),
         session.export_dir,
     );
+    app.frame = session.frame;
     app.color_depth = ColorDepth::from_colorterm(std::env::var("COLORTERM").ok().as_deref());
 
     let (events, inbox) = mpsc::channel();
@@ -125,7 +126,7 @@ impl Runner {
     fn carry_out(&mut self, app: &mut App, effects: Vec<Effect>) {
         for effect in effects {
             match effect {
-                Effect::Reload => self.reloader.request(),
+                Effect::Reload => self.reloader.request(app.frame),
                 Effect::StartRender => {
                     if let Some(old) = self.render.take() {
                         old.cancel();

@@ -19,8 +19,10 @@ pub struct Compiled {
     pub watch: Vec<PathBuf>,
 }
 
-/// Compiles the scene again from disk. Runs on a worker thread, never the UI thread.
-pub type Recompile = Box<dyn FnMut() -> Compiled + Send>;
+/// Compiles the scene again from disk, at an animation frame (`None`: the frame the
+/// command line asked for, or the scene's first). Runs on a worker thread, never the UI
+/// thread.
+pub type Recompile = Box<dyn FnMut(Option<u32>) -> Compiled + Send>;
 
 /// Everything `whitted debug` needs to start.
 pub struct Session {
@@ -30,6 +32,8 @@ pub struct Session {
     /// The files to watch for the first scene.
     pub watch: Vec<PathBuf>,
     pub recompile: Recompile,
+    /// The animation frame `scene` was compiled at (`--frame N`; `None`: the scene's first).
+    pub frame: Option<u32>,
     /// A pixel to trace at start (`--pixel X,Y`).
     pub pixel: Option<(u32, u32)>,
     /// Where `e` writes the ray tree's JSON.

@@ -161,6 +161,7 @@ fn apply(app: &mut App, action: Action) -> Vec<Effect> {
                 return vec![Effect::Reload];
             }
         }
+        Action::StepFrame { forward } => return step_frame(app, forward),
         Action::Export => return export(app),
         Action::ToggleShowAll => follow_update::toggle_show_all(app),
         Action::FollowHeaviest => follow_update::follow_heaviest(app),
@@ -486,6 +487,39 @@ fn export(app: &mut App) -> Vec<Effect> {
     vec![Effect::Export { path, contents }]
 }
 
+/// `<` `>`: the previous or next frame of an animated scene, compiled by the reload worker
+/// (requests merge, so holding the key compiles only the last frame asked for).
+fn step_frame(app: &mut App, forward: bool) -> Vec<Effect> {
+    let settings = &app.loaded.scene.settings;
+    if !settings.is_animated() {
+        app.set_message(
+            "the scene is not animated (`settings { frames N }`): no other frame",
+            false,
+        );
+        return Vec::new();
+    }
+    let range = settings.frame_range();
+    let (first, last) = (*range.start(), *range.end());
+    let current = app.frame.unwrap_or(first);
+    let next = if forward {
+        current.saturating_add(1).clamp(first, last)
+    } else {
+        current.saturating_sub(1).clamp(first, last)
+    };
+    if next == current {
+        let end = if forward { "last" } else { "first" };
+        app.set_message(
+            format!("frame {current} is the {end} frame ({first} to {last})"),
+            false,
+        );
+        return Vec::new();
+    }
+    app.frame = Some(next);
+    app.reloading = true;
+    app.set_message(format!("frame {next} of {first} to {last}"), false);
+    vec![Effect::Reload]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -503,6 +537,67 @@ mod tests {
             Rect::new(0, 0, 120, 40),
             "/tmp/out".into(),
         )
+    }
+
+    #[test]
+    fn angle_brackets_step_the_frames_of_an_animated_scene_and_stop_at_its_ends() {
+        // A still: nothing to step to, and no reload.
+        let mut still = app();
+        assert_eq!(
+            update(&mut still, Action::StepFrame { forward: true }),
+            vec![]
+        );
+        assert!(still
+            .message
+            .as_ref()
+            .unwrap()
+            .text
+            .contains("not animated"));
+        assert_eq!(still.frame, None);
+
+        let mut scene = whitted_scene().into_inner();
+        scene.settings.first_frame = 4;
+        scene.settings.frames = 3;
+        let valid = whitted_ir::validate(scene).unwrap_or_else(|_| panic!("invalid"));
+        let mut app = App::new(
+            "scenes/whitted.scene".into(),
+            LoadedScene::new(valid),
+            Rect::new(0, 0, 120, 40),
+            "/tmp/out".into(),
+        );
+        // From the first frame (4) back: already there.
+        assert_eq!(
+            update(&mut app, Action::StepFrame { forward: false }),
+            vec![]
+        );
+        assert_eq!(app.frame, None);
+        for expected in [5, 6] {
+            assert_eq!(
+                update(&mut app, Action::StepFrame { forward: true }),
+                vec![Effect::Reload]
+            );
+            assert_eq!(app.frame, Some(expected));
+        }
+        assert_eq!(app.message.as_ref().unwrap().text, "frame 6 of 4 to 6");
+        assert_eq!(
+            update(&mut app, Action::StepFrame { forward: true }),
+            vec![]
+        );
+        assert_eq!(app.frame, Some(6));
+        assert_eq!(
+            update(&mut app, Action::StepFrame { forward: false }),
+            vec![Effect::Reload]
+        );
+        assert_eq!(app.frame, Some(5));
+        assert_eq!(
+            crate::action::action_for_key(
+                ratatui::crossterm::event::KeyEvent::from(KeyCode::Char('>')),
+                Focus::Image,
+                false,
+                false
+            ),
+            Some(Action::StepFrame { forward: true })
+        );
     }
 
     fn picked_app() -> App {

@@ -27,7 +27,7 @@ pub use provenance::{ArgValue, FrameId, Provenance, Site, SiteId, SiteKind, Step
 pub use scene::{
     Attenuation, Camera, Color, CsgOp, Filter, Fresnel, Highlight, Light, LightKind, Material,
     Object, ObjectKind, Pattern, PatternKind, Projection, Quadric, QuadricForm, SamplePosition,
-    Sampling, Scene, SceneFormat, Settings, ShadowMode, Shape, WorldFromObject,
+    Sampling, Scene, SceneFormat, Settings, ShadowMode, Shape, WorldFromObject, DEFAULT_FPS,
 };
 pub use source::{FileId, LineCol, SourceFile, SourceMap, Span};
 pub use validate::{validate, InvalidScene, ValidScene};

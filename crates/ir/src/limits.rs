@@ -54,6 +54,19 @@ pub const MAX_PIXELS: u64 = 1 << 27;
 /// Anti-aliasing samples per pixel.
 pub const MAX_SAMPLES_PER_PIXEL: u32 = 4_096;
 
+/// Frames of one animation (`frames`, and `--frames` on the command line).
+pub const MAX_FRAMES: u32 = 100_000;
+
+/// The first frame number of an animation (`first_frame`).
+pub const MAX_FIRST_FRAME: u32 = 1_000_000_000;
+
+/// Frames per second of an animation (`fps`).
+pub const MAX_FPS: u32 = 1_000;
+
+/// Pixels an animated image (APNG or GIF) holds at once: every frame's pixels, frames times
+/// width times height, at 4 bytes each for the GIF encoder (1 GiB): 873 frames of 640x480.
+pub const MAX_ANIMATION_PIXELS: u64 = 1 << 28;
+
 /// Recursion depth of the tracer (`max_depth`).
 pub const MAX_DEPTH: u32 = 256;
 
@@ -234,6 +247,18 @@ pub const ALL: &[Limit] = &[
         "samples per pixel",
         MAX_SAMPLES_PER_PIXEL as u64,
         "anti-aliasing samples per pixel",
+    ),
+    count("frames", MAX_FRAMES as u64, "frames of one animation (`frames`, `--frames`)"),
+    count(
+        "first frame",
+        MAX_FIRST_FRAME as u64,
+        "the first frame number of an animation (`first_frame`)",
+    ),
+    count("fps", MAX_FPS as u64, "frames per second of an animation (`fps`)"),
+    count(
+        "animation pixels",
+        MAX_ANIMATION_PIXELS,
+        "frames times pixels of an animated PNG or GIF, which holds every frame at once",
     ),
     count("max depth", MAX_DEPTH as u64, "recursion depth of the tracer (`max_depth`)"),
     count(

@@ -72,6 +72,17 @@ pub fn print(scene: &Scene) -> String {
     if !changed.is_empty() {
         let _ = writeln!(out, "  {}", changed.join(", "));
     }
+    // An animation's frames: a line only for an animated scene.
+    if s.is_animated() || s.first_frame != 0 || s.fps != crate::scene::DEFAULT_FPS {
+        let range = s.frame_range();
+        let _ = writeln!(
+            out,
+            "  frames {}..={} at {} fps",
+            range.start(),
+            range.end(),
+            s.fps
+        );
+    }
     let c = &scene.camera;
     let projection = match c.projection {
         Projection::Perspective {

@@ -155,7 +155,33 @@ pub struct Settings {
     pub light_falloff: bool,
     /// A Fresnel rule for every material, replacing each material's own; `None`: each its own.
     pub fresnel_rule: Option<Fresnel>,
+    /// The animation's first frame number (`first_frame`); with `frames` it gives the frame
+    /// range the scene's `frame` and `clock` run over. Left out of the JSON at its default,
+    /// so that still scenes' dumps read as before.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub first_frame: u32,
+    /// How many frames the animation has (`frames`); 1 is a still.
+    #[serde(skip_serializing_if = "is_one")]
+    pub frames: u32,
+    /// Frames per second of the animation (`fps`), for animated images and videos.
+    #[serde(skip_serializing_if = "is_default_fps")]
+    pub fps: u32,
 }
+
+fn is_zero(n: &u32) -> bool {
+    *n == 0
+}
+
+fn is_one(n: &u32) -> bool {
+    *n == 1
+}
+
+fn is_default_fps(n: &u32) -> bool {
+    *n == DEFAULT_FPS
+}
+
+/// Frames per second when a scene does not say.
+pub const DEFAULT_FPS: u32 = 24;
 
 /// Where a pixel's samples are placed relative to the pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -169,6 +195,20 @@ pub enum SamplePosition {
 }
 
 impl Settings {
+    /// The frames of the animation, first to last (one frame for a still). The last frame
+    /// saturates at `u32::MAX`; the setting's ranges keep it well below.
+    pub fn frame_range(&self) -> std::ops::RangeInclusive<u32> {
+        let last = self
+            .first_frame
+            .saturating_add(self.frames.saturating_sub(1));
+        self.first_frame..=last
+    }
+
+    /// Whether the scene is an animation (more than one frame).
+    pub fn is_animated(&self) -> bool {
+        self.frames > 1
+    }
+
     /// Whether each pixel is the plain mean of its own samples (the box filter of radius
     /// 0.5, the default): the render then keeps no samples beyond the pixel.
     pub fn filter_is_own_pixel(&self) -> bool {
@@ -203,6 +243,9 @@ impl Default for Settings {
             total_internal_reflection: true,
             light_falloff: true,
             fresnel_rule: None,
+            first_frame: 0,
+            frames: 1,
+            fps: DEFAULT_FPS,
         }
     }
 }

@@ -405,6 +405,42 @@ pub const FRESNEL_RULE: SettingRow = SettingRow {
     },
 };
 
+pub const FRAMES: SettingRow = SettingRow {
+    name: "frames",
+    kind: SettingKind::Whole {
+        min: 1,
+        max: limits::MAX_FRAMES,
+    },
+    default: "1",
+    doc: "how many frames the animation has (1: a still); `frame` runs from `first_frame` to `first_frame + frames - 1`",
+    get: |s| Some(SettingValue::Whole(s.frames)),
+    set: |s, v| s.frames = whole(v),
+};
+
+pub const FIRST_FRAME: SettingRow = SettingRow {
+    name: "first_frame",
+    kind: SettingKind::Whole {
+        min: 0,
+        max: limits::MAX_FIRST_FRAME,
+    },
+    default: "0",
+    doc: "the animation's first frame number",
+    get: |s| Some(SettingValue::Whole(s.first_frame)),
+    set: |s, v| s.first_frame = whole(v),
+};
+
+pub const FPS: SettingRow = SettingRow {
+    name: "fps",
+    kind: SettingKind::Whole {
+        min: 1,
+        max: limits::MAX_FPS,
+    },
+    default: "24",
+    doc: "frames per second of the animation (an animated PNG's or GIF's frame delay, a video's rate)",
+    get: |s| Some(SettingValue::Whole(s.fps)),
+    set: |s, v| s.fps = whole(v),
+};
+
 /// Every setting, in the order the docs list them.
 pub const SETTINGS: &[SettingRow] = &[
     WIDTH,
@@ -431,6 +467,9 @@ pub const SETTINGS: &[SettingRow] = &[
     TOTAL_INTERNAL_REFLECTION,
     LIGHT_FALLOFF,
     FRESNEL_RULE,
+    FRAMES,
+    FIRST_FRAME,
+    FPS,
 ];
 
 /// The rules where the MIT 6.837 course's model and whitted's differ, and the switches

@@ -1,5 +1,8 @@
 //! Built-in constants and functions. Every angle in the language is in degrees, the trig
 //! functions included, so `cos(i * 360 / n)` places things around a circle.
+//!
+//! Three names are the animation's clock (`frame`, `clock`, `fps`): constants whose values
+//! the compilation's [`FrameClock`](crate::FrameClock) gives, not this table.
 
 use whitted_ir::DVec3;
 
@@ -19,10 +22,16 @@ pub enum Constant {
     Yellow,
     Cyan,
     Magenta,
+    /// The frame being compiled.
+    Frame,
+    /// The frame's place in the animation, 0 at the first frame to 1 at the last.
+    Clock,
+    /// Frames per second.
+    Fps,
 }
 
 impl Constant {
-    pub const ALL: [Constant; 11] = [
+    pub const ALL: [Constant; 14] = [
         Constant::Pi,
         Constant::Black,
         Constant::White,
@@ -34,6 +43,9 @@ impl Constant {
         Constant::Yellow,
         Constant::Cyan,
         Constant::Magenta,
+        Constant::Frame,
+        Constant::Clock,
+        Constant::Fps,
     ];
 
     pub fn name(self) -> &'static str {
@@ -49,6 +61,9 @@ impl Constant {
             Constant::Yellow => "yellow",
             Constant::Cyan => "cyan",
             Constant::Magenta => "magenta",
+            Constant::Frame => "frame",
+            Constant::Clock => "clock",
+            Constant::Fps => "fps",
         }
     }
 
@@ -56,9 +71,13 @@ impl Constant {
         Constant::ALL.into_iter().find(|c| c.name() == name)
     }
 
-    pub fn value(self) -> Value {
+    /// The constant's value; the clock's three names take theirs from `clock`.
+    pub fn value(self, clock: &crate::FrameClock) -> Value {
         let v = |r, g, b| Value::Vector(DVec3::new(r, g, b));
         match self {
+            Constant::Frame => Value::Number(f64::from(clock.frame)),
+            Constant::Clock => Value::Number(clock.clock()),
+            Constant::Fps => Value::Number(f64::from(clock.fps)),
             Constant::Pi => Value::Number(std::f64::consts::PI),
             Constant::Black => v(0.0, 0.0, 0.0),
             Constant::White => v(1.0, 1.0, 1.0),
@@ -70,6 +89,11 @@ impl Constant {
             Constant::Cyan => v(0.0, 1.0, 1.0),
             Constant::Magenta => v(1.0, 0.0, 1.0),
         }
+    }
+
+    /// Whether the value is the animation clock's (it changes from frame to frame).
+    pub fn is_clock(self) -> bool {
+        matches!(self, Constant::Frame | Constant::Clock | Constant::Fps)
     }
 }
 
@@ -110,10 +134,13 @@ pub enum Function {
     Turbulence,
     Len,
     Rand,
+    Lerp,
+    Smoothstep,
+    Keyframes,
 }
 
 impl Function {
-    pub const ALL: [Function; 34] = [
+    pub const ALL: [Function; 37] = [
         Function::Sqrt,
         Function::Pow,
         Function::Exp,
@@ -148,6 +175,9 @@ impl Function {
         Function::Turbulence,
         Function::Len,
         Function::Rand,
+        Function::Lerp,
+        Function::Smoothstep,
+        Function::Keyframes,
     ];
 
     pub fn name(self) -> &'static str {
@@ -186,6 +216,9 @@ impl Function {
             Function::Turbulence => "turbulence",
             Function::Len => "len",
             Function::Rand => "rand",
+            Function::Lerp => "lerp",
+            Function::Smoothstep => "smoothstep",
+            Function::Keyframes => "keyframes",
         }
     }
 
@@ -199,8 +232,8 @@ impl Function {
         match self {
             Sqrt | Exp | Log | Sin | Cos | Tan | Asin | Acos | Atan | Abs | Floor | Ceil
             | Round | Radians | Degrees | Length | Normalize | Len => (1, 1),
-            Pow | Atan2 | Min | Max | Dot | Cross | Rand => (2, 2),
-            Clamp | Mix | Rgb | Srgb => (3, 3),
+            Pow | Atan2 | Min | Max | Dot | Cross | Rand | Keyframes => (2, 2),
+            Clamp | Mix | Rgb | Srgb | Lerp | Smoothstep => (3, 3),
             Checker | Stripes | Marble | Wood | Turbulence => (2, 3),
         }
     }
@@ -243,6 +276,9 @@ impl Function {
             Turbulence => "turbulence(a, b, size)",
             Len => "len(array)",
             Rand => "rand(seed, i)",
+            Lerp => "lerp(a, b, t)",
+            Smoothstep => "smoothstep(edge0, edge1, x)",
+            Keyframes => "keyframes([[t0, value0], [t1, value1], ...], t)",
         }
     }
 }
@@ -381,7 +417,17 @@ pub fn call_math(function: Function, args: &[Value]) -> Result<Value, CallError>
             }
             Ok(Value::Vector(v.normalize()))
         }
-        Mix => {
+        Smoothstep => {
+            let (e0, e1, x) = (n(0)?, n(1)?, n(2)?);
+            if e0 == e1 {
+                return Err(CallError::Domain(format!(
+                    "`smoothstep` needs two different edges, not {e0} twice"
+                )));
+            }
+            let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+            num(t * t * (3.0 - 2.0 * t))
+        }
+        Mix | Lerp => {
             let t = n(2)?;
             match (args.first(), args.get(1)) {
                 (Some(Value::Number(a)), Some(Value::Number(b))) => num(a + (b - a) * t),
@@ -409,8 +455,8 @@ pub fn call_math(function: Function, args: &[Value]) -> Result<Value, CallError>
             srgb_to_linear(n(2)?),
         ))),
         Rand => num(crate::random::rand(n(0)?, n(1)?)),
-        Checker | Stripes | Marble | Wood | Turbulence | Len => Err(CallError::Domain(
-            "patterns and `len` are evaluated by the evaluator".into(),
+        Checker | Stripes | Marble | Wood | Turbulence | Len | Keyframes => Err(CallError::Domain(
+            "patterns, `len` and `keyframes` are evaluated by the evaluator".into(),
         )),
     }
 }

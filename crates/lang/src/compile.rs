@@ -17,7 +17,8 @@ use crate::parser::{self, ParseContext};
 use crate::properties::{self, Family, Kind, Prop};
 use crate::resolve::{Define, Resolver};
 use crate::suggest::{closest, list_and, list_or};
-use crate::{Compilation, CompileOptions, Limits, SourceLoader, WorkCounts};
+use crate::{Compilation, CompileOptions, FrameClock, Limits, SourceLoader, WorkCounts};
+use std::cell::Cell;
 
 /// Stacks to try for the compile thread, largest first. Only the pages actually touched are
 /// committed; the deepest legal nesting uses a fraction of the first. The smaller one is for
@@ -42,7 +43,25 @@ pub fn compile_file(
     on_big_stack(loader, move |loader, max_depth| {
         let display = path.to_string_lossy().into_owned();
         match loader.load(&path) {
-            Ok(bytes) => compile_root(&path, display, bytes, loader, options, max_depth),
+            Ok(bytes) => {
+                let mut bytes = Some(bytes);
+                with_frame_clock(options, |clock, clock_read| {
+                    // The second compilation, when there is one, reads the files again.
+                    let bytes = match bytes.take() {
+                        Some(bytes) => bytes,
+                        None => loader.load(&path).unwrap_or_default(),
+                    };
+                    compile_root(
+                        &path,
+                        display.clone(),
+                        bytes,
+                        loader,
+                        options,
+                        max_depth,
+                        (clock, clock_read),
+                    )
+                })
+            }
             Err(error) => Compilation {
                 sources: SourceMap::new(),
                 scene: None,
@@ -78,8 +97,60 @@ pub fn compile_bytes(
     let path = normalize(Path::new(name));
     let bytes = bytes.to_vec();
     on_big_stack(loader, move |loader, max_depth| {
-        compile_root(&path, name.to_string(), bytes, loader, options, max_depth)
+        with_frame_clock(options, |clock, clock_read| {
+            compile_root(
+                &path,
+                name.to_string(),
+                bytes.clone(),
+                loader,
+                options,
+                max_depth,
+                (clock, clock_read),
+            )
+        })
     })
+}
+
+/// Runs `compile` with the values of `frame`, `clock` and `fps` the scene's own settings
+/// give. Those settings are known only once the scene has run, so the first compilation
+/// assumes a still (the frame asked for, or 0, in a range of that one frame, at the default
+/// rate). A scene that never reads the clock is done; one that reads it and whose settings
+/// say otherwise is compiled again with its own clock. A scene whose frame range or rate
+/// depends on the clock (so that the two never agree) is an error.
+fn with_frame_clock(
+    options: &CompileOptions,
+    mut compile: impl FnMut(FrameClock, &Cell<bool>) -> Compilation,
+) -> Compilation {
+    let frame = options.frame.unwrap_or(0);
+    let assumed = FrameClock {
+        frame,
+        first: frame,
+        last: frame,
+        fps: whitted_ir::DEFAULT_FPS,
+    };
+    let clock_read = Cell::new(false);
+    let first = compile(assumed, &clock_read);
+    let actual = match &first.scene {
+        Some(scene) if clock_read.get() => FrameClock::of(&scene.settings, options.frame),
+        _ => return first,
+    };
+    if actual == assumed {
+        return first;
+    }
+    let clock_read = Cell::new(false);
+    let mut second = compile(actual, &clock_read);
+    if let Some(scene) = &second.scene {
+        let again = FrameClock::of(&scene.settings, options.frame);
+        if again != actual {
+            second.scene = None;
+            second.diagnostics.push(Diagnostic::new(
+                Severity::Error,
+                "the settings `frames`, `first_frame` and `fps` must not depend on `frame`, `clock` or `fps`".to_string(),
+                None,
+            ));
+        }
+    }
+    second
 }
 
 /// What the compile thread asks the caller's thread for.
@@ -444,6 +515,7 @@ fn compile_root(
     loader: &mut dyn SourceLoader,
     options: &CompileOptions,
     max_evaluation_depth: usize,
+    clock: (FrameClock, &Cell<bool>),
 ) -> Compilation {
     let limits = &options.limits;
     let mut loading = Loading {
@@ -543,6 +615,7 @@ fn compile_root(
             sources,
             diagnostics,
             work,
+            clock,
         },
         loader,
         limits,
@@ -557,7 +630,7 @@ fn compile_root(
 }
 
 /// What resolution leaves for evaluation.
-struct EvaluationInput {
+struct EvaluationInput<'c> {
     program: Program,
     interner: Interner,
     resolution: crate::resolve::Resolution,
@@ -566,11 +639,12 @@ struct EvaluationInput {
     sources: SourceMap,
     diagnostics: Vec<Diagnostic>,
     work: WorkCounts,
+    clock: (FrameClock, &'c Cell<bool>),
 }
 
 /// Evaluation, mesh files and validation: the phases after resolution.
 fn evaluate_and_validate(
-    input: EvaluationInput,
+    input: EvaluationInput<'_>,
     loader: &mut dyn SourceLoader,
     limits: &Limits,
     max_evaluation_depth: usize,
@@ -585,6 +659,7 @@ fn evaluate_and_validate(
         sources,
         mut diagnostics,
         work,
+        clock: (clock, clock_read),
     } = input;
     // Evaluation runs even after resolution errors (unresolved names evaluate quietly to
     // nothing), so that one run reports every error it can find.
@@ -605,6 +680,8 @@ fn evaluate_and_validate(
         crate::eval::CommandLine {
             defines: &defines,
             overrides: &overrides,
+            clock,
+            clock_read,
         },
         sources.clone(),
         max_evaluation_depth,

@@ -110,9 +110,47 @@ pub struct CompileOptions {
     /// rows of the property table (NAME, VALUE source text).
     pub settings: Vec<(String, String)>,
     pub limits: Limits,
+    /// The animation frame to compile: the value of `frame` (and, with the scene's frame
+    /// range, of `clock`). `None`: the scene's first frame.
+    pub frame: Option<u32>,
     /// Keep an [`editor::Index`] of the text (properties by block, names to definitions,
     /// symbols) in [`Compilation::index`], for a language server.
     pub index: bool,
+}
+
+/// What the animation's built-in names are worth in one compilation: `frame`, `clock` and
+/// `fps`. The frame range and rate are the scene's own settings (`first_frame`, `frames`,
+/// `fps`); the compiler finds them by compiling (see `compile.rs`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameClock {
+    pub frame: u32,
+    /// The first and last frames of the scene's range.
+    pub first: u32,
+    pub last: u32,
+    pub fps: u32,
+}
+
+impl FrameClock {
+    /// The clock of `frame` in the range of `settings`; `None` for the range's first frame.
+    pub fn of(settings: &whitted_ir::Settings, frame: Option<u32>) -> FrameClock {
+        let range = settings.frame_range();
+        FrameClock {
+            frame: frame.unwrap_or(*range.start()),
+            first: *range.start(),
+            last: *range.end(),
+            fps: settings.fps,
+        }
+    }
+
+    /// `(frame - first) / (last - first)`: 0 at the first frame, 1 at the last, 0 when the
+    /// range has one frame. A frame outside the range gives a clock outside [0, 1].
+    pub fn clock(&self) -> f64 {
+        if self.last == self.first {
+            return 0.0;
+        }
+        (f64::from(self.frame) - f64::from(self.first))
+            / (f64::from(self.last) - f64::from(self.first))
+    }
 }
 
 #[derive(Debug)]

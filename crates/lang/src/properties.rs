@@ -257,6 +257,15 @@ properties! {
     SamplePosition "sample_position" {
         Settings => setting_kind(&S::SAMPLE_POSITION), S::SAMPLE_POSITION.default, S::SAMPLE_POSITION.doc;
     }
+    Frames "frames" {
+        Settings => setting_kind(&S::FRAMES), S::FRAMES.default, S::FRAMES.doc;
+    }
+    FirstFrame "first_frame" {
+        Settings => setting_kind(&S::FIRST_FRAME), S::FIRST_FRAME.default, S::FIRST_FRAME.doc;
+    }
+    Fps "fps" {
+        Settings => setting_kind(&S::FPS), S::FPS.default, S::FPS.doc;
+    }
     FlipNormals "flip_normals" {
         Settings => setting_kind(&S::FLIP_NORMALS), S::FLIP_NORMALS.default, S::FLIP_NORMALS.doc;
     }

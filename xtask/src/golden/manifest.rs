@@ -53,6 +53,7 @@ struct RawScene {
     #[serde(default)]
     pixels: Vec<[u32; 2]>,
     course: Option<Vec<String>>,
+    frame: Option<u32>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -89,6 +90,8 @@ pub struct GoldenScene {
     /// reference is what `whitted mit6837 -input PATH -size W H -output OUT FLAGS` writes
     /// (8-bit linear, as the course's images). `None`: `whitted render`.
     pub course: Option<Vec<String>>,
+    /// For an animated scene, the frame rendered (`whitted render --frame N`).
+    pub frame: Option<u32>,
 }
 
 #[derive(Debug)]
@@ -134,6 +137,14 @@ pub fn parse(text: &str, origin: &Path) -> anyhow::Result<Manifest> {
         }
         let width = s.width.or(defaults.width).unwrap_or(DEFAULT_WIDTH);
         let height = s.height.or(defaults.height).unwrap_or(DEFAULT_HEIGHT);
+        if s.course.is_some() && s.frame.is_some() {
+            bail!(
+                "{}: `{}` is rendered by the course's command line, which has no frames: \
+                 leave out `frame`",
+                origin.display(),
+                s.name
+            );
+        }
         if s.course.is_some() && !s.pixels.is_empty() {
             bail!(
                 "{}: `{}` is rendered by the course's command line, which has no ray trees: \
@@ -173,6 +184,7 @@ pub fn parse(text: &str, origin: &Path) -> anyhow::Result<Manifest> {
             },
             pixels: s.pixels,
             course: s.course,
+            frame: s.frame,
         });
     }
     Ok(Manifest {
@@ -198,6 +210,7 @@ pub fn from_folder(scenes_dir: &Path) -> anyhow::Result<Manifest> {
             thresholds: Thresholds::default(),
             pixels: Vec::new(),
             course: None,
+            frame: None,
         });
     }
     Ok(Manifest {

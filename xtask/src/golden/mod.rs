@@ -210,6 +210,9 @@ fn scene_command(exe: &Path, root: &Path, subcommand: &str, scene: &GoldenScene)
     for define in &scene.defines {
         command.args(["-D", define]);
     }
+    if let Some(frame) = scene.frame {
+        command.args(["--frame", &frame.to_string()]);
+    }
     command.args([
         "--width",
         &scene.width.to_string(),

@@ -228,7 +228,7 @@ impl<'a> Evaluator<'a> {
     }
 
     /// Refuses infinity and NaN, pointing at the operation (`at`) that made them.
-    fn finite(&mut self, value: Value, at: Span) -> Eval<Value> {
+    pub(super) fn finite(&mut self, value: Value, at: Span) -> Eval<Value> {
         let ok = match value {
             Value::Number(x) => x.is_finite(),
             Value::Vector(v) => v.is_finite(),
@@ -277,6 +277,9 @@ impl<'a> Evaluator<'a> {
         }
         if function == Function::Len {
             return self.len_call(call, &args[..count]);
+        }
+        if function == Function::Keyframes {
+            return self.keyframes_call(call, &args[..count]);
         }
         match call_math(function, &args[..count]) {
             Ok(value) => self.finite(value, call.span),

@@ -249,7 +249,12 @@ impl<'a> Evaluator<'a> {
                 .get(slot as usize)
                 .copied()
                 .unwrap_or(Value::Poisoned),
-            Res::Builtin(constant) => constant.value(),
+            Res::Builtin(constant) => {
+                if constant.is_clock() {
+                    self.clock_read.set(true);
+                }
+                constant.value(&self.clock)
+            }
             Res::Word(_) | Res::Unresolved | Res::Error => Value::Poisoned,
         }
     }

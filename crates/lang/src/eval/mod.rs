@@ -13,6 +13,7 @@ mod arrays;
 mod builders;
 mod convert;
 mod expr;
+mod keyframes;
 mod loops;
 mod materials;
 mod objects;
@@ -86,6 +87,11 @@ pub(crate) struct Evaluator<'a> {
     defines: &'a [Define],
     /// `--set NAME=VALUE`: applied after the scene has run, so they win.
     overrides: &'a [crate::compile::SettingOverride],
+    /// The values of `frame`, `clock` and `fps`.
+    clock: crate::FrameClock,
+    /// Set when the scene reads `frame`, `clock` or `fps` (the compiler then checks that
+    /// the clock it assumed is the scene's own).
+    clock_read: &'a std::cell::Cell<bool>,
 
     globals: Vec<Value>,
     /// Call frames, each `frame_size` values; `base` is where the current frame starts.
@@ -137,6 +143,8 @@ pub(crate) struct Evaluator<'a> {
 pub(crate) struct CommandLine<'a> {
     pub defines: &'a [Define],
     pub overrides: &'a [crate::compile::SettingOverride],
+    pub clock: crate::FrameClock,
+    pub clock_read: &'a std::cell::Cell<bool>,
 }
 
 impl<'a> Evaluator<'a> {
@@ -149,7 +157,12 @@ impl<'a> Evaluator<'a> {
         sources: whitted_ir::SourceMap,
         max_depth: usize,
     ) -> Self {
-        let CommandLine { defines, overrides } = command_line;
+        let CommandLine {
+            defines,
+            overrides,
+            clock,
+            clock_read,
+        } = command_line;
         let scene = Scene {
             sources,
             ..Scene::default()
@@ -161,6 +174,8 @@ impl<'a> Evaluator<'a> {
             resolution,
             defines,
             overrides,
+            clock,
+            clock_read,
             globals: vec![Value::Poisoned; resolution.global_count as usize],
             stack: Vec::with_capacity(256),
             base: 0,

@@ -154,6 +154,7 @@ fn options() -> CompileOptions {
     CompileOptions {
         defines: Vec::new(),
         settings: Vec::new(),
+        frame: None,
         // The editor's index is built for every fuzzed text too: it must not panic either.
         index: true,
         limits: Limits {

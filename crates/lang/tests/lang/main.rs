@@ -2,6 +2,7 @@
 //! error rendered, the examples in docs/language.md, the scenes in scenes/, limits, and a
 //! fuzz test that throws thousands of broken inputs at the compiler.
 
+mod animation;
 mod budgets;
 mod constructs;
 mod docs;
