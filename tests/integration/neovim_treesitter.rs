@@ -95,8 +95,7 @@ fn neovim_highlights_and_folds_a_scene_with_the_tree_sitter_grammar() {
             .as_array()
             .expect("captures")
             .iter()
-            .filter(|c| c["row"] == row && c["col"] == col)
-            .last()
+            .rfind(|c| c["row"] == row && c["col"] == col)
             .unwrap_or_else(|| panic!("no capture at {row}:{col}: {written}"));
         (
             last["name"].as_str().expect("name").to_owned(),
