@@ -65,7 +65,7 @@ pub struct FarmArgs {
 pub enum FarmCommand {
     /// Plan a render as N tasks: write DIR/plan.json and the engine's job files (shell:
     /// run.sh; slurm: task.sbatch, merge.sbatch, submit.sh; k8s: job.yaml).
-    Plan(FarmPlanArgs),
+    Plan(Box<FarmPlanArgs>),
     /// Run a shell plan here (DIR/run.sh): the tasks not yet done, then the merge.
     Run(FarmDirArgs),
     /// List each task as done, missing, stale (the scene or settings changed) or corrupt;
@@ -106,6 +106,11 @@ pub struct FarmPlanArgs {
     /// How many tasks to split the render into (at most one per row of the image).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub tasks: u32,
+    /// Render these frames of an animation, A..=B (default: the scene's own frames when it
+    /// is animated). Tasks take whole frames, or, when --tasks is a multiple of the frame
+    /// count, bands of each frame.
+    #[arg(long, value_name = "A..=B", value_parser = parse_frames, conflicts_with = "frame")]
+    pub frames: Option<std::ops::RangeInclusive<u32>>,
     /// Where the tasks run.
     #[arg(long, value_enum, default_value_t = Engine::Shell)]
     pub engine: Engine,
@@ -275,7 +280,12 @@ pub struct RenderArgs {
           value_parser = clap::value_parser!(u32).range(1..))]
     pub tasks: Option<u32>,
     /// With --task: the folder the part and its manifest go to.
-    #[arg(long, value_name = "DIR", default_value = "parts", requires = "one_task")]
+    #[arg(
+        long,
+        value_name = "DIR",
+        default_value = "parts",
+        requires = "one_task"
+    )]
     pub parts: PathBuf,
     /// With --task: render even when a complete, fresh part is already there.
     #[arg(long, requires = "one_task")]

@@ -9,41 +9,166 @@ use whitted_tracer::{PixelRect, PreparedScene, RenderOptions};
 
 use crate::cli::{FarmMergeArgs, ImageFormat};
 use crate::farm::part::{self, PartState};
-use crate::farm::plan::read_plan;
+use crate::farm::plan::{read_plan, Plan};
 use crate::farm::task;
 use crate::image_output::{write_image, Pixels};
+use crate::setting_flags::apply_render_flags;
 use crate::Failure;
 
 pub fn merge(args: &FarmMergeArgs) -> Result<(), Failure> {
     let plan = read_plan(&args.dir)?;
-    let format = ImageFormat::from_path(&args.output).unwrap_or(ImageFormat::Png);
-    crate::render_cmd::check_output_folder(&args.output)?;
     let (scene, options, now) = crate::farm::compile_plan_scene(&plan)?;
     let parts = Path::new(&plan.parts);
+    let Some(range) = plan.frame_range() else {
+        crate::render_cmd::check_output_folder(&args.output)?;
+        let tasks: Vec<u32> = (0..plan.tasks).collect();
+        let image = assemble(&plan, parts, &now, None, &tasks, &options)?;
+        if args.verify {
+            verify(scene, &options, &image, args.samples, None)?;
+        }
+        return write(&args.output, &options, &image);
+    };
+    let pattern = crate::animation::FramePattern::parse(&args.output.to_string_lossy())
+        .map_err(Failure::Usage)?
+        .ok_or_else(|| {
+            Failure::Usage(format!(
+                "-o {}: the plan is an animation of frames {}..={}, merged into one image per \
+                 frame: put the frame number in the name, like frame-{{frame:04}}.png",
+                args.output.display(),
+                range.start(),
+                range.end()
+            ))
+        })?;
+    // Which tasks hold each frame, and every part checked before any image is written, so
+    // a merge that cannot finish writes nothing.
+    let mut holders: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
+    for index in 0..plan.tasks {
+        let task = task::TaskIndex {
+            index,
+            count: plan.tasks,
+        };
+        let share = task::share(Some(&range), task).map_err(Failure::Message)?;
+        for frame in share.frames.into_iter().flatten() {
+            holders.entry(frame).or_default().push(index);
+        }
+    }
+    for (&frame, tasks) in &holders {
+        for &index in tasks {
+            let name = part_name(&plan, index, Some(frame));
+            check_part(
+                &args.dir,
+                parts,
+                &now,
+                &name,
+                index,
+                plan.tasks,
+                Some(frame),
+            )?;
+        }
+    }
+    let mut first = Some((scene, options));
+    for (frame, tasks) in holders {
+        let (scene, options) = match first.take() {
+            Some(compiled) if frame == *range.start() => compiled,
+            _ => {
+                let loaded = task::load_frame(&plan.scene_args(), Some(frame), true)?;
+                let (loaded, options) = apply_render_flags(loaded, &plan.overrides())?;
+                (loaded.scene, options)
+            }
+        };
+        let image = assemble(&plan, parts, &now, Some(frame), &tasks, &options)?;
+        if args.verify {
+            verify(scene, &options, &image, args.samples, Some(frame))?;
+        }
+        let path = pattern.path(frame);
+        crate::render_cmd::check_output_folder(&path)?;
+        write(&path, &options, &image)?;
+    }
+    Ok(())
+}
+
+/// Encodes the merged pixels exactly as `whitted render` does, in the format of `path`.
+fn write(path: &Path, options: &RenderOptions, image: &[[f32; 3]]) -> Result<(), Failure> {
+    let format = ImageFormat::from_path(path).unwrap_or(ImageFormat::Png);
+    write_image(
+        path,
+        format,
+        options.width,
+        options.height,
+        Pixels::Linear(image),
+    )
+    .map_err(Failure::Message)
+}
+
+/// How messages name a part: `task 2/4`, or `task 2/4, frame 7`.
+fn part_name(plan: &Plan, index: u32, frame: Option<u32>) -> String {
+    match frame {
+        None => format!("task {index}/{}", plan.tasks),
+        Some(frame) => format!("task {index}/{}, frame {frame}", plan.tasks),
+    }
+}
+
+/// A part that is there, intact and fresh, or the error naming it.
+fn check_part(
+    dir: &Path,
+    parts: &Path,
+    now: &task::Fingerprint,
+    name: &str,
+    index: u32,
+    tasks: u32,
+    frame: Option<u32>,
+) -> Result<(Box<part::Manifest>, Vec<[f32; 3]>), Failure> {
+    check_part_reading(dir, parts, now, name, (index, tasks, frame), false)
+}
+
+fn check_part_reading(
+    dir: &Path,
+    parts: &Path,
+    now: &task::Fingerprint,
+    name: &str,
+    (index, tasks, frame): (u32, u32, Option<u32>),
+    keep_pixels: bool,
+) -> Result<(Box<part::Manifest>, Vec<[f32; 3]>), Failure> {
+    let (manifest, pixels) = match part::read_part(parts, index, tasks, frame, keep_pixels) {
+        PartState::Missing => {
+            return Err(Failure::Message(format!(
+                "{name}: its part is missing from {}: run the task (`whitted farm status {}` lists what is left)",
+                parts.display(),
+                dir.display()
+            )))
+        }
+        PartState::Corrupt(why) => {
+            return Err(Failure::Message(format!("{name}: the part is corrupt: {why}")))
+        }
+        PartState::Intact(manifest, pixels) => (manifest, pixels.unwrap_or_default()),
+    };
+    if let Some(why) = task::staleness(&manifest, now) {
+        return Err(Failure::Message(format!(
+            "{name}: refused: the part was {why}; render the task again"
+        )));
+    }
+    Ok((manifest, pixels))
+}
+
+/// One image (of `frame`, for an animation) from the parts of `tasks`: each checked, placed,
+/// and the whole covered exactly once.
+fn assemble(
+    plan: &Plan,
+    parts: &Path,
+    now: &task::Fingerprint,
+    frame: Option<u32>,
+    tasks: &[u32],
+    options: &RenderOptions,
+) -> Result<Vec<[f32; 3]>, Failure> {
+    let dir = Path::new(&plan.parts).parent().unwrap_or(Path::new("."));
     let (width, height) = (options.width, options.height);
     let mut image = vec![[0.0f32; 3]; width as usize * height as usize];
-    let mut placed: Vec<(u32, PixelRect)> = Vec::with_capacity(plan.tasks as usize);
+    let mut placed: Vec<(u32, PixelRect)> = Vec::with_capacity(tasks.len());
     let mut covered = 0u64;
-    for index in 0..plan.tasks {
-        let name = format!("task {index}/{}", plan.tasks);
-        let (manifest, pixels) = match part::read_part(parts, index, plan.tasks, true) {
-            PartState::Missing => {
-                return Err(Failure::Message(format!(
-                    "{name}: its part is missing from {}: run the task (`whitted farm status {}` lists what is left)",
-                    parts.display(),
-                    args.dir.display()
-                )))
-            }
-            PartState::Corrupt(why) => {
-                return Err(Failure::Message(format!("{name}: the part is corrupt: {why}")))
-            }
-            PartState::Intact(manifest, pixels) => (manifest, pixels.unwrap_or_default()),
-        };
-        if let Some(why) = task::staleness(&manifest, &now) {
-            return Err(Failure::Message(format!(
-                "{name}: refused: the part was {why}; render the task again"
-            )));
-        }
+    for &index in tasks {
+        let name = part_name(plan, index, frame);
+        let (manifest, pixels) =
+            check_part_reading(dir, parts, now, &name, (index, plan.tasks, frame), true)?;
         if (manifest.image_width, manifest.image_height) != (width, height) {
             return Err(Failure::Message(format!(
                 "{name}: refused: the part belongs to a {}x{} image, the scene makes {width}x{height}",
@@ -72,17 +197,13 @@ pub fn merge(args: &FarmMergeArgs) -> Result<(), Failure> {
     }
     let total = u64::from(width) * u64::from(height);
     if covered != total {
+        let of_frame = frame.map_or_else(String::new, |f| format!(" of frame {f}"));
         return Err(Failure::Message(format!(
-            "the {} parts cover {covered} of the image's {total} pixels (the tasks did not agree on the plan)",
-            plan.tasks
+            "the {} parts{of_frame} cover {covered} of the image's {total} pixels (the tasks did not agree on the plan)",
+            tasks.len()
         )));
     }
-    if args.verify {
-        verify(scene, &options, &image, args.samples)?;
-    }
-    write_image(&args.output, format, width, height, Pixels::Linear(&image))
-        .map_err(Failure::Message)?;
-    Ok(())
+    Ok(image)
 }
 
 fn overlap(a: &PixelRect, b: &PixelRect) -> bool {
@@ -120,6 +241,7 @@ fn verify(
     options: &RenderOptions,
     image: &[[f32; 3]],
     samples: u32,
+    frame: Option<u32>,
 ) -> Result<(), Failure> {
     let pool = crate::render_cmd::thread_pool(None)?;
     let prepared = pool.install(|| PreparedScene::new_releasing_ir(scene));
@@ -145,13 +267,15 @@ fn verify(
             .ok_or_else(|| Failure::Message("the verification render was cancelled".into()))?;
         let merged = image[y as usize * width as usize + x as usize];
         if again.map(f32::to_bits) != merged.map(f32::to_bits) {
+            let of_frame = frame.map_or_else(String::new, |f| format!(" of frame {f}"));
             return Err(Failure::Message(format!(
-                "--verify: pixel ({x}, {y}) is {merged:?} in the parts but renders as {again:?}: \
-                 the parts do not match this whitted's render of the scene"
+                "--verify: pixel ({x}, {y}){of_frame} is {merged:?} in the parts but renders as \
+                 {again:?}: the parts do not match this whitted's render of the scene"
             )));
         }
     }
-    eprintln!("verified {samples} pixels: each is bit for bit the render's");
+    let of_frame = frame.map_or_else(String::new, |f| format!(" of frame {f}"));
+    eprintln!("verified {samples} pixels{of_frame}: each is bit for bit the render's");
     Ok(())
 }
 

@@ -1,11 +1,10 @@
 //! `whitted farm`: plan a render as tasks for a laptop, Slurm or Kubernetes, see which tasks
 //! are done, and merge their parts into the image a single render makes (docs/farm.md).
 //!
-//! Where animation plugs in: a task is "a set of frames and a pixel region". Today every
-//! plan is one frame (the still) cut into row bands; frames add a frame range to
-//! [`part::Manifest`] and to the task plan (task I of N = frames x bands), and the merge
-//! writes one image per frame. Nothing here assumes a task is a band of one image beyond
-//! the plan and the merge's coverage check.
+//! A task is some frames and, of each, a band of rows (`task::share`): a still is one
+//! frame cut into N bands; an animation is cut into whole frames, or each frame into bands
+//! when N is a multiple of the frame count. A part is one frame's band of one task; the
+//! merge writes one image per frame.
 
 pub mod merge;
 pub mod part;
@@ -30,7 +29,8 @@ pub fn farm(args: &FarmArgs) -> Result<(), Failure> {
     }
 }
 
-/// The scene of `plan` compiled as its tasks compile it, and its fingerprint.
+/// The scene of `plan` compiled as its tasks compile it (at the first frame of an
+/// animation), and its fingerprint.
 pub fn compile_plan_scene(
     plan: &Plan,
 ) -> Result<
@@ -41,7 +41,7 @@ pub fn compile_plan_scene(
     ),
     Failure,
 > {
-    let loaded = load_scene(&plan.scene_args(), true)?;
+    let loaded = load_scene(&plan.fingerprint_args(), true)?;
     let (loaded, options) = apply_render_flags(loaded, &plan.overrides())?;
     let fingerprint = task::fingerprint(&loaded.scene);
     Ok((loaded.scene, options, fingerprint))
@@ -55,15 +55,39 @@ enum TaskStatus {
     Corrupt(String),
 }
 
-fn task_status(parts: &Path, task: u32, tasks: u32, now: &task::Fingerprint) -> TaskStatus {
-    match part::read_part(parts, task, tasks, false) {
-        PartState::Missing => TaskStatus::Missing,
-        PartState::Corrupt(why) => TaskStatus::Corrupt(why),
-        PartState::Intact(manifest, _) => match task::staleness(&manifest, now) {
-            Some(why) => TaskStatus::Stale(why),
-            None => TaskStatus::Done,
-        },
+/// A task's status: the worst of its parts' (corrupt, then stale, then missing), naming
+/// the frame for an animation.
+fn task_status(
+    parts: &Path,
+    task: task::TaskIndex,
+    frames: &[Option<u32>],
+    now: &task::Fingerprint,
+) -> TaskStatus {
+    let mut worst = TaskStatus::Done;
+    for &frame in frames {
+        let of_frame = |why: String| match frame {
+            Some(f) => format!("frame {f}: {why}"),
+            None => why,
+        };
+        let status = match part::read_part(parts, task.index, task.count, frame, false) {
+            PartState::Missing => TaskStatus::Missing,
+            PartState::Corrupt(why) => TaskStatus::Corrupt(of_frame(why)),
+            PartState::Intact(manifest, _) => match task::staleness(&manifest, now) {
+                Some(why) => TaskStatus::Stale(of_frame(why)),
+                None => TaskStatus::Done,
+            },
+        };
+        let rank = |s: &TaskStatus| match s {
+            TaskStatus::Done => 0,
+            TaskStatus::Missing => 1,
+            TaskStatus::Stale(_) => 2,
+            TaskStatus::Corrupt(_) => 3,
+        };
+        if rank(&status) > rank(&worst) {
+            worst = status;
+        }
     }
+    worst
 }
 
 /// `whitted farm status DIR`: one line per task, a summary, and exit 1 unless every task
@@ -74,8 +98,14 @@ fn status(args: &FarmDirArgs) -> Result<(), Failure> {
     let parts = Path::new(&plan.parts);
     let (mut done, mut missing, mut stale, mut corrupt) = (0u32, 0u32, 0u32, 0u32);
     let mut text = String::new();
+    let frames = plan.frame_range();
     for task in 0..plan.tasks {
-        let line = match task_status(parts, task, plan.tasks, &now) {
+        let index = task::TaskIndex {
+            index: task,
+            count: plan.tasks,
+        };
+        let share = task::share(frames.as_ref(), index).map_err(Failure::Message)?;
+        let line = match task_status(parts, index, &share.frames, &now) {
             TaskStatus::Done => {
                 done += 1;
                 "done".to_string()

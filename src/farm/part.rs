@@ -40,6 +40,9 @@ pub struct Manifest {
     pub task: u32,
     /// How many tasks the render was split into.
     pub tasks: u32,
+    /// The frame of an animation this part belongs to; none for a still.
+    #[serde(default)]
+    pub frame: Option<u32>,
     /// The whole image's size.
     pub image_width: u32,
     pub image_height: u32,
@@ -85,13 +88,16 @@ impl From<Region> for PixelRect {
     }
 }
 
-/// The base name of task `task` of `tasks`' files.
-pub fn part_stem(task: u32, tasks: u32) -> String {
-    format!("part-{task:04}-of-{tasks:04}")
+/// The base name of task `task` of `tasks`' files (for one frame of an animation).
+pub fn part_stem(task: u32, tasks: u32, frame: Option<u32>) -> String {
+    match frame {
+        None => format!("part-{task:04}-of-{tasks:04}"),
+        Some(frame) => format!("part-{task:04}-of-{tasks:04}-frame-{frame:06}"),
+    }
 }
 
-pub fn manifest_path(parts: &Path, task: u32, tasks: u32) -> PathBuf {
-    parts.join(format!("{}.json", part_stem(task, tasks)))
+pub fn manifest_path(parts: &Path, task: u32, tasks: u32, frame: Option<u32>) -> PathBuf {
+    parts.join(format!("{}.json", part_stem(task, tasks, frame)))
 }
 
 /// The hex SHA-256 of `bytes`, prefixed `sha256:`.
@@ -171,13 +177,13 @@ pub fn write_part(
     mut manifest: Manifest,
     pixels: &[[f32; 3]],
 ) -> Result<Manifest, String> {
-    let stem = part_stem(manifest.task, manifest.tasks);
+    let stem = part_stem(manifest.task, manifest.tasks, manifest.frame);
     let bytes = encode_pixels(manifest.region.width, manifest.region.height, pixels);
     manifest.pixels_file = format!("{stem}.f32");
     manifest.checksum = checksum(&bytes);
     // An old manifest goes first: a task killed from here on leaves its part missing,
     // rather than an old manifest over new pixels (which would read as corrupt).
-    let manifest_file = manifest_path(parts, manifest.task, manifest.tasks);
+    let manifest_file = manifest_path(parts, manifest.task, manifest.tasks, manifest.frame);
     match std::fs::remove_file(&manifest_file) {
         Ok(()) => {}
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
@@ -202,10 +208,16 @@ pub enum PartState {
     Intact(Box<Manifest>, Option<Vec<[f32; 3]>>),
 }
 
-/// Reads task `task` of `tasks`' part and checks its checksum and shape; keeps the pixels
-/// when `keep_pixels`.
-pub fn read_part(parts: &Path, task: u32, tasks: u32, keep_pixels: bool) -> PartState {
-    let path = manifest_path(parts, task, tasks);
+/// Reads task `task` of `tasks`' part (of `frame`, for an animation) and checks its
+/// checksum and shape; keeps the pixels when `keep_pixels`.
+pub fn read_part(
+    parts: &Path,
+    task: u32,
+    tasks: u32,
+    frame: Option<u32>,
+    keep_pixels: bool,
+) -> PartState {
+    let path = manifest_path(parts, task, tasks, frame);
     let text = match std::fs::read(&path) {
         Ok(text) => text,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return PartState::Missing,
@@ -217,12 +229,15 @@ pub fn read_part(parts: &Path, task: u32, tasks: u32, keep_pixels: bool) -> Part
             return PartState::Corrupt(format!("{} is not a part manifest: {e}", path.display()))
         }
     };
-    if manifest.task != task || manifest.tasks != tasks {
+    if manifest.task != task || manifest.tasks != tasks || manifest.frame != frame {
         return PartState::Corrupt(format!(
-            "{} says it is task {}/{}",
+            "{} says it is task {}/{}{}",
             path.display(),
             manifest.task,
-            manifest.tasks
+            manifest.tasks,
+            manifest
+                .frame
+                .map_or_else(String::new, |f| format!(" of frame {f}"))
         ));
     }
     // The manifest names a file beside it, never a path elsewhere.

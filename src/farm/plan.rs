@@ -31,6 +31,12 @@ pub struct Plan {
     pub scene: String,
     pub defines: Vec<(String, String)>,
     pub sets: Vec<(String, String)>,
+    /// `--frame N`: one frame of an animation, rendered as a still.
+    #[serde(default)]
+    pub frame: Option<u32>,
+    /// The frames of an animation the plan renders, first and last; none for a still.
+    #[serde(default)]
+    pub frames: Option<[u32; 2]>,
     pub width: Option<u32>,
     pub height: Option<u32>,
     pub spp: Option<u32>,
@@ -41,7 +47,8 @@ pub struct Plan {
     pub engine: String,
     /// Where the tasks write their parts (absolute; for Kubernetes, inside the container).
     pub parts: String,
-    /// The merged image the job's last step writes.
+    /// The merged image the job's last step writes (for an animation, a pattern with a
+    /// `{frame}` hole).
     pub merged: String,
     /// The sample render's estimate for one task: seconds on one core and memory in MiB.
     pub estimated_task_cpu_seconds: f64,
@@ -55,6 +62,21 @@ impl Plan {
             scene: PathBuf::from(&self.scene),
             define: self.defines.clone(),
             set: self.sets.clone(),
+            frame: self.frame,
+        }
+    }
+
+    /// The frames of an animation plan.
+    pub fn frame_range(&self) -> Option<std::ops::RangeInclusive<u32>> {
+        self.frames.map(|[first, last]| first..=last)
+    }
+
+    /// The scene arguments at the render's first frame, whose compile fingerprints the
+    /// parts (every frame is made from the same files, flags and whitted).
+    pub fn fingerprint_args(&self) -> SceneArgs {
+        SceneArgs {
+            frame: self.frames.map(|[first, _]| first).or(self.frame),
+            ..self.scene_args()
         }
     }
 
@@ -78,6 +100,14 @@ impl Plan {
         for (name, value) in &self.sets {
             args.push("--set".into());
             args.push(format!("{name}={value}"));
+        }
+        if let Some(frame) = self.frame {
+            args.push("--frame".into());
+            args.push(frame.to_string());
+        }
+        if let Some([first, last]) = self.frames {
+            args.push("--frames".into());
+            args.push(format!("{first}..={last}"));
         }
         for (flag, value) in [
             ("--width", self.width),
@@ -164,13 +194,14 @@ struct Estimate {
 }
 
 /// Renders the scene at a small size (at most about 64x64, same samples and settings),
-/// takes its CPU time per pixel, and scales it to a task's share of the pixels (the
-/// largest band counted 1.5 times the mean). Memory: a task's pixels (12 bytes each, and
-/// 12 per sample of the filter's margin film), the scene, and a base of 64 MiB.
+/// takes its CPU time per pixel, and scales it to a task's share: `frames` frames, each cut
+/// into `bands` bands (the largest band counted 1.5 times the mean). Memory: a task's
+/// pixels of one frame (12 bytes each, and 12 per sample of the filter's margin film), the
+/// scene, and a base of 64 MiB.
 fn estimate(
     prepared: &PreparedScene,
     options: &RenderOptions,
-    tasks: u32,
+    (bands, frames): (u32, u32),
     objects: usize,
 ) -> Estimate {
     let (w, h) = (options.width.max(1), options.height.max(1));
@@ -189,7 +220,10 @@ fn estimate(
     let seconds = started.elapsed().as_secs_f64();
     let per_pixel = seconds / (f64::from(sample.width) * f64::from(sample.height));
     let pixels = f64::from(w) * f64::from(h);
-    let task_pixels = pixels / f64::from(tasks.max(1)) * 1.5;
+    let task_pixels = match bands {
+        0 | 1 => pixels,
+        bands => pixels / f64::from(bands) * 1.5,
+    };
     let film = if whitted_tracer::PixelFilter::from_settings(prepared.settings()).is_own_pixel() {
         0.0
     } else {
@@ -198,7 +232,7 @@ fn estimate(
     let scene_bytes = objects as f64 * 512.0;
     let mib = |bytes: f64| (bytes / (1u64 << 20) as f64).ceil() as u64;
     Estimate {
-        task_cpu_seconds: per_pixel * task_pixels,
+        task_cpu_seconds: per_pixel * task_pixels * f64::from(frames.max(1)),
         task_memory_mib: mib(task_pixels * (24.0 + film) + scene_bytes) + 64,
         merge_memory_mib: mib(pixels * 15.0 * 2.0 + scene_bytes) + 64,
     }
@@ -232,17 +266,34 @@ pub fn plan(args: &FarmPlanArgs) -> Result<(), Failure> {
     let mut scene_args = args.scene.clone();
     scene_args.scene = crate::farm::task::absolute_scene(&args.scene.scene)?;
     let loaded = load_scene(&scene_args, true)?;
+    let frames = crate::farm::task::render_frames(args.frames.clone(), &scene_args, &loaded);
+    let first_task = crate::farm::task::TaskIndex {
+        index: 0,
+        count: args.tasks,
+    };
+    let share = crate::farm::task::share(frames.as_ref(), first_task)
+        .map_err(|e| Failure::Usage(format!("--tasks {}: {e}", args.tasks)))?;
     let (loaded, options) = apply_render_flags(loaded, &args.overrides)?;
-    if args.tasks > options.height {
+    if share.band.count > options.height {
         return Err(Failure::Usage(format!(
-            "--tasks {}: the image has {} rows and each task needs at least one",
-            args.tasks, options.height
+            "--tasks {}: each image would be cut into {} bands, but it has {} rows and each band \
+             needs at least one",
+            args.tasks, share.band.count, options.height
         )));
     }
     let objects = loaded.scene.objects.len();
     let pool = crate::render_cmd::thread_pool(None)?;
     let prepared = pool.install(|| PreparedScene::new_releasing_ir(loaded.scene));
-    let estimate = estimate(&prepared, &options, args.tasks, objects);
+    let frames_per_task = frames.as_ref().map_or(1, |range| {
+        let count = u64::from(*range.end()) - u64::from(*range.start()) + 1;
+        count.div_ceil(u64::from(args.tasks)) as u32
+    });
+    let estimate = estimate(
+        &prepared,
+        &options,
+        (share.band.count, frames_per_task),
+        objects,
+    );
 
     let whitted = std::env::current_exe()
         .map_err(|e| Failure::Message(format!("cannot find the whitted executable: {e}")))?;
@@ -262,12 +313,19 @@ pub fn plan(args: &FarmPlanArgs) -> Result<(), Failure> {
         (
             scene,
             "/farm/parts".to_string(),
-            format!("/farm/{stem}.png"),
+            format!("/farm/{stem}{}.png", frame_hole(&frames)),
         )
     } else {
         let merged = match &args.merged {
+            Some(path) if frames.is_some() && !path.to_string_lossy().contains("{frame") => {
+                return Err(Failure::Usage(format!(
+                    "--merged {}: an animation merges into one image per frame: put the frame \
+                     number in the name, like frame-{{frame:04}}.png",
+                    path.display()
+                )))
+            }
             Some(path) => absolute(path)?,
-            None => dir.join(format!("{stem}.png")),
+            None => dir.join(format!("{stem}{}.png", frame_hole(&frames))),
         };
         (
             scene_args.scene.display().to_string(),
@@ -286,6 +344,8 @@ pub fn plan(args: &FarmPlanArgs) -> Result<(), Failure> {
         scene,
         defines: args.scene.define.clone(),
         sets: args.scene.set.clone(),
+        frame: args.scene.frame,
+        frames: frames.as_ref().map(|r| [*r.start(), *r.end()]),
         width: args.overrides.width,
         height: args.overrides.height,
         spp: args.overrides.spp,
@@ -351,6 +411,14 @@ pub fn plan(args: &FarmPlanArgs) -> Result<(), Failure> {
         estimate.task_memory_mib
     );
     Ok(())
+}
+
+/// The frame number's place in the merged file names of an animation (nothing for a still).
+fn frame_hole(frames: &Option<std::ops::RangeInclusive<u32>>) -> &'static str {
+    match frames {
+        Some(_) => "-{frame:04}",
+        None => "",
+    }
 }
 
 fn absolute(path: &Path) -> Result<PathBuf, Failure> {

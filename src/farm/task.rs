@@ -1,19 +1,20 @@
-//! `whitted render SCENE --task I/N`: render one task of a still split into N parts of
-//! about the same cost, and write it with its manifest into the parts folder.
+//! `whitted render SCENE --task I/N`: render one task of a still or an animation split into
+//! N parts of about the same cost, and write it with its manifests into the parts folder.
 //!
 //! Every task works the plan out on its own (`whitted_tracer::task_plan`, a pure function
 //! of the compiled scene and N), so tasks need no coordinator; the merge checks that the
 //! parts they wrote cover the image exactly once.
 
+use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 
 use sha2::{Digest, Sha256};
 use whitted_ir::ValidScene;
 use whitted_tracer::{PreparedScene, RenderOptions};
 
-use crate::cli::RenderArgs;
+use crate::cli::{RenderArgs, SceneArgs};
 use crate::farm::part::{self, hex, Manifest, PartState, Region, MANIFEST_FORMAT};
-use crate::scene_input::load_scene;
+use crate::scene_input::{load_scene, Loaded};
 use crate::setting_flags::apply_render_flags;
 use crate::Failure;
 
@@ -176,7 +177,88 @@ pub fn absolute_scene(scene: &Path) -> Result<PathBuf, Failure> {
         .map_err(|e| Failure::Message(format!("cannot read {}: {e}", scene.display())))
 }
 
-/// `whitted render --task I/N` (or `--task-from-env`).
+/// What one task renders: some frames (a still is the one frame `None`), and of each
+/// frame one band of rows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Share {
+    pub frames: Vec<Option<u32>>,
+    /// The band of each frame: band `index` of `count` (a count of 1 is the whole image).
+    pub band: TaskIndex,
+}
+
+/// Task `task`'s share of a render of `frames` (`None`: a still). A still is cut into N
+/// bands. An animation of F frames is cut into whole frames when N <= F (contiguous runs of
+/// F/N frames, give or take one), or, when N is a multiple of F, each frame into N/F bands.
+pub fn share(frames: Option<&RangeInclusive<u32>>, task: TaskIndex) -> Result<Share, String> {
+    let Some(range) = frames else {
+        return Ok(Share {
+            frames: vec![None],
+            band: task,
+        });
+    };
+    let count = u64::from(*range.end()) - u64::from(*range.start()) + 1;
+    let (index, tasks) = (u64::from(task.index), u64::from(task.count));
+    let frame = |k: u64| Some(range.start() + k as u32);
+    if tasks <= count {
+        let (first, end) = (index * count / tasks, (index + 1) * count / tasks);
+        Ok(Share {
+            frames: (first..end).map(frame).collect(),
+            band: TaskIndex { index: 0, count: 1 },
+        })
+    } else if tasks % count == 0 {
+        let per = (tasks / count) as u32;
+        Ok(Share {
+            frames: vec![frame(index / u64::from(per))],
+            band: TaskIndex {
+                index: task.index % per,
+                count: per,
+            },
+        })
+    } else {
+        Err(format!(
+            "an animation of {count} frames splits into at most {count} tasks of whole frames, \
+             or into a multiple of {count} tasks (each frame in bands of rows); {tasks} is neither"
+        ))
+    }
+}
+
+/// The frames a render covers: `--frames`, else the scene's own range when it is animated
+/// and no single `--frame` was asked for; `None` for a still.
+pub fn render_frames(
+    frames: Option<RangeInclusive<u32>>,
+    scene: &SceneArgs,
+    loaded: &Loaded,
+) -> Option<RangeInclusive<u32>> {
+    frames.or_else(|| {
+        (scene.frame.is_none() && loaded.scene.settings.is_animated())
+            .then(|| crate::animation::frame_range(loaded))
+    })
+}
+
+/// `scene` compiled at `frame` (as it is, for a still).
+pub fn load_frame(scene: &SceneArgs, frame: Option<u32>, quiet: bool) -> Result<Loaded, Failure> {
+    match frame {
+        None => load_scene(scene, quiet),
+        Some(frame) => load_scene(
+            &SceneArgs {
+                frame: Some(frame),
+                ..scene.clone()
+            },
+            quiet,
+        ),
+    }
+}
+
+/// Whether task `task`'s part of `frame` is intact and made from the scene as it is now.
+fn is_fresh(parts: &Path, task: TaskIndex, frame: Option<u32>, now: &Fingerprint) -> bool {
+    match part::read_part(parts, task.index, task.count, frame, false) {
+        PartState::Intact(manifest, _) => staleness(&manifest, now).is_none(),
+        _ => false,
+    }
+}
+
+/// `whitted render --task I/N` (or `--task-from-env`): the task's share of a still or an
+/// animation, each frame's band written as a part with its manifest.
 pub fn render_task(args: &RenderArgs) -> Result<(), Failure> {
     let task = match args.task {
         Some(task) => task,
@@ -186,8 +268,22 @@ pub fn render_task(args: &RenderArgs) -> Result<(), Failure> {
     let mut scene_args = args.scene.clone();
     scene_args.scene = absolute_scene(&args.scene.scene)?;
     let loaded = load_scene(&scene_args, args.quiet)?;
-    let (loaded, options) = apply_render_flags(loaded, &args.overrides)?;
-    let now = fingerprint(&loaded.scene);
+    let frames = render_frames(args.frames.clone(), &scene_args, &loaded);
+    let share = share(frames.as_ref(), task)
+        .map_err(|e| Failure::Usage(format!("--task {}/{}: {e}", task.index, task.count)))?;
+    // Parts are checked against the scene at the render's first frame: every other frame
+    // is made from the same files, flags and whitted.
+    let first = frames.as_ref().map(|r| *r.start());
+    let first_loaded = match first {
+        Some(frame) if scene_args.frame != Some(frame) => {
+            load_frame(&scene_args, Some(frame), true)?
+        }
+        _ => loaded,
+    };
+    let first_loaded = apply_render_flags(first_loaded, &args.overrides)?;
+    let now = fingerprint(&first_loaded.0.scene);
+    // The scene compiled above serves its own frame, once.
+    let mut first_loaded = Some(first_loaded);
     std::fs::create_dir_all(&args.parts)
         .map_err(|e| Failure::Message(format!("cannot create {}: {e}", args.parts.display())))?;
     let say = |text: String| {
@@ -195,60 +291,77 @@ pub fn render_task(args: &RenderArgs) -> Result<(), Failure> {
             eprintln!("{text}");
         }
     };
-    if !args.force {
-        if let PartState::Intact(manifest, _) =
-            part::read_part(&args.parts, task.index, task.count, false)
-        {
-            if staleness(&manifest, &now).is_none() {
-                say(format!(
-                    "task {}/{}: its part in {} is complete and up to date; nothing to do \
-                     (--force renders it again)",
-                    task.index,
-                    task.count,
-                    args.parts.display()
-                ));
-                return Ok(());
-            }
-        }
-    }
+    let name = |frame: Option<u32>| match frame {
+        None => format!("task {}/{}", task.index, task.count),
+        Some(f) => format!("task {}/{}, frame {f}", task.index, task.count),
+    };
     let pool = crate::render_cmd::thread_pool(args.threads)?;
     let scene_path = scene_args.scene.display().to_string();
-    let prepared = pool.install(|| PreparedScene::new_releasing_ir(loaded.scene));
-    let region = plan_region(&pool, &prepared, &options, task)?;
-    let rendered = pool.install(|| {
-        whitted_tracer::render_region(&prepared, &options, region, &whitted_tracer::NoObserver)
-    });
-    let Some((image, stats)) = rendered else {
-        return Err(Failure::Message(
-            "the render was cancelled; nothing was written".into(),
+    for frame in share.frames {
+        if !args.force && is_fresh(&args.parts, task, frame, &now) {
+            say(format!(
+                "{}: its part in {} is complete and up to date; nothing to do (--force renders \
+                 it again)",
+                name(frame),
+                args.parts.display()
+            ));
+            continue;
+        }
+        let compiled = if frame == first {
+            first_loaded.take()
+        } else {
+            None
+        };
+        let (loaded, options) = match compiled {
+            Some(compiled) => compiled,
+            None => apply_render_flags(load_frame(&scene_args, frame, true)?, &args.overrides)?,
+        };
+        let prepared = pool.install(|| PreparedScene::new_releasing_ir(loaded.scene));
+        let region = if share.band.count == 1 {
+            whitted_tracer::PixelRect {
+                x: 0,
+                y: 0,
+                width: options.width,
+                height: options.height,
+            }
+        } else {
+            plan_region(&pool, &prepared, &options, share.band)?
+        };
+        let rendered = pool.install(|| {
+            whitted_tracer::render_region(&prepared, &options, region, &whitted_tracer::NoObserver)
+        });
+        let Some((image, stats)) = rendered else {
+            return Err(Failure::Message(
+                "the render was cancelled; nothing was written".into(),
+            ));
+        };
+        let manifest = Manifest {
+            format: MANIFEST_FORMAT,
+            whitted_version: env!("CARGO_PKG_VERSION").to_string(),
+            scene: scene_path.clone(),
+            scene_hash: now.scene_hash.clone(),
+            settings_hash: now.settings_hash.clone(),
+            settings: now.settings.clone(),
+            task: task.index,
+            tasks: task.count,
+            frame,
+            image_width: options.width,
+            image_height: options.height,
+            region: Region::from(region),
+            pixels_file: String::new(),
+            checksum: String::new(),
+            rays: stats.total_rays(),
+            render_seconds: stats.render_seconds,
+        };
+        part::write_part(&args.parts, manifest, &image.pixels).map_err(Failure::Message)?;
+        say(format!(
+            "{}: rows {}..{} written to {}",
+            name(frame),
+            region.y,
+            region.y + region.height,
+            args.parts.display()
         ));
-    };
-    let manifest = Manifest {
-        format: MANIFEST_FORMAT,
-        whitted_version: env!("CARGO_PKG_VERSION").to_string(),
-        scene: scene_path,
-        scene_hash: now.scene_hash,
-        settings_hash: now.settings_hash,
-        settings: now.settings,
-        task: task.index,
-        tasks: task.count,
-        image_width: options.width,
-        image_height: options.height,
-        region: Region::from(region),
-        pixels_file: String::new(),
-        checksum: String::new(),
-        rays: stats.total_rays(),
-        render_seconds: stats.render_seconds,
-    };
-    part::write_part(&args.parts, manifest, &image.pixels).map_err(Failure::Message)?;
-    say(format!(
-        "task {}/{}: rows {}..{} written to {}",
-        task.index,
-        task.count,
-        region.y,
-        region.y + region.height,
-        args.parts.display()
-    ));
+    }
     Ok(())
 }
 
@@ -283,6 +396,48 @@ mod tests {
         assert!(parse_task("x").unwrap_err().contains("not a task"));
         assert!(parse_task("-1/3").is_err());
         assert!(parse_task("1/2/3").is_err());
+    }
+
+    fn task(index: u32, count: u32) -> TaskIndex {
+        TaskIndex { index, count }
+    }
+
+    #[test]
+    fn an_animation_splits_into_whole_frames_or_bands_of_every_frame() {
+        // A still: band I of N.
+        let still = share(None, task(2, 5)).unwrap();
+        assert_eq!((still.frames, still.band), (vec![None], task(2, 5)));
+        // 10 frames from 3 in 4 tasks: runs of 2 or 3 whole frames, every frame once.
+        let frames = 3..=12;
+        let runs: Vec<Vec<Option<u32>>> = (0..4)
+            .map(|i| share(Some(&frames), task(i, 4)).unwrap().frames)
+            .collect();
+        assert_eq!(
+            runs,
+            vec![
+                vec![Some(3), Some(4)],
+                vec![Some(5), Some(6), Some(7)],
+                vec![Some(8), Some(9)],
+                vec![Some(10), Some(11), Some(12)],
+            ]
+        );
+        assert_eq!(share(Some(&frames), task(3, 4)).unwrap().band, task(0, 1));
+        // 10 tasks of 10 frames: one frame each; 30: three bands of each frame.
+        assert_eq!(
+            share(Some(&frames), task(9, 10)).unwrap().frames,
+            vec![Some(12)]
+        );
+        let banded = share(Some(&frames), task(7, 30)).unwrap();
+        assert_eq!((banded.frames, banded.band), (vec![Some(5)], task(1, 3)));
+        // 15 tasks of 10 frames is neither.
+        let refused = share(Some(&frames), task(0, 15)).unwrap_err();
+        assert!(refused.contains("multiple of 10"), "{refused}");
+        // One frame and the largest frame numbers do not overflow.
+        let last = u32::MAX - 1..=u32::MAX;
+        assert_eq!(
+            share(Some(&last), task(1, 2)).unwrap().frames,
+            vec![Some(u32::MAX)]
+        );
     }
 
     fn env<'a>(pairs: &'a [(&'a str, &'a str)]) -> impl Fn(&str) -> Option<String> + 'a {

@@ -437,3 +437,67 @@ fn a_task_from_the_environment_needs_the_flag() {
     assert!(status.success());
     assert!(parts.join("part-0001-of-0002.json").exists());
 }
+
+#[test]
+fn an_animation_merges_frame_by_frame_byte_identical_to_one_render() {
+    let temp = tempfile::tempdir().unwrap();
+    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/turntable.scene");
+    let frames = ["--frames", "3..=8"];
+    let single = temp.path().join("single-{frame}.png");
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        single.to_str().unwrap(),
+    ];
+    args.extend(SIZE);
+    args.extend(frames);
+    args.push("--quiet");
+    ok(&args);
+    // 6 frames: runs of whole frames (4 tasks), one frame each (6), bands of each (12).
+    for tasks in [4, 6, 12] {
+        let dir = temp.path().join(format!("farm-{tasks}"));
+        let dir_text = plan(&scene, &dir, tasks, &frames);
+        ok(&["farm", "run", &dir_text]);
+        for frame in 3..=8 {
+            let merged = std::fs::read(dir.join(format!("turntable-{frame:04}.png")))
+                .unwrap_or_else(|e| panic!("{tasks} tasks: frame {frame}: {e}"));
+            let single = std::fs::read(temp.path().join(format!("single-{frame}.png"))).unwrap();
+            assert!(merged == single, "{tasks} tasks: frame {frame} differs");
+        }
+        assert!(!dir.join("turntable-0002.png").exists());
+        assert!(!dir.join("turntable-0009.png").exists());
+    }
+    // A lost frame's part: status names the task and the merge writes no frame at all.
+    let dir = temp.path().join("farm-4");
+    let dir_text = dir.display().to_string();
+    std::fs::remove_file(dir.join("parts/part-0001-of-0004-frame-000005.json")).unwrap();
+    let (done, report) = status_of(&dir_text, 1);
+    assert!(!done && report.contains("missing"), "{report}");
+    let again = temp.path().join("again-{frame}.png");
+    let output = run(&["farm", "merge", &dir_text, "-o", again.to_str().unwrap()]);
+    assert!(!output.status.success());
+    assert!(
+        text(&output).contains("task 1/4, frame 5"),
+        "{}",
+        text(&output)
+    );
+    assert!(
+        !temp.path().join("again-3.png").exists(),
+        "nothing is written"
+    );
+    // Tasks that do not split 6 frames evenly are refused when planning.
+    let output = run(&[
+        "farm",
+        "plan",
+        scene.to_str().unwrap(),
+        "--tasks",
+        "9",
+        "--frames",
+        "3..=8",
+        "-o",
+        temp.path().join("nine").to_str().unwrap(),
+    ]);
+    assert_eq!(output.status.code(), Some(2), "{}", text(&output));
+    assert!(text(&output).contains("multiple of 6"), "{}", text(&output));
+}

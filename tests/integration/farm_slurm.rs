@@ -1,6 +1,7 @@
 //! The render farm on a real Slurm cluster (`slurm_cluster.rs`): `whitted farm plan
 //! --engine slurm` and its `submit.sh` run by the real `sbatch`, the parts merged by the
-//! dependent merge job, and the result compared byte for byte with one `whitted render`;
+//! dependent merge job, and the result (a still, and a 12-frame animation) compared byte for
+//! byte with one `whitted render`;
 //! then a cancelled task, reported by `farm status`, redone by submitting the plan again.
 //! Without Slurm the test says so and runs the same plan through the shell engine, unless
 //! `WHITTED_REQUIRE_SLURM` is set (`.ci/run` sets it, having installed Slurm).
@@ -105,6 +106,39 @@ fn a_slurm_plan_merges_byte_identical_to_one_render_and_redoes_a_cancelled_task(
     assert!(merged == single, "the merged image differs from one render");
     let report = status(&dir);
     assert!(report.status.success(), "{}", text(&report));
+
+    // A 12-frame animation in 4 tasks of 3 whole frames, each frame equal to one render's.
+    let dir = work.path().join("animation");
+    let turntable = "scenes/turntable.scene";
+    let frames = ["--frames", "0..=11"];
+    let mut args = vec![
+        "farm", "plan", turntable, "--tasks", "4", "--engine", "slurm", "-o",
+    ];
+    let dir_text = dir.display().to_string();
+    args.push(&dir_text);
+    args.extend(SIZE);
+    args.extend(frames);
+    ok(&args);
+    let (array, merge) = submit(&cluster, &dir);
+    cluster.wait_for(&array, limit);
+    cluster.wait_for(&merge, limit);
+    assert_eq!(cluster.job_state(&merge), "COMPLETED", "{}", cluster.logs());
+    let pattern = work.path().join("single-{frame}.png");
+    let mut args = vec![
+        "render",
+        turntable,
+        "-o",
+        pattern.to_str().unwrap(),
+        "--quiet",
+    ];
+    args.extend(SIZE);
+    args.extend(frames);
+    ok(&args);
+    for frame in 0..12 {
+        let merged = std::fs::read(dir.join(format!("turntable-{frame:04}.png"))).unwrap();
+        let single = std::fs::read(work.path().join(format!("single-{frame}.png"))).unwrap();
+        assert!(merged == single, "frame {frame} differs from one render's");
+    }
 
     // Task 2 cancelled before it runs (the node is held so that it cannot run first): the
     // merge waits forever on it, and status names it.
