@@ -607,7 +607,18 @@ impl App {
                 } else {
                     ""
                 };
-                self.set_message(format!("reloaded {}{note}{closed}", self.scene_name), false);
+                // An animated scene says which frame is shown now (`<` `>` step them).
+                let frame = match self.frame {
+                    Some(frame) if self.loaded.scene.settings.is_animated() => {
+                        let range = self.loaded.scene.settings.frame_range();
+                        format!(" at frame {frame} of {} to {}", range.start(), range.end())
+                    }
+                    _ => String::new(),
+                };
+                self.set_message(
+                    format!("reloaded {}{frame}{note}{closed}", self.scene_name),
+                    false,
+                );
                 let mut effects = vec![Effect::StartRender];
                 effects.extend(retrace);
                 effects
