@@ -548,9 +548,16 @@ fn write_video(
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
-    let temp = tempfile::Builder::new()
-        .prefix(".whitted-")
-        .suffix(&format!(".{extension}"))
+    let mut builder = tempfile::Builder::new();
+    let suffix = format!(".{extension}");
+    builder.prefix(".whitted-").suffix(&suffix);
+    // A video is an ordinary file, not a private one (tempfile's 0600): 0666 and the umask.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let temp = builder
         .tempfile_in(dir)
         .map_err(|e| Failure::Message(format!("cannot write {}: {e}", output.display())))?;
     let _registered = crate::interrupt::register(temp.path());

@@ -152,23 +152,11 @@ pub fn decode_pixels(bytes: &[u8]) -> Result<(u32, u32, Vec<[f32; 3]>), String> 
 }
 
 /// Writes `bytes` to `path` through a temporary file in the same folder, renamed over it
-/// only once complete and synced.
+/// only once complete and synced (with the permissions any written image gets).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let dir = match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let describe = |e: &dyn std::fmt::Display| format!("cannot write {}: {e}", path.display());
-    let mut temp = tempfile::Builder::new()
-        .prefix(".whitted-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(|e| describe(&e))?;
-    let _registered = crate::interrupt::register(temp.path());
-    temp.write_all(bytes).map_err(|e| describe(&e))?;
-    temp.as_file().sync_all().map_err(|e| describe(&e))?;
-    temp.persist(path).map_err(|e| describe(&e.error))?;
-    Ok(())
+    crate::image_output::write_atomically(path, |file| {
+        file.write_all(bytes).map_err(|e| e.to_string())
+    })
 }
 
 /// Writes a part: the pixels, then the manifest (with the pixels' checksum filled in).

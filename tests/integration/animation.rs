@@ -354,3 +354,48 @@ fn a_video_without_ffmpeg_says_that_ffmpeg_is_needed() {
     assert!(message.contains("needs ffmpeg"), "{message}");
     assert!(!video.exists());
 }
+
+#[test]
+fn a_video_through_ffmpeg_holds_every_frame_and_is_not_private() {
+    let has = |program: &str| {
+        std::process::Command::new(program)
+            .arg("-version")
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !has("ffmpeg") || !has("ffprobe") {
+        eprintln!(
+            "ffmpeg is not installed here: the video path is not run (apt-get install ffmpeg)"
+        );
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let video = dir.path().join("turn.mp4");
+    let video_text = video.to_str().unwrap();
+    let args = [
+        "render",
+        "scenes/turntable.scene",
+        "--frames",
+        "0..=5",
+        "-o",
+        video_text,
+    ];
+    crate::support::ok(&args);
+    let probe = std::process::Command::new("ffprobe")
+        .args(["-v", "error", "-count_frames", "-show_entries"])
+        .args([
+            "stream=nb_read_frames,width,height",
+            "-of",
+            "csv=p=0",
+            video_text,
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(String::from_utf8_lossy(&probe.stdout).trim(), "160,120,6");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&video).unwrap().permissions().mode();
+        assert_ne!(mode & 0o044, 0, "the video is private: {mode:o}");
+    }
+}

@@ -468,6 +468,14 @@ fn an_animation_merges_frame_by_frame_byte_identical_to_one_render() {
         assert!(!dir.join("turntable-0002.png").exists());
         assert!(!dir.join("turntable-0009.png").exists());
     }
+    // Parts are ordinary files that another user of the cluster's folder can read.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let part = temp.path().join("farm-4/parts/part-0001-of-0004-frame-000005.f32");
+        let mode = std::fs::metadata(part).unwrap().permissions().mode();
+        assert_ne!(mode & 0o044, 0, "the part is private: {mode:o}");
+    }
     // A lost frame's part: status names the task and the merge writes no frame at all.
     let dir = temp.path().join("farm-4");
     let dir_text = dir.display().to_string();
