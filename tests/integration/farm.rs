@@ -472,7 +472,9 @@ fn an_animation_merges_frame_by_frame_byte_identical_to_one_render() {
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
-        let part = temp.path().join("farm-4/parts/part-0001-of-0004-frame-000005.f32");
+        let part = temp
+            .path()
+            .join("farm-4/parts/part-0001-of-0004-frame-000005.f32");
         let mode = std::fs::metadata(part).unwrap().permissions().mode();
         assert_ne!(mode & 0o044, 0, "the part is private: {mode:o}");
     }
