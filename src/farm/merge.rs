@@ -22,7 +22,7 @@ pub fn merge(args: &FarmMergeArgs) -> Result<(), Failure> {
     let Some(range) = plan.frame_range() else {
         crate::render_cmd::check_output_folder(&args.output)?;
         let tasks: Vec<u32> = (0..plan.tasks).collect();
-        let image = assemble(&plan, parts, &now, None, &tasks, &options)?;
+        let image = assemble((&args.dir, &plan), parts, &now, None, &tasks, &options)?;
         if args.verify {
             verify(scene, &options, &image, args.samples, None)?;
         }
@@ -60,9 +60,8 @@ pub fn merge(args: &FarmMergeArgs) -> Result<(), Failure> {
                 parts,
                 &now,
                 &name,
-                index,
-                plan.tasks,
-                Some(frame),
+                (index, plan.tasks, Some(frame)),
+                false,
             )?;
         }
     }
@@ -76,7 +75,14 @@ pub fn merge(args: &FarmMergeArgs) -> Result<(), Failure> {
                 (loaded.scene, options)
             }
         };
-        let image = assemble(&plan, parts, &now, Some(frame), &tasks, &options)?;
+        let image = assemble(
+            (&args.dir, &plan),
+            parts,
+            &now,
+            Some(frame),
+            &tasks,
+            &options,
+        )?;
         if args.verify {
             verify(scene, &options, &image, args.samples, Some(frame))?;
         }
@@ -108,20 +114,9 @@ fn part_name(plan: &Plan, index: u32, frame: Option<u32>) -> String {
     }
 }
 
-/// A part that is there, intact and fresh, or the error naming it.
+/// A part that is there, intact and fresh (its pixels when `keep_pixels`), or the error
+/// naming it.
 fn check_part(
-    dir: &Path,
-    parts: &Path,
-    now: &task::Fingerprint,
-    name: &str,
-    index: u32,
-    tasks: u32,
-    frame: Option<u32>,
-) -> Result<(Box<part::Manifest>, Vec<[f32; 3]>), Failure> {
-    check_part_reading(dir, parts, now, name, (index, tasks, frame), false)
-}
-
-fn check_part_reading(
     dir: &Path,
     parts: &Path,
     now: &task::Fingerprint,
@@ -153,14 +148,13 @@ fn check_part_reading(
 /// One image (of `frame`, for an animation) from the parts of `tasks`: each checked, placed,
 /// and the whole covered exactly once.
 fn assemble(
-    plan: &Plan,
+    (dir, plan): (&Path, &Plan),
     parts: &Path,
     now: &task::Fingerprint,
     frame: Option<u32>,
     tasks: &[u32],
     options: &RenderOptions,
 ) -> Result<Vec<[f32; 3]>, Failure> {
-    let dir = Path::new(&plan.parts).parent().unwrap_or(Path::new("."));
     let (width, height) = (options.width, options.height);
     let mut image = vec![[0.0f32; 3]; width as usize * height as usize];
     let mut placed: Vec<(u32, PixelRect)> = Vec::with_capacity(tasks.len());
@@ -168,7 +162,7 @@ fn assemble(
     for &index in tasks {
         let name = part_name(plan, index, frame);
         let (manifest, pixels) =
-            check_part_reading(dir, parts, now, &name, (index, plan.tasks, frame), true)?;
+            check_part(dir, parts, now, &name, (index, plan.tasks, frame), true)?;
         if (manifest.image_width, manifest.image_height) != (width, height) {
             return Err(Failure::Message(format!(
                 "{name}: refused: the part belongs to a {}x{} image, the scene makes {width}x{height}",

@@ -318,12 +318,7 @@ pub fn render_task(args: &RenderArgs) -> Result<(), Failure> {
         };
         let prepared = pool.install(|| PreparedScene::new_releasing_ir(loaded.scene));
         let region = if share.band.count == 1 {
-            whitted_tracer::PixelRect {
-                x: 0,
-                y: 0,
-                width: options.width,
-                height: options.height,
-            }
+            whitted_tracer::PixelRect::whole(options.width, options.height)
         } else {
             plan_region(&pool, &prepared, &options, share.band)?
         };

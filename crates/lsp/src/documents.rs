@@ -1,12 +1,25 @@
 //! The open documents: each one's text as the editor has it (which imports read instead of
 //! the disk), its line index, and what the last analysis of that text found.
 
+use std::collections::HashMap;
 use std::path::PathBuf;
 
 use lsp_types::{TextDocumentContentChangeEvent, Url};
 
 use crate::analysis::Analysis;
 use crate::position::LineIndex;
+
+/// The open documents whose last analysis kept an editor index (every file parsed), each
+/// with its analysis and index: what references, renames and file strings search.
+pub fn indexed(
+    documents: &HashMap<Url, Document>,
+) -> impl Iterator<Item = (&Url, &Document, &Analysis, &whitted_lang::editor::Index)> {
+    documents.iter().filter_map(|(uri, document)| {
+        let analysis = document.analysis.as_ref()?;
+        let index = analysis.index.as_ref()?;
+        Some((uri, document, analysis, index))
+    })
+}
 
 pub struct Document {
     pub text: String,

@@ -9,7 +9,7 @@ use lsp_types::{Location, Url};
 use whitted_ir::Span;
 
 use crate::analysis::Locator;
-use crate::documents::Document;
+use crate::documents::{indexed, Document};
 
 /// A place in a file: its URI and byte range (the same file read by two compiles has the
 /// same bytes, so the same place has the same key in both).
@@ -59,13 +59,7 @@ pub fn occurrences(documents: &HashMap<Url, Document>, definition: &Place) -> Op
     let mut found: BTreeSet<Place> = BTreeSet::new();
     let mut locations: HashMap<Place, Location> = HashMap::new();
     let mut name = None;
-    for (uri, document) in documents {
-        let Some(analysis) = document.analysis.as_ref() else {
-            continue;
-        };
-        let Some(index) = analysis.index.as_ref() else {
-            continue;
-        };
+    for (uri, document, analysis, index) in indexed(documents) {
         let mut locator = Locator::new(uri, &analysis.sources, &document.lines);
         let mut add = |locator: &mut Locator<'_>, span: Span| {
             let Some(at) = place(locator, span) else {

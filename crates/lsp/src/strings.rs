@@ -24,7 +24,7 @@ use lsp_types::{Location, PrepareRenameResponse, Range, TextEdit, Url, Workspace
 use whitted_ir::Span;
 
 use crate::analysis::{Analysis, Locator};
-use crate::documents::Document;
+use crate::documents::{indexed, Document};
 use crate::references::Place;
 use crate::Files;
 
@@ -115,13 +115,7 @@ impl Found {
 /// name's literal, with its quotes.
 fn objects_named(documents: &HashMap<Url, Document>, uri: &Url, name: &str) -> Found {
     let mut found = Found::default();
-    for (other, document) in documents {
-        let Some(analysis) = document.analysis.as_ref() else {
-            continue;
-        };
-        let Some(index) = analysis.index.as_ref() else {
-            continue;
-        };
+    for (other, document, analysis, index) in indexed(documents) {
         if !reads(other, analysis, uri) {
             continue;
         }
@@ -172,13 +166,7 @@ pub fn references(
         }
         Named::File { identity, path } => {
             let mut found = Found::default();
-            for (other, document) in documents {
-                let Some(analysis) = document.analysis.as_ref() else {
-                    continue;
-                };
-                let Some(index) = analysis.index.as_ref() else {
-                    continue;
-                };
+            for (other, document, analysis, index) in indexed(documents) {
                 let mut locator = Locator::new(other, &analysis.sources, &document.lines);
                 for (span, written) in &index.paths {
                     let same = resolve(analysis, *span, written)
@@ -341,13 +329,7 @@ pub fn will_rename(
     let mut edits: HashMap<Place, Location> = HashMap::new();
     let mut texts: HashMap<Place, String> = HashMap::new();
     let mut places: BTreeSet<Place> = BTreeSet::new();
-    for (uri, document) in documents {
-        let Some(analysis) = document.analysis.as_ref() else {
-            continue;
-        };
-        let Some(index) = analysis.index.as_ref() else {
-            continue;
-        };
+    for (uri, document, analysis, index) in indexed(documents) {
         let mut locator = Locator::new(uri, &analysis.sources, &document.lines);
         for (span, written) in &index.paths {
             let (Some(target), Some(source)) = (

@@ -94,14 +94,6 @@ impl PixelRect {
         }
         .clipped(width, height)
     }
-
-    /// Whether pixel `(x, y)` lies inside.
-    pub fn contains(&self, x: u32, y: u32) -> bool {
-        x >= self.x
-            && y >= self.y
-            && u64::from(x) < u64::from(self.x) + u64::from(self.width)
-            && u64::from(y) < u64::from(self.y) + u64::from(self.height)
-    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
