@@ -329,7 +329,22 @@ fn bad_task_input_gets_a_clear_message() {
     let temp = tempfile::tempdir().unwrap();
     let scene_text = scene().display().to_string();
     let parts = temp.path().join("parts").display().to_string();
-    let cases: [(&[&str], i32, &str); 6] = [
+    let out = temp.path().join("whole.png").display().to_string();
+    let small = ["--width", "8", "--height", "6", "-o"];
+    let force: Vec<&str> = ["render", scene_text.as_str(), "--force"]
+        .into_iter()
+        .chain(small)
+        .chain([out.as_str()])
+        .collect();
+    let parts_alone: Vec<&str> = ["render", scene_text.as_str(), "--parts", parts.as_str()]
+        .into_iter()
+        .chain(small)
+        .chain([out.as_str()])
+        .collect();
+    let cases: [(&[&str], i32, &str); 8] = [
+        // --force and --parts mean nothing without a task: refused, not silently ignored.
+        (&force, 2, "<--task <I/N>|--task-from-env>"),
+        (&parts_alone, 2, "<--task <I/N>|--task-from-env>"),
         (
             &["render", &scene_text, "--task", "5/4", "--parts", &parts],
             2,

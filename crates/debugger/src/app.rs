@@ -791,6 +791,29 @@ mod tests {
     }
 
     #[test]
+    fn a_reload_of_an_animated_scene_says_which_frame_it_shows() {
+        let animated = || {
+            let mut scene = whitted_scene().into_inner();
+            scene.settings.first_frame = 4;
+            scene.settings.frames = 3;
+            whitted_ir::validate(scene).unwrap_or_else(|_| panic!("invalid"))
+        };
+        let mut app = App::new(
+            "scenes/whitted.scene".into(),
+            LoadedScene::new(animated()),
+            Rect::new(0, 0, 120, 40),
+            "/tmp".into(),
+        );
+        app.frame = Some(5);
+        app.reloading = true;
+        app.apply_reload(Ok((LoadedScene::new(animated()), 0)));
+        assert_eq!(
+            app.message.as_ref().map(|m| m.text.as_str()),
+            Some("reloaded scenes/whitted.scene at frame 5 of 4 to 6")
+        );
+    }
+
+    #[test]
     fn a_failed_reload_keeps_the_scene_and_shows_errors_until_a_good_one() {
         let mut app = app();
         app.render_started(1);
