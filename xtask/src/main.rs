@@ -24,8 +24,12 @@ commands:
   deps     only the dependency-direction checks
   golden   render the golden scenes and compare with tests/golden/ (--bless to update;
            --scenes DIR --refs DIR for your own folders)
-  bench    release build, then time the benchmark scenes (prints Mrays/s);
-           --size WxH, --programs (only the scenes-written-by-programs table)
+  bench    release build, then time the benchmark scenes (prints Mrays/s), each run
+           alternately with the base revision's binary and printed beside it;
+           --size WxH, --only TEXT (only the render rows whose label has TEXT),
+           --base REV (default HEAD~1 on a clean work tree, HEAD on a changed one),
+           --no-base, --mesh (only the mesh rows), --csg (only the CSG rows),
+           --programs (only the scenes-written-by-programs table), --lsp
   fuzz     the whole-pipeline fuzzer: --cases N (1000), --seed S (from the clock),
            --case K (only case K of the seed), --save (shrink new failures into
            tests/fuzz-regressions/), --replay (only the regression inputs)";

@@ -1,31 +1,47 @@
-//! The bench's mesh case (issue 11): a sphere of 1,000,000 triangles written as an `.obj`
-//! (500 bands of 1,000 quads, every vertex shared, so it is a closed solid) with a scene that
-//! renders it as glass over a floor, so that rays enter, cross and leave the mesh.
+//! The bench's generated mesh cases (issue 11, issue 31): a sphere of 1,000,000 triangles
+//! written as an `.obj` (500 bands of 1,000 quads, every vertex shared, so it is a closed
+//! solid) with two scenes over a floor: matte (opaque, diffuse and specular: the primary and
+//! shadow rays' cost) and glass (rays enter, cross and leave the mesh).
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Bands from pole to pole, and quads around each: 2·SLICES·(STACKS − 1) triangles.
 const STACKS: u32 = 501;
 const SLICES: u32 = 1_000;
 
-/// Writes `mesh1m.obj` and `mesh1m.scene` into `dir` (once: the files are kept between
-/// runs) and returns the scene's path.
-pub(super) fn write(dir: &Path) -> anyhow::Result<PathBuf> {
+pub(super) const MATTE_SCENE: &str = "mesh1m-matte.scene";
+pub(super) const GLASS_SCENE: &str = "mesh1m-glass.scene";
+
+const SETTING: &str = "camera perspective { eye <0, 1.2, -4.5> look_at <0, 0.2, 0> fov 40 }\n\
+                       light point { position <3, 6, -4> }\n\
+                       plane { normal <0, 1, 0> offset -1 material { diffuse checker(rgb(0.9, 0.9, 0.9), rgb(0.2, 0.3, 0.2), 0.5) } }\n";
+
+/// Writes `mesh1m.obj` (once: it is kept between runs) and the matte and glass scenes that
+/// render it into `dir`.
+pub(super) fn write(dir: &Path) -> anyhow::Result<()> {
     let obj = dir.join("mesh1m.obj");
-    let scene = dir.join("mesh1m.scene");
     if !obj.exists() {
-        std::fs::write(&obj, sphere_obj(STACKS, SLICES))?;
+        // Under another name first, so that an interrupted run leaves no half sphere.
+        let partial = dir.join("mesh1m.obj.partial");
+        std::fs::write(&partial, sphere_obj(STACKS, SLICES))?;
+        std::fs::rename(&partial, &obj)?;
     }
     std::fs::write(
-        &scene,
-        "// Written by `cargo xtask bench`: a glass sphere of 1,000,000 triangles.\n\
-         camera perspective { eye <0, 1.2, -4.5> look_at <0, 0.2, 0> fov 40 }\n\
-         light point { position <3, 6, -4> }\n\
-         plane { normal <0, 1, 0> offset -1 material { diffuse checker(rgb(0.9, 0.9, 0.9), rgb(0.2, 0.3, 0.2), 0.5) } }\n\
-         mesh \"ball\" { file \"mesh1m.obj\" material { diffuse 0 specular 0.8 shininess 200 transmissive 0.9 reflective 0.1 ior 1.5 } }\n",
+        dir.join(MATTE_SCENE),
+        format!(
+            "// Written by `cargo xtask bench`: an opaque sphere of 1,000,000 triangles.\n{SETTING}\
+             mesh \"ball\" {{ file \"mesh1m.obj\" material {{ diffuse <0.8, 0.3, 0.2> specular 0.5 shininess 60 }} }}\n"
+        ),
     )?;
-    Ok(scene)
+    std::fs::write(
+        dir.join(GLASS_SCENE),
+        format!(
+            "// Written by `cargo xtask bench`: a glass sphere of 1,000,000 triangles.\n{SETTING}\
+             mesh \"ball\" {{ file \"mesh1m.obj\" material {{ diffuse 0 specular 0.8 shininess 200 transmissive 0.9 reflective 0.1 ior 1.5 }} }}\n"
+        ),
+    )?;
+    Ok(())
 }
 
 /// A unit sphere as OBJ text: poles, then rings of `slices` vertices, faces wound outward.

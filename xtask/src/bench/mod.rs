@@ -1,7 +1,9 @@
 //! `cargo xtask bench`: builds the release binary and times the benchmark scenes.
 //!
 //! Prints figures; asserts nothing about time (machines are noisy and shared). Each render
-//! runs with one thread (the honest per-core figure) and with every core.
+//! runs with one thread (the honest per-core figure) and with every core, alternately with
+//! the base revision's binary (`base.rs`) when there is one, so that each figure is printed
+//! beside the base's from the same minutes of the same machine.
 
 use std::path::Path;
 use std::process::Command;
@@ -12,8 +14,14 @@ use serde::Deserialize;
 
 use crate::{run_cargo, run_cargo_with, workspace_root};
 
+mod base;
+mod compare;
+mod dragon;
 mod mesh;
+mod options;
 mod programs;
+
+use compare::{change, is_regression, spread, Better};
 
 /// One benchmark render: a scene, its `-D` overrides and what to print it as.
 struct Case {
@@ -23,6 +31,17 @@ struct Case {
     defines: &'static [&'static str],
     /// The equivalent POV-Ray scene, for a side-by-side figure when `povray` is installed.
     pov: Option<&'static str>,
+    /// What writes the scene under target/bench/ before it is rendered (`--mesh` rows).
+    generated: Option<Generated>,
+}
+
+/// The scenes the bench writes itself rather than keeps in `scenes/bench/`.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Generated {
+    /// `mesh.rs`: the 1,000,000-triangle sphere.
+    Sphere,
+    /// `dragon.rs`: the Stanford dragon, fetched from the npm registry.
+    Dragon,
 }
 
 const RENDERS: &[Case] = &[
@@ -31,31 +50,49 @@ const RENDERS: &[Case] = &[
         scene: "scenes/bench/classic.scene",
         defines: &[],
         pov: Some("scenes/bench/pov/classic.pov"),
+        generated: None,
     },
     Case {
         label: "1,000 spheres",
         scene: "scenes/bench/spheres1000.scene",
         defines: &[],
         pov: Some("scenes/bench/pov/spheres1000.pov"),
+        generated: None,
     },
     Case {
         label: "grid 10,000 spheres",
         scene: "scenes/bench/grid.scene",
         defines: &["N=100"],
         pov: None,
+        generated: None,
     },
     Case {
         label: "grid 1,000,000 spheres",
         scene: "scenes/bench/grid.scene",
         defines: &["N=1000"],
         pov: Some("scenes/bench/pov/grid.pov"),
+        generated: None,
     },
     Case {
-        label: "mesh 1,000,000 triangles",
-        // Written by `mesh::write` before the renders.
-        scene: "target/bench/mesh1m.scene",
+        label: "mesh 1M triangles, matte",
+        scene: "target/bench/mesh1m-matte.scene",
         defines: &[],
         pov: None,
+        generated: Some(Generated::Sphere),
+    },
+    Case {
+        label: "mesh 1M triangles, glass",
+        scene: "target/bench/mesh1m-glass.scene",
+        defines: &[],
+        pov: None,
+        generated: Some(Generated::Sphere),
+    },
+    Case {
+        label: "dragon, 202,520 triangles",
+        scene: "target/bench/dragon.scene",
+        defines: &[],
+        pov: None,
+        generated: Some(Generated::Dragon),
     },
 ];
 
@@ -67,24 +104,28 @@ const CSG_RENDERS: &[Case] = &[
         scene: "scenes/bench/union10k.scene",
         defines: &[],
         pov: None,
+        generated: None,
     },
     Case {
         label: "group of the same spheres",
         scene: "scenes/bench/union10k.scene",
         defines: &["UNION=0"],
         pov: None,
+        generated: None,
     },
     Case {
         label: "Menger sponge, level 3",
         scene: "scenes/bench/menger.scene",
         defines: &[],
         pov: None,
+        generated: None,
     },
     Case {
         label: "1,000 box-and-plane crystals",
         scene: "scenes/bench/crystals.scene",
         defines: &[],
         pov: None,
+        generated: None,
     },
 ];
 
@@ -94,12 +135,14 @@ const COMPILES: &[Case] = &[
         scene: "scenes/bench/grid.scene",
         defines: &["N=316"],
         pov: None,
+        generated: None,
     },
     Case {
         label: "grid N=1000 (1,000,000 spheres)",
         scene: "scenes/bench/grid.scene",
         defines: &["N=1000"],
         pov: None,
+        generated: None,
     },
 ];
 
@@ -124,32 +167,9 @@ struct Stats {
 }
 
 pub fn run(args: &[String]) -> anyhow::Result<()> {
-    let mut width = 640;
-    let mut height = 480;
-    let mut only_programs = false;
-    let mut only_mesh = false;
-    let mut only_csg = false;
-    let mut iter = args.iter();
-    while let Some(arg) = iter.next() {
-        match arg.as_str() {
-            "--size" => {
-                let value = iter.next().context("--size needs WxH")?;
-                let (w, h) = value
-                    .split_once('x')
-                    .context("--size needs WxH, e.g. 320x240")?;
-                width = w.parse().context("bad width")?;
-                height = h.parse().context("bad height")?;
-            }
-            "--programs" => only_programs = true,
-            "--mesh" => only_mesh = true,
-            "--csg" => only_csg = true,
-            "--lsp" => return lsp_latency(),
-            other => {
-                bail!(
-                    "unknown bench option `{other}` (known: --size WxH, --programs, --mesh, --csg, --lsp)"
-                )
-            }
-        }
+    let options = options::parse(args)?;
+    if options.lsp {
+        return lsp_latency();
     }
     run_cargo(&["build", "--release", "--locked", "--bin", "whitted"])?;
     let root = workspace_root();
@@ -157,29 +177,63 @@ pub fn run(args: &[String]) -> anyhow::Result<()> {
     let out_dir = root.join("target/bench");
     std::fs::create_dir_all(&out_dir)?;
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    if only_programs {
+    if options.programs {
         return programs::run(&exe, &out_dir, RUNS);
     }
-    if only_csg {
-        return render_table(&exe, &out_dir, CSG_RENDERS, width, height, cores);
+    let size = (options.width, options.height);
+    let wanted = |case: &&Case| {
+        options
+            .only
+            .as_deref()
+            .is_none_or(|text| case.label.contains(text))
+            && (!options.mesh || case.generated.is_some())
+    };
+    let cases: Vec<&Case> = if options.csg {
+        CSG_RENDERS.iter().filter(wanted).collect()
+    } else {
+        RENDERS.iter().chain(CSG_RENDERS).filter(wanted).collect()
+    };
+    if cases.is_empty() {
+        bail!(
+            "no render row's label contains `{}`",
+            options.only.as_deref().unwrap_or("")
+        );
     }
-    let started = Instant::now();
-    mesh::write(&out_dir)?;
-    println!(
-        "(the 1,000,000-triangle mesh is in {}, written in {:.1}s)",
-        out_dir.display(),
-        started.elapsed().as_secs_f64()
-    );
-    let renders: Vec<&Case> = RENDERS
-        .iter()
-        .chain(CSG_RENDERS)
-        .filter(|case| !only_mesh || case.scene.ends_with("mesh1m.scene"))
-        .collect();
-    render_table(&exe, &out_dir, renders, width, height, cores)?;
-    if only_mesh {
+    let cases = write_generated(&out_dir, cases)?;
+    if cases.is_empty() {
+        // The only rows asked for were skipped, and a line above said why.
         return Ok(());
     }
-
+    let base = match base::choose(&options.base, base::work_tree_changed(&root)?) {
+        None => {
+            println!("(no base: --no-base)");
+            None
+        }
+        Some(choice) => match base::build(&root, &out_dir, &choice.revision) {
+            Ok(base) => {
+                println!(
+                    "(base: {} = {}, {}; its binary is {})",
+                    choice.revision,
+                    base.short_sha,
+                    choice.why,
+                    base.exe.display()
+                );
+                Some(base)
+            }
+            Err(error) => {
+                println!("(no base: {error:#}; the table shows the work tree alone)");
+                None
+            }
+        },
+    };
+    match &base {
+        Some(base) => comparison_table(&exe, base, &out_dir, cases, size, cores)?,
+        None => render_table(&exe, &out_dir, cases, size, cores)?,
+    }
+    if options.mesh || options.csg || options.only.is_some() {
+        return Ok(());
+    }
+    let (width, height) = size;
     // One render per process pays for cold caches, first-touch page faults on the image and
     // thread start-up: on a 40 ms render that is a fifth of the time. The tracer's own bench
     // example renders the same scenes (built in Rust) repeatedly in one process: the
@@ -285,8 +339,147 @@ fn run_bench_example(args: &[&str], path: Option<&str>) -> anyhow::Result<()> {
     run_cargo_with(&command, &env)
 }
 
+/// Writes the scenes the selected cases need under `out_dir` (the sphere mesh once, the
+/// dragon fetched when missing) and returns the cases that can run: a dragon that cannot
+/// be had is one line saying why its row is skipped, never a failed bench.
+fn write_generated<'c>(out_dir: &Path, cases: Vec<&'c Case>) -> anyhow::Result<Vec<&'c Case>> {
+    let needs = |what| cases.iter().any(|case| case.generated == Some(what));
+    if needs(Generated::Sphere) {
+        let started = Instant::now();
+        mesh::write(out_dir)?;
+        println!(
+            "(the 1,000,000-triangle sphere is in {}, written in {:.1}s)",
+            out_dir.display(),
+            started.elapsed().as_secs_f64()
+        );
+    }
+    let mut dragon_ready = true;
+    if needs(Generated::Dragon) {
+        if let Err(error) = dragon::prepare(out_dir) {
+            println!("(dragon row skipped: {error:#})");
+            dragon_ready = false;
+        }
+    }
+    Ok(cases
+        .into_iter()
+        .filter(|case| dragon_ready || case.generated != Some(Generated::Dragon))
+        .collect())
+}
+
+/// The command that renders `case` at `size` on `threads` threads into `output`, printing
+/// `--stats=json` (the same for the work tree's binary and the base's).
+fn render_command(
+    exe: &Path,
+    case: &Case,
+    (width, height): (u32, u32),
+    threads: usize,
+    output: &Path,
+) -> Command {
+    let mut command = Command::new(exe);
+    command.arg("render").arg(workspace_root().join(case.scene));
+    for define in case.defines {
+        command.args(["-D", define]);
+    }
+    command
+        .args([
+            "--width",
+            &width.to_string(),
+            "--height",
+            &height.to_string(),
+        ])
+        .args([
+            "--max-depth",
+            "5",
+            "--spp",
+            "1",
+            "--threads",
+            &threads.to_string(),
+        ])
+        .args(["--stats=json", "--quiet", "-o"])
+        .arg(output);
+    command
+}
+
+/// Runs one render; its stats and wall seconds, or the first line of its error (a base
+/// binary may not know a newer scene's syntax: the caller decides what that means).
+fn render_once(command: &mut Command, case: &Case) -> Result<(Stats, f64), String> {
+    let started = Instant::now();
+    let result = command
+        .output()
+        .map_err(|error| format!("cannot run it: {error}"))?;
+    let wall = started.elapsed().as_secs_f64();
+    if !result.status.success() {
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        let first = stderr
+            .lines()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("no message");
+        return Err(format!("{} failed: {first}", case.scene));
+    }
+    let stats: Stats = serde_json::from_slice(&result.stdout)
+        .map_err(|error| format!("cannot read the stats of {}: {error}", case.scene))?;
+    Ok((stats, wall))
+}
+
+/// What RUNS renders of one case on one binary and thread count come to.
+///
+/// The CPU figures come from the run that used the least CPU time, the wall figures (what
+/// more threads buy) from the fastest run by the clock, the build time is the least of the
+/// runs'; each spread is (most − least) / least over the runs, the noise a change must
+/// exceed to be marked.
+struct Summary {
+    stats: Stats,
+    least_cpu: f64,
+    cpu_spread: f64,
+    best_render: f64,
+    best_wall: f64,
+    /// Shapes and BVH, seconds.
+    least_build: f64,
+    build_spread: f64,
+    peak_mib: Option<f64>,
+    peak_spread: f64,
+}
+
+impl Summary {
+    fn of(runs: Vec<(Stats, f64)>) -> Option<Summary> {
+        let least = |values: &mut dyn Iterator<Item = f64>| values.fold(f64::INFINITY, f64::min);
+        let least_cpu = least(&mut runs.iter().map(|(s, _)| s.render_cpu_seconds));
+        let cpu_spread = spread(runs.iter().map(|(s, _)| s.render_cpu_seconds));
+        let best_render = least(&mut runs.iter().map(|(s, _)| s.render_seconds));
+        let best_wall = least(&mut runs.iter().map(|&(_, wall)| wall));
+        let least_build = least(&mut runs.iter().map(|(s, _)| s.build_seconds));
+        let build_spread = spread(runs.iter().map(|(s, _)| s.build_seconds));
+        let peaks: Vec<f64> = runs
+            .iter()
+            .filter_map(|(s, _)| s.peak_memory_kib)
+            .map(|k| k as f64 / 1024.0)
+            .collect();
+        let peak_spread = spread(peaks.iter().copied());
+        let (stats, _) = runs
+            .into_iter()
+            .min_by(|a, b| a.0.render_cpu_seconds.total_cmp(&b.0.render_cpu_seconds))?;
+        let peak_mib = stats.peak_memory_kib.map(|k| k as f64 / 1024.0);
+        Some(Summary {
+            stats,
+            least_cpu,
+            cpu_spread,
+            best_render,
+            best_wall,
+            least_build,
+            build_spread,
+            peak_mib,
+            peak_spread,
+        })
+    }
+
+    fn mrays_per_cpu_second(&self) -> f64 {
+        self.stats.total_rays as f64 / self.least_cpu.max(1e-9) / 1e6
+    }
+}
+
 /// Renders each case RUNS times on one thread and on every core (at least two) and prints
-/// the best runs with the spread of the CPU times.
+/// the best runs with the spread of the CPU times: the table without a base (`--no-base`,
+/// or no base could be built), with every figure the stats give.
 ///
 /// The honest per-core figure is rays per CPU-second of the render threads on one thread:
 /// a thread's own CPU clock does not count the time other programs take on a shared
@@ -294,15 +487,13 @@ fn run_bench_example(args: &[&str], path: Option<&str>) -> anyhow::Result<()> {
 /// many-thread one (by the clock, since that is what more threads buy, so it means
 /// something only on an otherwise idle machine). Peak memory is the process's, scene and
 /// image included.
-fn render_table<'c>(
+fn render_table(
     exe: &Path,
     out_dir: &Path,
-    cases: impl IntoIterator<Item = &'c Case>,
-    width: u32,
-    height: u32,
+    cases: Vec<&Case>,
+    (width, height): (u32, u32),
     cores: usize,
 ) -> anyhow::Result<()> {
-    let root = workspace_root();
     println!(
         "\nrenders ({width}x{height}, max depth 5, 1 spp; release build; best of {RUNS} runs: \
          render and wall by the clock, cpu = the render threads' CPU time with its spread \
@@ -332,83 +523,32 @@ fn render_table<'c>(
         let mut one_thread_render = None;
         for threads in [1, cores.max(2)] {
             let output = out_dir.join(format!("{}.png", case.scene.replace(['/', '.'], "_")));
-            let mut command = Command::new(exe);
-            command.arg("render").arg(root.join(case.scene));
-            for define in case.defines {
-                command.args(["-D", define]);
-            }
-            command
-                .args([
-                    "--width",
-                    &width.to_string(),
-                    "--height",
-                    &height.to_string(),
-                ])
-                .args([
-                    "--max-depth",
-                    "5",
-                    "--spp",
-                    "1",
-                    "--threads",
-                    &threads.to_string(),
-                ])
-                .args(["--stats=json", "--quiet", "-o"])
-                .arg(&output);
+            let mut command = render_command(exe, case, (width, height), threads, &output);
             // Best of RUNS: single-shot timings on a shared machine are noisy, and the
             // fastest run is the one least disturbed by other work; the spread says how
             // noisy they were.
             let mut runs: Vec<(Stats, f64)> = Vec::with_capacity(RUNS);
             for _ in 0..RUNS {
-                let started = Instant::now();
-                let result = command
-                    .output()
-                    .with_context(|| format!("cannot run {}", exe.display()))?;
-                let wall = started.elapsed().as_secs_f64();
-                if !result.status.success() {
-                    bail!(
-                        "{} failed:\n{}",
-                        case.scene,
-                        String::from_utf8_lossy(&result.stderr)
-                    );
-                }
-                let stats: Stats = serde_json::from_slice(&result.stdout)
-                    .with_context(|| format!("cannot read the stats of {}", case.scene))?;
+                let run = render_once(&mut command, case).map_err(anyhow::Error::msg)?;
                 debug_assert!(
-                    stats.width == width && stats.height == height && stats.max_depth == 5
+                    run.0.width == width && run.0.height == height && run.0.max_depth == 5
                 );
-                runs.push((stats, wall));
+                runs.push(run);
             }
-            // The CPU figures come from the run that used the least CPU time, the wall
-            // figures (what more threads buy) from the fastest run by the clock.
-            let cpu: Vec<f64> = runs.iter().map(|(s, _)| s.render_cpu_seconds).collect();
-            let least_cpu = cpu.iter().copied().fold(f64::INFINITY, f64::min);
-            let most_cpu = cpu.iter().copied().fold(0.0, f64::max);
-            let spread = (most_cpu - least_cpu) / least_cpu.max(1e-9);
-            let best_render = runs
-                .iter()
-                .map(|(s, _)| s.render_seconds)
-                .fold(f64::INFINITY, f64::min);
-            let best_wall = runs
-                .iter()
-                .map(|&(_, wall)| wall)
-                .fold(f64::INFINITY, f64::min);
-            let Some((stats, _)) = runs
-                .into_iter()
-                .min_by(|a, b| a.0.render_cpu_seconds.total_cmp(&b.0.render_cpu_seconds))
-            else {
+            let Some(summary) = Summary::of(runs) else {
                 bail!("no run of {}", case.scene);
             };
-            let per_cpu = stats.total_rays as f64 / least_cpu.max(1e-9) / 1e6;
             let scaling = match one_thread_render {
                 None => {
-                    one_thread_render = Some(best_render);
+                    one_thread_render = Some(summary.best_render);
                     String::new()
                 }
-                Some(one) => format!("{:.2}x", one / best_render.max(1e-9)),
+                Some(one) => format!("{:.2}x", one / summary.best_render.max(1e-9)),
             };
-            let peak = stats
-                .peak_memory_kib
-                .map_or("n/a".to_string(), |k| format!("{:.0}", k as f64 / 1024.0));
+            let peak = summary
+                .peak_mib
+                .map_or("n/a".to_string(), |m| format!("{m:.0}"));
+            let stats = &summary.stats;
             println!(
                 "{:<30} {:>3} {:>7} {:>6.3}s {:>6.3}s {:>6.3}s {:>6.3}s {:>6.3}s {:>5.0}% {:>7.3}s {:>10} {:>8.2} {:>7} {:>8}",
                 case.label,
@@ -417,19 +557,201 @@ fn render_table<'c>(
                 stats.compile_seconds,
                 stats.shapes_seconds,
                 stats.build_seconds - stats.shapes_seconds,
-                best_render,
-                least_cpu,
-                spread * 100.0,
-                best_wall,
+                summary.best_render,
+                summary.least_cpu,
+                summary.cpu_spread * 100.0,
+                summary.best_wall,
                 stats.total_rays,
-                per_cpu,
+                summary.mrays_per_cpu_second(),
                 scaling,
                 peak
             );
-            walk = stats.bvh_walk;
+            walk.clone_from(&stats.bvh_walk);
         }
     }
     println!("(BVH walk: {walk}; `WHITTED_TRAVERSAL=baseline|avx2|avx512` forces one)");
+    Ok(())
+}
+
+/// The table beside the base (issue 31): each case on one thread and on every core, the
+/// work tree's binary and the base's run alternately (new, base, new, base, ...: RUNS each)
+/// so that a load that comes and goes on the shared machine falls on both, and each figure
+/// printed beside the base's with the change, marked `!` when worse and `*` when better by
+/// more than the runs' spread (and 1%; 4 MiB for memory). Rows a regression marks are
+/// listed again at the end.
+fn comparison_table(
+    exe: &Path,
+    base: &base::Base,
+    out_dir: &Path,
+    cases: Vec<&Case>,
+    (width, height): (u32, u32),
+    cores: usize,
+) -> anyhow::Result<()> {
+    println!(
+        "\nrenders beside the base {} ({width}x{height}, max depth 5, 1 spp; release builds, \
+         run alternately, {RUNS} runs each)\n\
+         Mray per CPU-second: of the render threads, in the run with the least CPU time; build: \
+         shapes + BVH, least of the runs;\n\
+         peak: the process's peak memory; change: ! worse, * better, by more than the \
+         new and base spreads added (and 1%, and 4 MiB);\n\
+         spread: (most - least) / least CPU time, new/base; scale: best 1-thread render / \
+         best many-thread render (new)",
+        base.short_sha
+    );
+    println!(
+        "{:<32}  {:^22}  {:^22}  {:^22}",
+        "", "Mray per CPU-second", "build seconds", "peak MiB"
+    );
+    println!(
+        "{:<28} {:>3}  {:>6} {:>6} {:>7}   {:>6} {:>6} {:>7}   {:>6} {:>6} {:>7}  {:>8} {:>6}",
+        "scene",
+        "thr",
+        "new",
+        "base",
+        "change",
+        "new",
+        "base",
+        "change",
+        "new",
+        "base",
+        "change",
+        "spread",
+        "scale"
+    );
+    let mut regressions = Vec::new();
+    let mut base_failures = 0;
+    let mut walk = String::from("none");
+    for case in cases {
+        let mut one_thread_render = None;
+        for threads in [1, cores.max(2)] {
+            let stem = case.scene.replace(['/', '.'], "_");
+            let size = (width, height);
+            let mut new_command = render_command(
+                exe,
+                case,
+                size,
+                threads,
+                &out_dir.join(format!("{stem}.png")),
+            );
+            let mut base_command = render_command(
+                &base.exe,
+                case,
+                size,
+                threads,
+                &out_dir.join(format!("{stem}-base.png")),
+            );
+            let mut new_runs = Vec::with_capacity(RUNS);
+            let mut base_runs = Vec::with_capacity(RUNS);
+            let mut base_failure = None;
+            for _ in 0..RUNS {
+                new_runs.push(render_once(&mut new_command, case).map_err(anyhow::Error::msg)?);
+                if base_failure.is_none() {
+                    match render_once(&mut base_command, case) {
+                        Ok(run) => base_runs.push(run),
+                        Err(message) => base_failure = Some(message),
+                    }
+                }
+            }
+            let Some(new) = Summary::of(new_runs) else {
+                bail!("no run of {}", case.scene);
+            };
+            let old = if base_failure.is_none() {
+                Summary::of(base_runs)
+            } else {
+                None
+            };
+            let scaling = match one_thread_render {
+                None => {
+                    one_thread_render = Some(new.best_render);
+                    String::new()
+                }
+                Some(one) => format!("{:.2}x", one / new.best_render.max(1e-9)),
+            };
+            let or_dash = |value: Option<f64>, decimals: usize| {
+                value.map_or("-".to_string(), |v| format!("{v:.decimals$}"))
+            };
+            let beside = |new: f64, old: Option<f64>, noise: f64, better| match old {
+                Some(old) => change(new, old, noise, better),
+                None => format!("{:>8}", "-"),
+            };
+            let rays = beside(
+                new.mrays_per_cpu_second(),
+                old.as_ref().map(Summary::mrays_per_cpu_second),
+                old.as_ref().map_or(0.0, |o| o.cpu_spread + new.cpu_spread),
+                Better::Higher,
+            );
+            let build = beside(
+                new.least_build,
+                old.as_ref().map(|o| o.least_build),
+                old.as_ref()
+                    .map_or(0.0, |o| o.build_spread + new.build_spread),
+                Better::Lower,
+            );
+            let peak = match (new.peak_mib, old.as_ref().and_then(|o| o.peak_mib)) {
+                // Two binaries of the same source (the work tree's and its HEAD's, built in
+                // two folders) peaked at 44-46 and 47 MiB on the dragon, run after run: a
+                // few MiB are the process's noise (thread stacks, allocator arenas, the
+                // binary's own pages), not a change of the renderer.
+                (Some(n), Some(o)) => change(
+                    n,
+                    o,
+                    old.as_ref()
+                        .map_or(0.0, |o| o.peak_spread + new.peak_spread)
+                        .max(PEAK_NOISE_MIB / o.max(1.0)),
+                    Better::Lower,
+                ),
+                _ => format!("{:>8}", "-"),
+            };
+            let spreads = format!(
+                "{:.0}/{}%",
+                new.cpu_spread * 100.0,
+                or_dash(old.as_ref().map(|o| o.cpu_spread * 100.0), 0)
+            );
+            println!(
+                "{:<28} {:>3}  {:>6.2} {:>6} {rays}  {:>6.3} {:>6} {build}  {:>6} {:>6} {peak} {:>8} {:>6}",
+                case.label,
+                threads,
+                new.mrays_per_cpu_second(),
+                or_dash(old.as_ref().map(Summary::mrays_per_cpu_second), 2),
+                new.least_build,
+                or_dash(old.as_ref().map(|o| o.least_build), 3),
+                or_dash(new.peak_mib, 0),
+                or_dash(old.as_ref().and_then(|o| o.peak_mib), 0),
+                spreads,
+                scaling
+            );
+            if let Some(message) = &base_failure {
+                println!("  base failed: {message}");
+                base_failures += 1;
+            }
+            let what: Vec<&str> = [(&rays, "Mray/cpu"), (&build, "build"), (&peak, "peak")]
+                .into_iter()
+                .filter(|(c, _)| is_regression(c))
+                .map(|(_, name)| name)
+                .collect();
+            if !what.is_empty() {
+                regressions.push(format!(
+                    "{} on {threads} thread{}: {}",
+                    case.label,
+                    if threads == 1 { "" } else { "s" },
+                    what.join(", ")
+                ));
+            }
+            walk.clone_from(&new.stats.bvh_walk);
+        }
+    }
+    println!("(BVH walk: {walk}; `WHITTED_TRAVERSAL=baseline|avx2|avx512` forces one)");
+    if base_failures > 0 {
+        println!("the base failed on {base_failures} row(s): those have nothing to compare");
+    }
+    if regressions.is_empty() {
+        println!("no figure is worse than the base's by more than its runs' spread");
+    } else {
+        println!("WORSE than the base by more than the runs' spread:");
+        for line in regressions {
+            println!("  {line}");
+        }
+    }
     Ok(())
 }
 
@@ -468,6 +790,9 @@ pub(super) fn measure(
 }
 
 const POVRAY: &str = "/usr/bin/povray";
+
+/// Peak-memory changes this small (MiB) are never marked: see `comparison_table`.
+const PEAK_NOISE_MIB: f64 = 4.0;
 
 /// Each render is run this many times and the fastest run reported, for whitted and POV-Ray alike.
 const RUNS: usize = 3;
