@@ -66,7 +66,7 @@ impl SimdPath {
     }
 }
 
-/// [`Bvh::traverse`] with a SIMD child test.
+/// [`Bvh::traverse_groups`] with a SIMD child test.
 #[inline]
 pub(crate) fn traverse(
     simd: SimdPath,
@@ -75,7 +75,7 @@ pub(crate) fn traverse(
     tmin: f32,
     tmax: f32,
     stack: &mut Vec<UVec2>,
-    visit: impl FnMut(u32, f32) -> Step,
+    visit: impl FnMut(u32, u32, f32) -> Step,
 ) {
     // Off x86-64 no `SimdPath` exists, so there is nothing to call.
     #[cfg(not(target_arch = "x86_64"))]
@@ -134,7 +134,7 @@ mod x86 {
         tmin: f32,
         tmax: f32,
         stack: &mut Vec<UVec2>,
-        visit: impl FnMut(u32, f32) -> Step,
+        visit: impl FnMut(u32, u32, f32) -> Step,
     ) {
         bvh.traverse_with(&EightLanes::new(ray, tmin), ray, tmax, stack, visit);
     }
@@ -159,7 +159,7 @@ mod x86 {
         tmin: f32,
         tmax: f32,
         stack: &mut Vec<UVec2>,
-        visit: impl FnMut(u32, f32) -> Step,
+        visit: impl FnMut(u32, u32, f32) -> Step,
     ) {
         let query = MaskedLanes(EightLanes::new(ray, tmin));
         bvh.traverse_with(&query, ray, tmax, stack, visit);

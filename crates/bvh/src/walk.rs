@@ -402,15 +402,33 @@ impl Bvh {
         stack: &mut Vec<UVec2>,
         visit: impl FnMut(u32, f32) -> Step,
     ) {
+        self.traverse_groups(ray, tmin, tmax, stack, one_by_one(visit));
+    }
+
+    /// [`Bvh::traverse`] a node at a time: `visit_group(base, bits, tmax)` is shown the
+    /// primitives of the leaves the segment touches at one node, `base + i` for each set
+    /// bit `i` of `bits`, which [`Bvh::traverse`] visits from the highest bit down. A
+    /// visitor that tests them together (several in SIMD lanes) and then takes their
+    /// results in that order sees exactly what `traverse`'s visitor sees. It returns
+    /// `Step::Shrink` with the last `tmax` it shrank to, or `Step::Stop`.
+    #[inline]
+    pub fn traverse_groups(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        stack: &mut Vec<UVec2>,
+        visit_group: impl FnMut(u32, u32, f32) -> Step,
+    ) {
         if self.nodes.is_empty() {
             return;
         }
         match self.path {
             ChildTestPath::Baseline => {
-                self.traverse_with(&NodeQuery::new(ray, tmin), ray, tmax, stack, visit);
+                self.traverse_with(&NodeQuery::new(ray, tmin), ray, tmax, stack, visit_group);
             }
             ChildTestPath::Simd(simd) => {
-                simd::traverse(simd, self, ray, tmin, tmax, stack, visit);
+                simd::traverse(simd, self, ray, tmin, tmax, stack, visit_group);
             }
         }
     }
@@ -423,19 +441,19 @@ impl Bvh {
         ray: &Ray,
         tmax: f32,
         stack: &mut Vec<UVec2>,
-        visit: impl FnMut(u32, f32) -> Step,
+        visit_group: impl FnMut(u32, u32, f32) -> Step,
     ) {
         // One walk per octant of the direction, so that the near and far planes of each
         // axis and the order of inner children are constants inside the loop.
         match octant_inv4(ray.direction) & 0b111 {
-            0 => self.traverse_octant::<0>(query, tmax, stack, visit),
-            1 => self.traverse_octant::<1>(query, tmax, stack, visit),
-            2 => self.traverse_octant::<2>(query, tmax, stack, visit),
-            3 => self.traverse_octant::<3>(query, tmax, stack, visit),
-            4 => self.traverse_octant::<4>(query, tmax, stack, visit),
-            5 => self.traverse_octant::<5>(query, tmax, stack, visit),
-            6 => self.traverse_octant::<6>(query, tmax, stack, visit),
-            _ => self.traverse_octant::<7>(query, tmax, stack, visit),
+            0 => self.traverse_octant::<0>(query, tmax, stack, visit_group),
+            1 => self.traverse_octant::<1>(query, tmax, stack, visit_group),
+            2 => self.traverse_octant::<2>(query, tmax, stack, visit_group),
+            3 => self.traverse_octant::<3>(query, tmax, stack, visit_group),
+            4 => self.traverse_octant::<4>(query, tmax, stack, visit_group),
+            5 => self.traverse_octant::<5>(query, tmax, stack, visit_group),
+            6 => self.traverse_octant::<6>(query, tmax, stack, visit_group),
+            _ => self.traverse_octant::<7>(query, tmax, stack, visit_group),
         }
     }
 
@@ -446,7 +464,7 @@ impl Bvh {
         query: &impl ChildTest,
         tmax: f32,
         stack: &mut Vec<UVec2>,
-        mut visit: impl FnMut(u32, f32) -> Step,
+        mut visit_group: impl FnMut(u32, u32, f32) -> Step,
     ) {
         let mut tmax = tmax;
         let inner_order = &INNER_ORDER[OCT as usize];
@@ -454,14 +472,13 @@ impl Bvh {
         let mut current_group = UVec2::new(0, 0x8000_0000);
         let mut primitive_group = UVec2::ZERO;
         loop {
-            while primitive_group.y != 0 {
-                let local = first_bit_high(primitive_group.y);
-                primitive_group.y &= !(1u32 << local);
-                match visit(primitive_group.x + local, tmax) {
+            if primitive_group.y != 0 {
+                match visit_group(primitive_group.x, primitive_group.y, tmax) {
                     Step::Continue => {}
                     Step::Shrink(t) => tmax = t,
                     Step::Stop => return,
                 }
+                primitive_group.y = 0;
             }
 
             if current_group.y & 0xff00_0000 != 0 {
@@ -768,6 +785,29 @@ fn leaf_primitive_bits(node: &WideNode, mut leaves: u32) -> u32 {
         leaves &= leaves - 1;
     }
     bits
+}
+
+/// A group visitor ([`Bvh::traverse_groups`]) that shows `visit` the group's primitives
+/// one at a time, from the highest bit down, as the walk always has.
+#[inline(always)]
+fn one_by_one(mut visit: impl FnMut(u32, f32) -> Step) -> impl FnMut(u32, u32, f32) -> Step {
+    #[inline(always)]
+    move |base, mut bits, mut tmax| {
+        let mut step = Step::Continue;
+        while bits != 0 {
+            let local = first_bit_high(bits);
+            bits &= !(1u32 << local);
+            match visit(base + local, tmax) {
+                Step::Continue => {}
+                Step::Shrink(t) => {
+                    tmax = t;
+                    step = Step::Shrink(t);
+                }
+                Step::Stop => return Step::Stop,
+            }
+        }
+        step
+    }
 }
 
 #[inline(always)]

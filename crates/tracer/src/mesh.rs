@@ -23,6 +23,7 @@ use whitted_ir::Mesh;
 
 use crate::hit_error::{self, BoundedPoint};
 use crate::shapes::{triangle_hit, triangle_hit_uv, Part, RawSpan};
+use four::TriangleColumns;
 use whitted_bvh::Bound;
 use whitted_bvh::Ray;
 use whitted_bvh::{Bvh, Step};
@@ -42,7 +43,9 @@ struct Triangle {
 #[derive(Debug)]
 pub struct PreparedMesh {
     /// In BVH primitive order, so that BVH ids index them directly.
-    triangles: Vec<Triangle>,
+    /// Its triangles in BVH primitive order, so that BVH ids index them directly, as
+    /// columns that load four at a time.
+    triangles: TriangleColumns,
     /// The corners of each triangle (same order), into `normals`: only for meshes whose
     /// file gave vertex normals.
     corners: Vec<[u32; 3]>,
@@ -101,7 +104,7 @@ impl PreparedMesh {
             }
         }
         PreparedMesh {
-            triangles,
+            triangles: TriangleColumns::new(&triangles),
             corners,
             normals: mesh.normals.iter().map(|n| Vec3::from_array(*n)).collect(),
             bvh,
@@ -145,8 +148,89 @@ impl PreparedMesh {
         }
     }
 
-    /// The nearest triangle crossed strictly inside `(tmin, tmax)`, in mesh space.
+    /// The nearest triangle crossed strictly inside `(tmin, tmax)`, in mesh space. Through
+    /// the BVH, the triangles of the leaves a ray reaches at a node are tested four at a
+    /// time ([`FourTriangles`]) and their hits taken in the walk's order: the same hit,
+    /// bit for bit, as testing them one by one.
     pub(crate) fn first_hit(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<(f32, Part)> {
+        let mut best = None;
+        if let Some(bvh) = &self.bvh {
+            with_stack(|stack| {
+                bvh.traverse_groups(ray, tmin, tmax, stack, |base, bits, tmax| {
+                    self.nearest_in_group(ray, (tmin, tmax), base, bits, &mut best)
+                })
+            });
+            return best;
+        }
+        self.each_candidate(ray, tmin, tmax, |i, tmax| {
+            let Some(t) = self.triangles.get(i as usize).and_then(|tri| tri.hit(ray)) else {
+                return Step::Continue;
+            };
+            if t > tmin && t < tmax {
+                best = Some((t, i));
+                Step::Shrink(t)
+            } else {
+                Step::Continue
+            }
+        });
+        best
+    }
+
+    /// The nearest of the triangles `base + i` (for each set bit `i` of `bits`) crossed
+    /// inside `(tmin, tmax)`, taken from the highest bit down as the walk would show them
+    /// one at a time: into `best`, with the step the walk takes.
+    #[inline(always)]
+    fn nearest_in_group(
+        &self,
+        ray: &Ray,
+        (tmin, mut tmax): (f32, f32),
+        base: u32,
+        bits: u32,
+        best: &mut Option<(f32, Part)>,
+    ) -> Step {
+        // Every window of four triangles in a row that holds one of the group's, tested
+        // at once (a node's leaves hold neighbours: a group of three usually takes one
+        // window); then the hits taken from the highest bit down. `ts` has room for a
+        // window starting at any of the 32 bits.
+        let mut ts = [0.0f32; 36];
+        let mut hits = 0u32;
+        let mut window = bits;
+        while window != 0 {
+            let first = window.trailing_zeros();
+            let lanes = ts.get_mut(first as usize..first as usize + 4);
+            if let (Some(four), Some(lanes)) = (self.triangles.four((base + first) as usize), lanes)
+            {
+                let (t, hit) = four.hit(ray);
+                t.write_to_slice(lanes);
+                hits |= hit.bitmask() << first;
+            }
+            window &= !(0xF << first);
+        }
+        hits &= bits;
+        let mut step = Step::Continue;
+        while hits != 0 {
+            let local = 31 - hits.leading_zeros();
+            hits &= !(1u32 << local);
+            let t = ts.get(local as usize).copied().unwrap_or(f32::NAN);
+            if t > tmin && t < tmax {
+                *best = Some((t, base + local));
+                tmax = t;
+                step = Step::Shrink(t);
+            }
+        }
+        step
+    }
+
+    /// [`PreparedMesh::first_hit`] as it was before leaves were tested four at a time:
+    /// the walk shows the triangles one by one: the oracle for the grouped test, which
+    /// must give the same hit, bit for bit.
+    #[cfg(test)]
+    pub(crate) fn first_hit_one_at_a_time(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<(f32, Part)> {
         let mut best = None;
         self.each_candidate(ray, tmin, tmax, |i, tmax| {
             let Some(t) = self.triangles.get(i as usize).and_then(|tri| tri.hit(ray)) else {
@@ -171,7 +255,8 @@ impl PreparedMesh {
         tmax: f32,
     ) -> Option<(f32, Part)> {
         let mut best: Option<(f32, Part)> = None;
-        for (i, tri) in self.triangles.iter().enumerate() {
+        for (i, tri) in (0..self.triangles.len()).filter_map(|i| Some((i, self.triangles.get(i)?)))
+        {
             if let Some(t) = tri.hit(ray) {
                 if t > tmin && t < best.map_or(tmax, |b| b.0) {
                     best = Some((t, i as Part));
@@ -408,5 +493,6 @@ fn span(t_in: f32, part_in: Part, t_out: f32, part_out: Part) -> RawSpan {
     }
 }
 
+mod four;
 #[cfg(test)]
 mod tests;

@@ -492,7 +492,10 @@ fn meshes_keep_the_binned_sah_tree() {
     let mesh = terrain(40, &mut Rng(17));
     let sah = PreparedMesh::new(&mesh);
     let forced = with_morton_top(|| PreparedMesh::new(&mesh));
-    let corners: Vec<Vec3A> = sah.triangles.iter().map(|t| Vec3A::from(t.a)).collect();
+    let corners: Vec<Vec3A> = (0..sah.triangles.len())
+        .filter_map(|i| sah.triangles.get(i))
+        .map(|t| Vec3A::from(t.a))
+        .collect();
     let aabbs: Vec<obvhs::aabb::Aabb> = corners
         .iter()
         .map(|&a| obvhs::aabb::Aabb::new(a, a + 1.0))
@@ -501,4 +504,49 @@ fn meshes_keep_the_binned_sah_tree() {
     let (_, sah_order) = Bvh::build(&aabbs);
     assert_eq!(forced.triangles, sah.triangles);
     assert_ne!(morton_order, sah_order, "the Morton top was not forced");
+}
+
+/// Leaves tested four triangles at a time (`four.rs`) against the walk that shows them one
+/// by one: the same triangle and the same `t`, bit for bit, for awkward rays on two meshes
+/// (a sphere, a jagged terrain), at the origin and far from it, huge and tiny.
+/// Planted bugs, seen failing: a cross product with its terms swapped
+/// (`self.z * b.y - self.y * b.z`), and the hits taken lowest bit first.
+#[test]
+fn four_triangles_at_a_time_find_what_one_at_a_time_finds() {
+    let mut rng = Rng(31);
+    let mut meshes = vec![
+        tessellated_sphere(1.5, 24, 48, false),
+        terrain(40, &mut rng),
+    ];
+    // Where rounding is coarse: the terrain far away, and scaled huge and tiny.
+    for (offset, scale) in [(1e5f32, 1.0f32), (0.0, 1e4), (0.0, 1e-4)] {
+        let mut far = terrain(20, &mut rng);
+        for p in &mut far.positions {
+            *p = p.map(|c| c * scale + offset);
+        }
+        meshes.push(far);
+    }
+    let mut compared = 0;
+    let mut hits = 0;
+    for mesh in &meshes {
+        let prepared = PreparedMesh::new(mesh);
+        assert!(prepared.bvh.is_some(), "{} has no BVH", mesh.file);
+        for ray in &awkward_rays(mesh, &mut rng, 3_000) {
+            for (tmin, tmax) in [(0.0, f32::INFINITY), (1e-3, 5.0), (f32::NEG_INFINITY, 2.0)] {
+                let grouped = prepared.first_hit(ray, tmin, tmax);
+                let single = prepared.first_hit_one_at_a_time(ray, tmin, tmax);
+                let bits = |h: Option<(f32, u32)>| h.map(|(t, part)| (t.to_bits(), part));
+                assert_eq!(
+                    bits(grouped),
+                    bits(single),
+                    "{}: ray {ray:?} in ({tmin}, {tmax})",
+                    mesh.file
+                );
+                compared += 1;
+                hits += usize::from(single.is_some());
+            }
+        }
+    }
+    // The comparison means something only if many queries hit.
+    assert!(hits * 4 > compared, "{hits} hits in {compared} queries");
 }
