@@ -680,11 +680,16 @@ fn comparison_table(
                 old.as_ref().map_or(0.0, |o| o.cpu_spread + new.cpu_spread),
                 Better::Higher,
             );
+            // A build of a few hundred objects takes well under a millisecond, where the
+            // clock's own jitter is tens of percent (Menger 0.000 s was marked +53%): a
+            // build change counts only beyond a few milliseconds.
             let build = beside(
                 new.least_build,
                 old.as_ref().map(|o| o.least_build),
-                old.as_ref()
-                    .map_or(0.0, |o| o.build_spread + new.build_spread),
+                old.as_ref().map_or(0.0, |o| {
+                    (o.build_spread + new.build_spread)
+                        .max(BUILD_NOISE_SECONDS / o.least_build.max(1e-9))
+                }),
                 Better::Lower,
             );
             let peak = match (new.peak_mib, old.as_ref().and_then(|o| o.peak_mib)) {
@@ -792,6 +797,9 @@ pub(super) fn measure(
 const POVRAY: &str = "/usr/bin/povray";
 
 /// Peak-memory changes this small (MiB) are never marked: see `comparison_table`.
+/// Build times closer than this are the clock's jitter, not a change (see the table).
+const BUILD_NOISE_SECONDS: f64 = 0.005;
+
 const PEAK_NOISE_MIB: f64 = 4.0;
 
 /// Each render is run this many times and the fastest run reported, for whitted and POV-Ray alike.

@@ -90,17 +90,26 @@ pub(super) struct TriangleColumns {
 }
 
 impl TriangleColumns {
-    pub(super) fn new(triangles: &[Triangle]) -> TriangleColumns {
-        let mut columns: [Vec<f32>; 9] =
-            std::array::from_fn(|_| Vec::with_capacity(triangles.len() + 3));
-        let last = triangles.last().copied();
-        for t in triangles.iter().chain(last.iter().cycle().take(3)) {
+    pub(super) fn new(triangles: impl Iterator<Item = Triangle>) -> TriangleColumns {
+        let len = triangles.size_hint().0;
+        let mut columns: [Vec<f32>; 9] = std::array::from_fn(|_| Vec::with_capacity(len + 3));
+        let mut push = |t: &Triangle| {
             let values = [
                 t.a.x, t.a.y, t.a.z, t.edge1.x, t.edge1.y, t.edge1.z, t.edge2.x, t.edge2.y,
                 t.edge2.z,
             ];
             for (column, value) in columns.iter_mut().zip(values) {
                 column.push(value);
+            }
+        };
+        let mut last = None;
+        for t in triangles {
+            push(&t);
+            last = Some(t);
+        }
+        if let Some(t) = last {
+            for _ in 0..3 {
+                push(&t);
             }
         }
         TriangleColumns { columns }
