@@ -161,7 +161,7 @@ impl PreparedMesh {
 
     /// The nearest triangle crossed strictly inside `(tmin, tmax)`, in mesh space. Through
     /// the BVH, the triangles of the leaves a ray reaches at a node are tested four at a
-    /// time ([`FourTriangles`]) and their hits taken in the walk's order: the same hit,
+    /// time ([`four::FourTriangles`]) and their hits taken in the walk's order: the same hit,
     /// bit for bit, as testing them one by one.
     pub(crate) fn first_hit(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<(f32, Part)> {
         let mut best = None;
@@ -173,18 +173,7 @@ impl PreparedMesh {
             });
             return best;
         }
-        self.each_candidate(ray, tmin, tmax, |i, tmax| {
-            let Some(t) = self.triangles.get(i as usize).and_then(|tri| tri.hit(ray)) else {
-                return Step::Continue;
-            };
-            if t > tmin && t < tmax {
-                best = Some((t, i));
-                Step::Shrink(t)
-            } else {
-                Step::Continue
-            }
-        });
-        best
+        self.first_hit_one_at_a_time(ray, tmin, tmax)
     }
 
     /// The nearest of the triangles `base + i` (for each set bit `i` of `bits`) crossed
@@ -232,10 +221,9 @@ impl PreparedMesh {
         step
     }
 
-    /// [`PreparedMesh::first_hit`] as it was before leaves were tested four at a time:
-    /// the walk shows the triangles one by one: the oracle for the grouped test, which
-    /// must give the same hit, bit for bit.
-    #[cfg(test)]
+    /// The nearest hit with the triangles shown one by one (by the BVH walk, or all of
+    /// them for a mesh without one): [`PreparedMesh::first_hit`] of a small mesh, and the
+    /// oracle of its grouped test, which must give the same hit, bit for bit.
     pub(crate) fn first_hit_one_at_a_time(
         &self,
         ray: &Ray,
