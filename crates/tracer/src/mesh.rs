@@ -42,7 +42,6 @@ struct Triangle {
 /// A mesh of the IR, prepared once however many objects instance it.
 #[derive(Debug)]
 pub struct PreparedMesh {
-    /// In BVH primitive order, so that BVH ids index them directly.
     /// Its triangles in BVH primitive order, so that BVH ids index them directly, as
     /// columns that load four at a time.
     triangles: TriangleColumns,

@@ -11,7 +11,7 @@
 //! cross product's components are `a.y·b.z − a.z·b.y` and so on, `min`/`max` are the same
 //! SSE instructions with the same operand first, no fused multiply-add), so each lane's
 //! `t`, and whether it is a hit, are bit for bit the single test's (`tests.rs` compares
-//! them on generated and awkward triangles and rays).
+//! the walk's hits with those of the one-at-a-time walk on awkward rays and meshes).
 
 use glam::{BVec4A, Vec3, Vec3A, Vec4};
 
@@ -83,7 +83,7 @@ impl Lanes {
 
 /// A mesh's triangles as nine arrays of coordinates (structure of arrays), padded with
 /// three copies of the last so that any four in a row load as lanes.
-#[derive(Debug, Default, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub(super) struct TriangleColumns {
     /// `a.x, a.y, a.z, edge1.x, ..., edge2.z` of every triangle.
     columns: [Vec<f32>; 9],
@@ -137,10 +137,8 @@ impl TriangleColumns {
     /// Triangles `first` to `first + 3` in lanes 0 to 3 (`None` past the end).
     #[inline(always)]
     pub(super) fn four(&self, first: usize) -> Option<FourTriangles> {
-        let lane = |c: usize| -> Option<Vec4> {
-            let column = self.columns.get(c)?;
-            Some(Vec4::from_slice(column.get(first..first + 4)?))
-        };
+        // Nine fixed columns: only the window itself can be out of range.
+        let lane = |c: usize| Some(Vec4::from_slice(self.columns[c].get(first..first + 4)?));
         Some(FourTriangles {
             a: Lanes {
                 x: lane(0)?,
