@@ -36,6 +36,13 @@ pub(super) fn change(new: f64, base: f64, noise: f64, better: Better) -> String 
     format!("{:>+6.1}%{mark}", fraction * 100.0)
 }
 
+/// The noise of a figure for [`change`]: the runs' relative `spreads`, or `floor` (in the
+/// figure's own unit) relative to `base`, whichever is larger: below the floor a
+/// difference is the measurement's own (a clock's jitter, a process's stray MiB).
+pub(super) fn noise(spreads: f64, floor: f64, base: f64) -> f64 {
+    spreads.max(floor / base.max(1e-9))
+}
+
 /// Whether [`change`] marked a regression.
 pub(super) fn is_regression(change: &str) -> bool {
     change.trim_end().ends_with('!')
@@ -82,6 +89,29 @@ mod tests {
     fn more_time_or_memory_is_worse() {
         assert!(is_regression(&change(1.2, 1.0, 0.05, Better::Lower)));
         assert_eq!(change(0.8, 1.0, 0.05, Better::Lower), " -20.0%*");
+    }
+
+    /// A 0.000 s build that clock jitter made half again as long is not marked (the
+    /// Menger sponge's was, "+53%!"); the same ratio on a build of seconds is.
+    #[test]
+    fn a_change_below_the_floor_of_its_unit_is_not_marked() {
+        let tiny = change(0.00046, 0.0003, noise(0.02, 0.005, 0.0003), Better::Lower);
+        assert!(!is_regression(&tiny), "{tiny}");
+        let real = change(0.46, 0.3, noise(0.02, 0.005, 0.3), Better::Lower);
+        assert!(is_regression(&real), "{real}");
+        // Memory: 3 MiB more of 45 is the process's noise, 12 MiB more is not.
+        assert!(!is_regression(&change(
+            48.0,
+            45.0,
+            noise(0.0, 4.0, 45.0),
+            Better::Lower
+        )));
+        assert!(is_regression(&change(
+            57.0,
+            45.0,
+            noise(0.0, 4.0, 45.0),
+            Better::Lower
+        )));
     }
 
     #[test]

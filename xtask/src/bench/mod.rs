@@ -21,7 +21,7 @@ mod mesh;
 mod options;
 mod programs;
 
-use compare::{change, is_regression, spread, Better};
+use compare::{change, is_regression, noise, spread, Better};
 
 /// One benchmark render: a scene, its `-D` overrides and what to print it as.
 struct Case {
@@ -687,8 +687,11 @@ fn comparison_table(
                 new.least_build,
                 old.as_ref().map(|o| o.least_build),
                 old.as_ref().map_or(0.0, |o| {
-                    (o.build_spread + new.build_spread)
-                        .max(BUILD_NOISE_SECONDS / o.least_build.max(1e-9))
+                    noise(
+                        o.build_spread + new.build_spread,
+                        BUILD_NOISE_SECONDS,
+                        o.least_build,
+                    )
                 }),
                 Better::Lower,
             );
@@ -700,9 +703,12 @@ fn comparison_table(
                 (Some(n), Some(o)) => change(
                     n,
                     o,
-                    old.as_ref()
-                        .map_or(0.0, |o| o.peak_spread + new.peak_spread)
-                        .max(PEAK_NOISE_MIB / o.max(1.0)),
+                    noise(
+                        old.as_ref()
+                            .map_or(0.0, |o| o.peak_spread + new.peak_spread),
+                        PEAK_NOISE_MIB,
+                        o,
+                    ),
                     Better::Lower,
                 ),
                 _ => format!("{:>8}", "-"),
@@ -797,10 +803,10 @@ pub(super) fn measure(
 const POVRAY: &str = "/usr/bin/povray";
 
 /// Peak-memory changes this small (MiB) are never marked: see `comparison_table`.
+const PEAK_NOISE_MIB: f64 = 4.0;
+
 /// Build times closer than this are the clock's jitter, not a change (see the table).
 const BUILD_NOISE_SECONDS: f64 = 0.005;
-
-const PEAK_NOISE_MIB: f64 = 4.0;
 
 /// Each render is run this many times and the fastest run reported, for whitted and POV-Ray alike.
 const RUNS: usize = 3;
