@@ -160,7 +160,7 @@ fn solid_contains(scene: &Scene, handle: Handle<Object>, p: DVec3) -> Option<boo
     match &object.kind {
         ObjectKind::Shape { shape } => {
             let q = object.world_from_object.inverse().transform_point3(p);
-            shape_contains(scene, shape, q)
+            shape_contains(scene, &shape.get(), q)
         }
         ObjectKind::Csg { op, children } => {
             let mut inside = children
@@ -551,7 +551,7 @@ impl Reshader<'_> {
         let leaf = &self.scene.objects[Handle::from_index(hit.leaf.handle as usize)];
         let solid = match &leaf.kind {
             // A mesh is a solid when its data says so (closed and consistently oriented).
-            ObjectKind::Shape { shape } => self.scene.is_solid_shape(shape),
+            ObjectKind::Shape { shape } => self.scene.is_solid_shape(&shape.get()),
             _ => true,
         };
         let kr = c(&m.reflective);

@@ -227,7 +227,8 @@ mod tests {
                             shape: whitted_ir::Shape::Sphere {
                                 center: whitted_ir::DVec3::ZERO,
                                 radius: 1e19,
-                            },
+                            }
+                            .into(),
                         },
                         world_from_object: whitted_ir::WorldFromObject::IDENTITY,
                         material,

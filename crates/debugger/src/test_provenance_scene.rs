@@ -125,12 +125,13 @@ pub fn provenance_scene() -> ValidScene {
             let angle = (f64::from(i) * 360.0 / 12.0).to_radians();
             let handle = scene.objects.append(
                 Object {
-                    name: Some(format!("bead {i}")),
+                    name: scene.object_names.add(&format!("bead {i}")),
                     kind: ObjectKind::Shape {
                         shape: Shape::Sphere {
                             center: DVec3::new(2.0 * angle.cos(), 2.0 * angle.sin(), 0.0),
                             radius: 0.35,
-                        },
+                        }
+                        .into(),
                     },
                     world_from_object: world_from_object.into(),
                     material: red,

@@ -145,8 +145,10 @@ pub fn whitted_scene() -> ValidScene {
     let mut object = |name: &str, shape: Shape, material, start: &str| {
         let handle = scene.objects.append(
             Object {
-                name: Some(name.into()),
-                kind: ObjectKind::Shape { shape },
+                name: scene.object_names.add(name),
+                kind: ObjectKind::Shape {
+                    shape: shape.into(),
+                },
                 world_from_object: DMat4::IDENTITY.into(),
                 material,
             },
@@ -352,7 +354,7 @@ pub fn hall_of_mirrors() -> ValidScene {
             Object {
                 name: None,
                 kind: ObjectKind::Shape {
-                    shape: Shape::Plane { normal, offset },
+                    shape: Shape::Plane { normal, offset }.into(),
                 },
                 world_from_object: DMat4::IDENTITY.into(),
                 material: mirror,

@@ -12,7 +12,7 @@ pub fn contains(scene: &Scene, handle: Handle<Object>, p: DVec3) -> Option<bool>
     match &object.kind {
         ObjectKind::Shape { shape } => {
             let local = object.world_from_object.inverse().transform_point3(p);
-            shape_contains(scene, shape, local)
+            shape_contains(scene, &shape.get(), local)
         }
         ObjectKind::Csg { op, children } => {
             let mut inside = children

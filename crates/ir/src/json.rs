@@ -51,6 +51,7 @@ struct ObjectEntry<'a> {
     location: String,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     made_by: Vec<StepJson<'a>>,
+    name: Option<&'a str>,
     #[serde(flatten)]
     value: &'a Object,
 }
@@ -71,6 +72,7 @@ impl Serialize for Objects<'_> {
                         .iter()
                         .map(|step| StepJson::new(step, &scene.sources))
                         .collect(),
+                    name: scene.name_of(value),
                     value,
                 }),
         )

@@ -8,6 +8,7 @@ mod diagnostic;
 mod json;
 pub mod limits;
 mod mesh;
+mod object_shape;
 mod print;
 pub mod properties;
 mod provenance;
@@ -22,6 +23,7 @@ pub use arena::{Arena, Handle};
 pub use diagnostic::{Diagnostic, Label, Severity};
 pub use json::{document as json_document, to_json, ArgJson, IrDocument, StepJson};
 pub use mesh::{BadEdge, EdgeDefect, Mesh, NotSolid};
+pub use object_shape::{NameId, Names, ObjectShape};
 pub use print::print;
 pub use provenance::{ArgValue, FrameId, Provenance, Site, SiteId, SiteKind, Step};
 pub use scene::{

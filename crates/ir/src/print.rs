@@ -237,13 +237,12 @@ fn material_fields(m: &Material) -> String {
 fn print_object(scene: &Scene, handle: Handle<Object>, depth: usize, out: &mut String) {
     let object = &scene.objects[handle];
     let indent = "  ".repeat(depth);
-    let name = object
-        .name
-        .as_deref()
+    let name = scene
+        .name_of(object)
         .map(|n| format!(" {n:?}"))
         .unwrap_or_default();
     let what = match &object.kind {
-        ObjectKind::Shape { shape } => shape_text(scene, shape),
+        ObjectKind::Shape { shape } => shape_text(scene, &shape.get()),
         ObjectKind::Csg { op, .. } => op.name().to_string(),
         ObjectKind::Group { .. } => "group".to_string(),
     };

@@ -13,7 +13,7 @@ use crate::limits::{
     MAX_COORDINATE, MAX_DEPTH, MAX_FILTERED_SAMPLES, MAX_IMAGE_SIDE, MAX_INTENSITY, MAX_IOR,
     MAX_PIXELS, MAX_SAMPLES_PER_PIXEL, MIN_IOR, MIN_SIZE,
 };
-use crate::scene::{Color, LightKind, Material, Object, ObjectKind, Projection, Scene, Shape};
+use crate::scene::{Color, LightKind, Material, Object, Projection, Scene, Shape};
 use crate::source::Span;
 use crate::written::{BlockKind, Written};
 
@@ -359,7 +359,7 @@ impl Ranges<'_> {
     fn object(&mut self, object: &Object, mesh_boxes: &[Option<(DVec3, DVec3)>], span: Span) {
         let m = &object.world_from_object;
         self.matrix("object's transform", m, span);
-        let ObjectKind::Shape { shape } = &object.kind else {
+        let Some(shape) = &object.kind.shape() else {
             return;
         };
         // The shape's own numbers, then its box in world space.
@@ -535,7 +535,8 @@ mod tests {
                     shape: Shape::Sphere {
                         center: glam::DVec3::ZERO,
                         radius: 1.0,
-                    },
+                    }
+                    .into(),
                 },
                 world_from_object: WorldFromObject::IDENTITY,
                 material,
@@ -600,19 +601,21 @@ mod tests {
                 s.materials[Handle::from_index(0)].ior = v
             }),
             ("sphere's `radius`", |s, v| {
-                if let ObjectKind::Shape {
-                    shape: Shape::Sphere { radius, .. },
-                } = &mut s.objects[Handle::from_index(0)].kind
-                {
-                    *radius = v;
+                if let ObjectKind::Shape { shape } = &mut s.objects[Handle::from_index(0)].kind {
+                    shape.update(|s| {
+                        if let Shape::Sphere { radius, .. } = s {
+                            *radius = v;
+                        }
+                    });
                 }
             }),
             ("sphere's `center`", |s, v| {
-                if let ObjectKind::Shape {
-                    shape: Shape::Sphere { center, .. },
-                } = &mut s.objects[Handle::from_index(0)].kind
-                {
-                    center.y = v;
+                if let ObjectKind::Shape { shape } = &mut s.objects[Handle::from_index(0)].kind {
+                    shape.update(|s| {
+                        if let Shape::Sphere { center, .. } = s {
+                            center.y = v;
+                        }
+                    });
                 }
             }),
             ("object's transform", |s, v| {
@@ -656,11 +659,12 @@ mod tests {
         // Tiny sizes round to nothing in f32: refused, with the limit named.
         for value in [5e-324, 1e-310, 1e-40] {
             let mut scene = base();
-            if let ObjectKind::Shape {
-                shape: Shape::Sphere { radius, .. },
-            } = &mut scene.objects[Handle::from_index(0)].kind
-            {
-                *radius = value;
+            if let ObjectKind::Shape { shape } = &mut scene.objects[Handle::from_index(0)].kind {
+                shape.update(|s| {
+                    if let Shape::Sphere { radius, .. } = s {
+                        *radius = value;
+                    }
+                });
             }
             let messages = messages(scene);
             assert!(
@@ -711,11 +715,12 @@ mod tests {
         let mut scene = base();
         scene.objects[Handle::from_index(0)].world_from_object =
             DMat4::from_scale(glam::DVec3::new(1e-4, 1e2, 1e2)).into();
-        if let ObjectKind::Shape {
-            shape: Shape::Sphere { radius, .. },
-        } = &mut scene.objects[Handle::from_index(0)].kind
-        {
-            *radius = 1e-6;
+        if let ObjectKind::Shape { shape } = &mut scene.objects[Handle::from_index(0)].kind {
+            shape.update(|s| {
+                if let Shape::Sphere { radius, .. } = s {
+                    *radius = 1e-6;
+                }
+            });
         }
         let messages = messages(scene);
         assert!(
@@ -731,11 +736,12 @@ mod tests {
         let mut scene = base();
         scene.objects[Handle::from_index(0)].world_from_object =
             DMat4::from_scale(glam::DVec3::splat(1e6)).into();
-        if let ObjectKind::Shape {
-            shape: Shape::Sphere { radius, .. },
-        } = &mut scene.objects[Handle::from_index(0)].kind
-        {
-            *radius = 1e4;
+        if let ObjectKind::Shape { shape } = &mut scene.objects[Handle::from_index(0)].kind {
+            shape.update(|s| {
+                if let Shape::Sphere { radius, .. } = s {
+                    *radius = 1e4;
+                }
+            });
         }
         let messages = messages(scene);
         assert!(

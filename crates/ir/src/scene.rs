@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use crate::arena::{Arena, Handle};
 use crate::mesh::Mesh;
+use crate::object_shape::{NameId, Names, ObjectShape};
 use crate::provenance::Provenance;
 use crate::source::{SourceMap, Span};
 use crate::written::Written;
@@ -696,7 +697,7 @@ impl CsgOp {
 #[serde(tag = "type", rename_all = "snake_case")]
 pub enum ObjectKind {
     Shape {
-        shape: Shape,
+        shape: ObjectShape,
     },
     /// A solid made from solid children; children come before the node in the arena.
     Csg {
@@ -709,9 +710,22 @@ pub enum ObjectKind {
     },
 }
 
+impl ObjectKind {
+    /// The shape of a shape object (`None` for CSG and groups).
+    pub fn shape(&self) -> Option<Shape> {
+        match self {
+            ObjectKind::Shape { shape } => Some(shape.get()),
+            ObjectKind::Csg { .. } | ObjectKind::Group { .. } => None,
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Object {
-    pub name: Option<String>,
+    /// Its name in the scene's [`Scene::object_names`]; read it with [`Scene::object_name`].
+    /// (The scene's JSON writes the name itself, beside the object's other fields.)
+    #[serde(skip)]
+    pub name: Option<NameId>,
     pub kind: ObjectKind,
     /// The full transform from this node's space to world space (parents already applied).
     pub world_from_object: WorldFromObject,
@@ -800,6 +814,8 @@ pub struct Scene {
     pub meshes: Arena<Mesh>,
     /// The top-level objects, in source order. Every other object is reachable from these.
     pub roots: Vec<Handle<Object>>,
+    /// The names objects were given (an object holds an index into this).
+    pub object_names: Names,
     pub sources: SourceMap,
     /// How each object was made: the imports, calls and loop iterations around it.
     pub provenance: Provenance,
@@ -830,8 +846,8 @@ impl Scene {
     /// The display name of an object: its own name, or its kind and handle.
     pub fn object_label(&self, handle: Handle<Object>) -> String {
         let object = &self.objects[handle];
-        match &object.name {
-            Some(name) => name.clone(),
+        match self.name_of(object) {
+            Some(name) => name.to_string(),
             None => {
                 let kind = match &object.kind {
                     ObjectKind::Shape { shape } => shape.kind_name(),
@@ -841,6 +857,18 @@ impl Scene {
                 format!("{kind} {handle}")
             }
         }
+    }
+
+    /// The name `handle`'s object was given, if any.
+    pub fn object_name(&self, handle: Handle<Object>) -> Option<&str> {
+        self.objects
+            .get(handle)
+            .and_then(|object| self.name_of(object))
+    }
+
+    /// The name `object` (an object of this scene) was given, if any.
+    pub fn name_of(&self, object: &Object) -> Option<&str> {
+        object.name.map(|id| self.object_names.get(id))
     }
 
     /// Whether a shape encloses a volume: [`Shape::is_solid`], with meshes answered by

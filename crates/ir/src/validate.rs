@@ -376,14 +376,14 @@ impl Checker {
             );
         }
         match &object.kind {
-            ObjectKind::Shape {
-                shape: Shape::Mesh { mesh, .. },
-            } => {
-                if !scene.meshes.contains(*mesh) {
-                    self.error(format!("the object refers to a missing mesh {mesh}"), span);
+            ObjectKind::Shape { shape } => match shape.get() {
+                Shape::Mesh { mesh, .. } => {
+                    if !scene.meshes.contains(mesh) {
+                        self.error(format!("the object refers to a missing mesh {mesh}"), span);
+                    }
                 }
-            }
-            ObjectKind::Shape { shape } => self.shape(shape, span),
+                shape => self.shape(&shape, span),
+            },
             ObjectKind::Csg { op, children } => {
                 if children.is_empty() {
                     self.error(format!("this {} has no children", op.name()), span);
@@ -395,10 +395,10 @@ impl Checker {
                     if !is_solid(scene, child) {
                         let child_span = scene.objects.span(child);
                         // A mesh says why it is not a solid, with an edge and its face.
-                        let why = match &scene.objects[child].kind {
-                            ObjectKind::Shape {
-                                shape: Shape::Mesh { mesh, .. },
-                            } => scene.meshes.get(*mesh).and_then(|m| m.not_solid.as_ref()),
+                        let why = match scene.objects[child].kind.shape() {
+                            Some(Shape::Mesh { mesh, .. }) => {
+                                scene.meshes.get(mesh).and_then(|m| m.not_solid.as_ref())
+                            }
                             _ => None,
                         };
                         // `an intersection`, but `a union` (its first sound is a consonant).
@@ -664,7 +664,7 @@ impl Checker {
 
 fn is_solid(scene: &Scene, handle: Handle<Object>) -> bool {
     match &scene.objects[handle].kind {
-        ObjectKind::Shape { shape } => scene.is_solid_shape(shape),
+        ObjectKind::Shape { shape } => scene.is_solid_shape(&shape.get()),
         ObjectKind::Csg { .. } => true,
         ObjectKind::Group { .. } => false,
     }
@@ -709,7 +709,9 @@ mod tests {
         let object = scene.objects.append(
             Object {
                 name: None,
-                kind: ObjectKind::Shape { shape },
+                kind: ObjectKind::Shape {
+                    shape: shape.into(),
+                },
                 world_from_object: WorldFromObject::IDENTITY,
                 material,
             },

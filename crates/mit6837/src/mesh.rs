@@ -100,7 +100,8 @@ impl<'a> Converter<'a, '_> {
                         mesh,
                         // The course's meshes are faceted: its files have no normals.
                         smooth: false,
-                    },
+                    }
+                    .into(),
                 },
                 world_from_object: world_from_object.into(),
                 material,

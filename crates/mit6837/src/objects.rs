@@ -397,7 +397,9 @@ impl<'a> Converter<'a, '_> {
         self.append(
             Object {
                 name: None,
-                kind: ObjectKind::Shape { shape },
+                kind: ObjectKind::Shape {
+                    shape: shape.into(),
+                },
                 world_from_object: world_from_object.into(),
                 material,
             },

@@ -6,8 +6,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use whitted_ir::{
-    DMat4, DVec3, Diagnostic, Highlight, LightKind, ObjectKind, Projection, Scene, ShadowMode,
-    Shape,
+    DMat4, DVec3, Diagnostic, Highlight, LightKind, Projection, Scene, ShadowMode, Shape,
 };
 
 use crate::{convert, is_mit6837, Conversion, CourseOptions, MeshLoader};
@@ -162,8 +161,8 @@ fn every_construct_becomes_the_ir_the_course_means() {
     // The plane: normal normalised, offset kept; under Translate then UniformScale, with
     // the inner group's material.
     assert!(matches!(
-        objects[1].kind,
-        ObjectKind::Shape { shape: Shape::Plane { normal, offset } } if normal == DVec3::Y && offset == -1.0
+        objects[1].kind.shape(),
+        Some(Shape::Plane { normal, offset }) if normal == DVec3::Y && offset == -1.0
     ));
     assert_eq!(objects[1].world_from_object.matrix(), transform);
     assert_eq!(objects[1].material.index(), 1);
@@ -310,10 +309,8 @@ fn a_mesh_becomes_one_ir_mesh_instanced_by_its_triangle_mesh() {
     let instances: Vec<_> = scene
         .objects
         .iter_with_spans()
-        .filter_map(|(_, o, span)| match o.kind {
-            ObjectKind::Shape {
-                shape: Shape::Mesh { mesh, smooth },
-            } => Some((
+        .filter_map(|(_, o, span)| match o.kind.shape() {
+            Some(Shape::Mesh { mesh, smooth }) => Some((
                 mesh,
                 smooth,
                 o.world_from_object.matrix(),

@@ -457,13 +457,11 @@ fn prepare_leaf(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (
     let object = &scene.objects[handle];
     // Projective rows are ignored: the language only makes affine transforms.
     let world_from_object = DAffine3::from_mat4(object.world_from_object.matrix());
-    let (geometry, bound, snap) = match &object.kind {
-        ObjectKind::Shape {
-            shape: Shape::Mesh { mesh, smooth },
-        } => match shared.meshes.get(mesh.index()) {
+    let (geometry, bound, snap) = match object.kind.shape() {
+        Some(Shape::Mesh { mesh, smooth }) => match shared.meshes.get(mesh.index()) {
             Some(prepared) => {
                 let (instance, bound) =
-                    MeshInstance::new(Arc::clone(prepared), *smooth, &world_from_object);
+                    MeshInstance::new(Arc::clone(prepared), smooth, &world_from_object);
                 (Geometry::Mesh(Box::new(instance)), bound, Snap::None)
             }
             // Validation refuses a missing mesh; should one arrive, it is nothing.
@@ -476,10 +474,10 @@ fn prepare_leaf(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (
                 Snap::None,
             ),
         },
-        ObjectKind::Shape { shape } => {
-            let (geometry, bound) = Geometry::new(shape, &world_from_object);
+        Some(shape) => {
+            let (geometry, bound) = Geometry::new(&shape, &world_from_object);
             let snap = match shape {
-                Shape::Plane { normal, offset } => Snap::plane(*normal, *offset),
+                Shape::Plane { normal, offset } => Snap::plane(normal, offset),
                 Shape::Box { min, max } => Snap::Box {
                     min: min.as_vec3a(),
                     max: max.as_vec3a(),
@@ -490,7 +488,7 @@ fn prepare_leaf(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (
         }
         // Validation keeps groups out of CSG and flattening keeps them out of items; should
         // one arrive anyway it is an empty solid.
-        ObjectKind::Group { .. } | ObjectKind::Csg { .. } => (
+        None => (
             Geometry::Plane {
                 normal: Vec3A::Y,
                 offset: 0.0,

@@ -70,7 +70,13 @@ impl SceneBuilder {
         world_from_object: DMat4,
         material: Handle<Material>,
     ) -> Handle<Object> {
-        self.object(ObjectKind::Shape { shape }, world_from_object, material)
+        self.object(
+            ObjectKind::Shape {
+                shape: shape.into(),
+            },
+            world_from_object,
+            material,
+        )
     }
 
     /// A top-level shape.
@@ -124,7 +130,7 @@ impl SceneBuilder {
     }
 
     pub fn name(&mut self, handle: Handle<Object>, name: &str) {
-        self.scene.objects[handle].name = Some(name.to_string());
+        self.scene.objects[handle].name = self.scene.object_names.add(name);
     }
 
     fn default_material(&mut self) -> Handle<Material> {

@@ -219,7 +219,7 @@ fn opaque_solid(context: &Context<'_>, hit: &HitInfo) -> bool {
         return false;
     };
     let solid = match &object.kind {
-        ObjectKind::Shape { shape } => context.scene.is_solid_shape(shape),
+        ObjectKind::Shape { shape } => context.scene.is_solid_shape(&shape.get()),
         ObjectKind::Csg { .. } => true,
         ObjectKind::Group { .. } => false,
     };
@@ -307,14 +307,14 @@ fn is_convex(scene: &Scene, handle: u32) -> bool {
         return false;
     };
     match &object.kind {
-        ObjectKind::Shape { shape } => match shape {
+        ObjectKind::Shape { shape } => match shape.get() {
             Shape::Sphere { .. }
             | Shape::Box { .. }
             | Shape::Plane { .. }
             | Shape::Disk { .. }
             | Shape::Triangle { .. } => true,
-            Shape::Cylinder { capped, .. } | Shape::Cone { capped, .. } => *capped,
-            Shape::Quadric { form, .. } => *form == QuadricForm::Ellipsoid,
+            Shape::Cylinder { capped, .. } | Shape::Cone { capped, .. } => capped,
+            Shape::Quadric { form, .. } => form == QuadricForm::Ellipsoid,
             _ => false,
         },
         ObjectKind::Csg { .. } | ObjectKind::Group { .. } => false,

@@ -60,7 +60,7 @@ impl Bounds {
 pub fn world_bounds(scene: &Scene, handle: Handle<Object>) -> Option<Bounds> {
     let object = scene.objects.get(handle)?;
     match &object.kind {
-        ObjectKind::Shape { shape } => shape_bounds(scene, shape, &object.world_from_object),
+        ObjectKind::Shape { shape } => shape_bounds(scene, &shape.get(), &object.world_from_object),
         ObjectKind::Csg { op, children } => {
             let mut boxes = children.iter().map(|&c| world_bounds(scene, c));
             match op {

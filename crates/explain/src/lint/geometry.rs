@@ -29,7 +29,7 @@ pub(super) fn object_name(scene: &Scene, handle: Handle<Object>) -> String {
     let Some(object) = scene.objects.get(handle) else {
         return format!("object {handle}");
     };
-    match &object.name {
+    match scene.name_of(object) {
         Some(name) => {
             let kind = match &object.kind {
                 ObjectKind::Shape { shape } => shape.kind_name(),
@@ -117,12 +117,7 @@ pub(super) fn lights_inside_solids(scene: &Scene, lints: &mut Vec<Lint>) {
             }
             let name = object_name(scene, object_handle);
             let light_name = light_label(scene, light_handle);
-            let plane = matches!(
-                object.kind,
-                ObjectKind::Shape {
-                    shape: Shape::Plane { .. }
-                }
-            );
+            let plane = matches!(object.kind.shape(), Some(Shape::Plane { .. }));
             let (inside, fix) = if plane {
                 (
                     format!("below {name} (on the side its normal points away from)"),
@@ -228,10 +223,10 @@ pub(super) fn facing_away_from_lights(scene: &Scene, lints: &mut Vec<Lint>) {
     }
     for &handle in &scene.roots {
         let object = &scene.objects[handle];
-        let ObjectKind::Shape { shape } = &object.kind else {
+        let Some(shape) = object.kind.shape() else {
             continue;
         };
-        let (normal, on_surface, what) = match *shape {
+        let (normal, on_surface, what) = match shape {
             Shape::Plane { normal, offset } => {
                 let p = normal * (offset / normal.length_squared());
                 (normal, p, "plane")

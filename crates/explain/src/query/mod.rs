@@ -212,7 +212,7 @@ fn named(scene: &Scene, name: &str, at: &std::ops::Range<usize>) -> Result<Vec<u
     let handles: Vec<u32> = scene
         .objects
         .iter()
-        .filter(|(_, o)| o.name.as_deref() == Some(name))
+        .filter(|(_, o)| scene.name_of(o) == Some(name))
         .map(|(h, _): (Handle<Object>, _)| h.index() as u32)
         .collect();
     if !handles.is_empty() {
@@ -221,7 +221,7 @@ fn named(scene: &Scene, name: &str, at: &std::ops::Range<usize>) -> Result<Vec<u
     let mut names: Vec<&str> = scene
         .objects
         .iter()
-        .filter_map(|(_, o)| o.name.as_deref())
+        .filter_map(|(_, o)| scene.name_of(o))
         .collect();
     names.sort_unstable();
     names.dedup();

@@ -79,7 +79,7 @@ impl<'a> Evaluator<'a> {
                 ObjectKind::Group { children }
             }
             _ => ObjectKind::Shape {
-                shape: self.shape(tag, &builder, header)?,
+                shape: self.shape(tag, &builder, header)?.into(),
             },
         };
         let object = Object {
@@ -410,7 +410,7 @@ impl<'a> Evaluator<'a> {
                 attenuation: builder.attenuation,
             },
         };
-        let name = self.object_name(name)?;
+        let name = self.name_text(name)?;
         self.scene.lights.append(
             Light {
                 name,

@@ -2,7 +2,7 @@
 //! the name has when the string is evaluated (numbers as written, `3` not `3.0`).
 
 use whitted_ir::limits::MAX_STRING_BYTES;
-use whitted_ir::Diagnostic;
+use whitted_ir::{Diagnostic, NameId};
 
 use super::{Abort, Eval, Evaluator};
 use crate::ast::*;
@@ -20,7 +20,17 @@ impl<'a> Evaluator<'a> {
     }
 
     /// The name of an object or light, formatted.
-    pub(super) fn object_name(&mut self, name: Option<&StrLit>) -> Eval<Option<String>> {
+    /// The object's name, kept in the scene's name table. (The table refuses only past
+    /// 2^32 - 1 names, which the memory budget charged here stops long before.)
+    pub(super) fn object_name(&mut self, name: Option<&StrLit>) -> Eval<Option<NameId>> {
+        let Some(text) = self.name_text(name)? else {
+            return Ok(None);
+        };
+        Ok(self.scene.object_names.add(&text))
+    }
+
+    /// A light's or object's name as text, charged to the memory budget.
+    pub(super) fn name_text(&mut self, name: Option<&StrLit>) -> Eval<Option<String>> {
         let Some(lit) = name else { return Ok(None) };
         let text = self.format_string(lit)?;
         self.charge(text.len() + std::mem::size_of::<String>(), lit.span)?;

@@ -157,9 +157,8 @@ pub(crate) fn load_meshes(
     for (_, object) in scene.objects.iter() {
         if let ObjectKind::Csg { children, .. } = &object.kind {
             for &child in children {
-                if let Some(ObjectKind::Shape {
-                    shape: Shape::Mesh { mesh, .. },
-                }) = scene.objects.get(child).map(|o| &o.kind)
+                if let Some(Shape::Mesh { mesh, .. }) =
+                    scene.objects.get(child).and_then(|o| o.kind.shape())
                 {
                     if let Some(slot) = in_csg.get_mut(mesh.index()) {
                         *slot = true;

@@ -135,10 +135,8 @@ fn let_bindings_and_block_scope() {
     let radii: Vec<f64> = scene
         .objects
         .iter()
-        .filter_map(|(_, o)| match &o.kind {
-            ObjectKind::Shape {
-                shape: Shape::Sphere { radius, .. },
-            } => Some(*radius),
+        .filter_map(|(_, o)| match o.kind.shape() {
+            Some(Shape::Sphere { radius, .. }) => Some(radius),
             _ => None,
         })
         .collect();
@@ -151,10 +149,8 @@ fn for_loops_nest_and_ranges_include_or_exclude_the_end() {
     let centers: Vec<DVec3> = scene
         .objects
         .iter()
-        .filter_map(|(_, o)| match &o.kind {
-            ObjectKind::Shape {
-                shape: Shape::Sphere { center, .. },
-            } => Some(*center),
+        .filter_map(|(_, o)| match o.kind.shape() {
+            Some(Shape::Sphere { center, .. }) => Some(center),
             _ => None,
         })
         .collect();
@@ -439,14 +435,7 @@ fn every_shape() {
     let capped: Vec<bool> = scene
         .objects
         .iter()
-        .map(|(_, o)| {
-            matches!(
-                o.kind,
-                ObjectKind::Shape {
-                    shape: Shape::Cylinder { capped: true, .. }
-                }
-            )
-        })
+        .map(|(_, o)| matches!(o.kind.shape(), Some(Shape::Cylinder { capped: true, .. })))
         .collect();
     assert_eq!(capped, [false, true]);
 }
@@ -455,10 +444,8 @@ fn every_shape() {
 fn quadrics_general_and_named() {
     let coefficients = |input: &str| -> (QuadricForm, [f64; 10]) {
         let scene = scene(input);
-        match &scene.objects[scene.roots[0]].kind {
-            ObjectKind::Shape {
-                shape: Shape::Quadric { form, quadric },
-            } => (*form, quadric.coefficients()),
+        match scene.objects[scene.roots[0]].kind.shape() {
+            Some(Shape::Quadric { form, quadric }) => (form, quadric.coefficients()),
             other => panic!("not a quadric: {other:?}"),
         }
     };

@@ -6,7 +6,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use whitted_ir::{ObjectKind, Severity, Shape};
+use whitted_ir::{Severity, Shape};
 use whitted_lang::{compile_source, CompileOptions, Limits, SourceLoader};
 
 use crate::support::{check_errors_with, output, MapLoader};
@@ -59,10 +59,7 @@ fn a_thousand_instances_read_the_file_once_and_share_one_mesh() {
     let mut instances = 0;
     let mut smooth = Vec::new();
     for (_, object) in scene.objects.iter() {
-        if let ObjectKind::Shape {
-            shape: Shape::Mesh { mesh, smooth: s },
-        } = object.kind
-        {
+        if let Some(Shape::Mesh { mesh, smooth: s }) = object.kind.shape() {
             assert_eq!(mesh, handle);
             instances += 1;
             smooth.push(s);

@@ -2,7 +2,7 @@
 //! step`, `while` and assignment, `rand`, formatted strings and expression-bodied functions.
 //! Values are checked against oracles written here (a `Vec`, a formula, a hash by hand).
 
-use whitted_ir::{ObjectKind, Shape};
+use whitted_ir::Shape;
 use whitted_lang::{CompileOptions, Limits};
 
 use crate::support::*;
@@ -13,10 +13,8 @@ fn xs(input: &str) -> Vec<f64> {
     scene
         .objects
         .iter()
-        .filter_map(|(_, o)| match &o.kind {
-            ObjectKind::Shape {
-                shape: Shape::Sphere { center, .. },
-            } => Some(center.x),
+        .filter_map(|(_, o)| match o.kind.shape() {
+            Some(Shape::Sphere { center, .. }) => Some(center.x),
             _ => None,
         })
         .collect()
@@ -28,7 +26,7 @@ fn names(input: &str) -> Vec<String> {
     scene
         .objects
         .iter()
-        .filter_map(|(_, o)| o.name.clone())
+        .filter_map(|(_, o)| scene.name_of(o).map(str::to_string))
         .collect()
 }
 
@@ -114,7 +112,7 @@ fn arrays_hold_any_value_and_nest() {
     let names: Vec<_> = scene
         .objects
         .iter()
-        .filter_map(|(_, o)| o.name.clone())
+        .filter_map(|(_, o)| scene.name_of(o))
         .collect();
     assert_eq!(names, ["left", "right"]);
     assert_eq!(
@@ -275,10 +273,7 @@ fn rand_is_roughly_uniform() {
     let scene = scene("for i in 0..4000 { sphere { center <rand(3, i), 0, 0> radius 0.1 } }");
     let mut bins = [0usize; 10];
     for (_, object) in scene.objects.iter() {
-        if let ObjectKind::Shape {
-            shape: Shape::Sphere { center, .. },
-        } = &object.kind
-        {
+        if let Some(Shape::Sphere { center, .. }) = object.kind.shape() {
             bins[(center.x * 10.0) as usize] += 1;
         }
     }

@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use whitted_ir::{DVec3, ObjectKind, Scene, Shape};
+use whitted_ir::{DVec3, Scene, Shape};
 use whitted_lang::{compile_source, render_diagnostics, Compilation, CompileOptions, SourceLoader};
 
 /// Files by path, for imports; anything else is "not found".
@@ -116,11 +116,8 @@ pub fn scene(input: &str) -> Scene {
 /// The centre of the first sphere in a scene.
 pub fn first_center(scene: &Scene) -> DVec3 {
     for (_, object) in scene.objects.iter() {
-        if let ObjectKind::Shape {
-            shape: Shape::Sphere { center, .. },
-        } = &object.kind
-        {
-            return *center;
+        if let Some(Shape::Sphere { center, .. }) = object.kind.shape() {
+            return center;
         }
     }
     panic!("no sphere in the scene")
@@ -142,10 +139,12 @@ pub fn boolean(expr: &str) -> bool {
         "if {expr} {{ sphere {{ }} }} else {{ box {{ }} }}"
     ));
     let is_sphere = matches!(
-        scene.objects.iter().next().map(|(_, o)| &o.kind),
-        Some(ObjectKind::Shape {
-            shape: Shape::Sphere { .. }
-        })
+        scene
+            .objects
+            .iter()
+            .next()
+            .and_then(|(_, o)| o.kind.shape()),
+        Some(Shape::Sphere { .. })
     );
     is_sphere
 }

@@ -40,7 +40,7 @@ pub(crate) fn object_ref(scene: &Scene, handle: Handle<Object>) -> ObjectRef {
     };
     ObjectRef {
         handle: handle.index() as u32,
-        name: object.name.clone(),
+        name: scene.name_of(object).map(str::to_string),
         label: scene.object_label(handle),
         kind: kind.to_string(),
         location: scene.sources.location(span),
