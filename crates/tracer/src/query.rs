@@ -127,11 +127,13 @@ pub(crate) fn item_hit(
         Item::Shape(Leaf {
             geometry: Geometry::Sphere { center, radius },
             ..
-        }) => sphere_first_hit(ray, *center, *radius, tmin, tmax).map(|t| (t, 0, 0, false)),
+        }) => sphere_first_hit(ray, Vec3A::from(*center), *radius, tmin, tmax)
+            .map(|t| (t, 0, 0, false)),
         Item::Shape(Leaf {
             geometry: Geometry::Plane { normal, offset },
             ..
-        }) => plane_first_hit(ray, *normal, *offset, tmin, tmax).map(|t| (t, 0, 0, false)),
+        }) => plane_first_hit(ray, Vec3A::from(*normal), *offset, tmin, tmax)
+            .map(|t| (t, 0, 0, false)),
         _ => other_item_hit(item, ray, tmin, tmax, scratch),
     }
 }
@@ -505,12 +507,12 @@ impl PreparedScene {
         let leaf = item.leaf(hit.leaf);
         let (bounded, normal) = match &leaf.geometry {
             Geometry::Sphere { center, radius } => {
-                hit_error::on_sphere(*center, *radius, ray.at(hit.t))
+                hit_error::on_sphere(Vec3A::from(*center), *radius, ray.at(hit.t))
             }
             // What `Geometry::normal` computes for a plane, inline: floors are hit often.
             Geometry::Plane { normal, offset } => (
-                hit_error::on_plane(*normal, *offset, ray.at(hit.t)),
-                unit_normal(*normal, ray),
+                hit_error::on_plane(Vec3A::from(*normal), *offset, ray.at(hit.t)),
+                unit_normal(Vec3A::from(*normal), ray),
             ),
             geometry => (
                 geometry.bounded_point(ray, hit.t, hit.part),
@@ -541,7 +543,8 @@ impl PreparedScene {
     #[inline]
     pub(crate) fn resolve_material(&self, leaf: &Leaf, point: Vec3A, part: Part) -> Resolved {
         let mut material = leaf.material;
-        let Some(frame) = &leaf.pattern_frame else {
+        // Only a leaf whose material has a pattern was given a frame (found in one step).
+        let Some(frame) = self.pattern_frames.get(leaf.object) else {
             return Resolved {
                 material,
                 blend: None,

@@ -2,7 +2,7 @@
 //! from a validated IR scene: f32 shapes with their transforms folded in, resolved materials
 //! and lights, the camera basis, CSG trees, and the BVH over bounded objects.
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use glam::{DAffine3, Vec3A};
@@ -16,26 +16,25 @@ use crate::camera::PreparedCamera;
 use crate::csg::{ChildAccel, CsgNode, CsgTree, NO_ACCEL};
 use crate::hit_error;
 use crate::light::PreparedLight;
-use crate::material::{color, PatternFrame, PreparedMaterial, Snap};
+use crate::material::{color, PatternFrame, PatternFrames, PreparedMaterial, Snap};
 use crate::mesh::{MeshInstance, PreparedMesh};
 use crate::query::Surface;
 use crate::shapes::Geometry;
 use whitted_bvh::Bound;
 use whitted_bvh::Bvh;
 
-/// A primitive shape ready to intersect, with what shading needs to know about it.
+/// A primitive shape ready to intersect, with what shading needs to know about it. (A
+/// patterned leaf's frame is in [`PreparedScene`]'s `pattern_frames`, by `object`.)
 #[derive(Clone, Debug)]
 pub struct Leaf {
     pub geometry: Geometry,
     /// The IR object of this shape (a CSG leaf reports itself, not the CSG root).
     pub object: Handle<Object>,
     pub material: Handle<Material>,
-    /// Only for leaves whose material has a pattern.
-    pub pattern_frame: Option<Box<PatternFrame>>,
 }
 
 /// One top-level thing to intersect: a shape or a whole CSG solid. Groups are flattened
-/// into their members, so they never appear here. Kept small (48 bytes): a million of them
+/// into their members, so they never appear here. Kept small (32 bytes): a million of them
 /// must fit in cache-friendly memory.
 #[derive(Clone, Debug)]
 pub enum Item {
@@ -79,6 +78,8 @@ pub struct PreparedScene {
     pub(crate) bounded: Vec<Item>,
     /// Planes, unbounded quadrics and CSG solids with an infinite bound: tested one by one.
     pub(crate) unbounded: Vec<Item>,
+    /// The frames of the leaves whose material has a pattern.
+    pub(crate) pattern_frames: PatternFrames,
     pub(crate) bvh: Option<Bvh>,
     pub(crate) background: Vec3A,
     pub(crate) ambient: Vec3A,
@@ -196,6 +197,7 @@ struct Shapes {
     bounded: Vec<Item>,
     aabbs: Vec<Aabb>,
     unbounded: Vec<Item>,
+    pattern_frames: PatternFrames,
 }
 
 impl Shapes {
@@ -204,10 +206,12 @@ impl Shapes {
         let shared = Shared {
             materials: &shapes.materials,
             meshes: &meshes,
+            frames: Mutex::default(),
         };
         let roots = flatten_groups(scene);
         let (items, aabbs) = prepare_items(scene, &shared, &roots);
-        shapes.with_items(items, aabbs)
+        let frames = shared.into_frames();
+        shapes.with_items(items, aabbs, frames)
     }
 
     /// [`Shapes::new`] that frees the scene's objects as it goes: the items are prepared
@@ -220,6 +224,7 @@ impl Shapes {
         let shared = Shared {
             materials: &shapes.materials,
             meshes: &meshes,
+            frames: Mutex::default(),
         };
         let roots = flatten_groups(&scene);
         // The last object each chunk's predecessors can reach.
@@ -246,10 +251,11 @@ impl Shapes {
             scene.objects.truncate(reach.map_or(0, |last| last + 1));
         }
         drop(scene);
+        let frames = shared.into_frames();
         let (mut items, mut aabbs): (Vec<Item>, Vec<Aabb>) = reversed;
         items.reverse();
         aabbs.reverse();
-        shapes.with_items(items, aabbs)
+        shapes.with_items(items, aabbs, frames)
     }
 
     /// Everything but the items, and the prepared meshes the items will share.
@@ -292,13 +298,19 @@ impl Shapes {
             bounded: Vec::new(),
             aabbs: Vec::new(),
             unbounded: Vec::new(),
+            pattern_frames: PatternFrames::default(),
         };
         (shapes, meshes)
     }
 
     /// Takes the prepared items with their bounds stored as boxes (see [`bound_as_box`]),
     /// in scene order, and keeps them apart by bound, in place.
-    fn with_items(self, mut bounded: Vec<Item>, mut aabbs: Vec<Aabb>) -> Shapes {
+    fn with_items(
+        self,
+        mut bounded: Vec<Item>,
+        mut aabbs: Vec<Aabb>,
+        pattern_frames: PatternFrames,
+    ) -> Shapes {
         // The items without a finite bound leave the array in order: the unbounded are tested
         // one by one, the empty never.
         let mut position = 0;
@@ -324,6 +336,7 @@ impl Shapes {
             bounded,
             aabbs,
             unbounded,
+            pattern_frames,
             ..self
         }
     }
@@ -342,6 +355,7 @@ impl Shapes {
             bounded,
             aabbs,
             unbounded,
+            pattern_frames,
         } = self;
         let (bounded, bvh) = build_bvh(bounded, aabbs);
         PreparedScene {
@@ -353,6 +367,7 @@ impl Shapes {
             materials,
             bounded,
             unbounded,
+            pattern_frames,
             bvh,
             background: color(&settings.background),
             ambient: color(&settings.ambient),
@@ -425,10 +440,18 @@ fn prepare_boxed_item(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>
     (item, bound_as_box(bound))
 }
 
-/// What every item's preparation reads: the prepared materials and meshes.
+/// What every item's preparation reads (the prepared materials and meshes), and where it
+/// leaves the patterned leaves' frames (in any order: preparation is parallel).
 struct Shared<'a> {
     materials: &'a [PreparedMaterial],
     meshes: &'a [Arc<PreparedMesh>],
+    frames: Mutex<Vec<(Handle<Object>, PatternFrame)>>,
+}
+
+impl Shared<'_> {
+    fn into_frames(self) -> PatternFrames {
+        PatternFrames::new(self.frames.into_inner().unwrap_or_else(|e| e.into_inner()))
+    }
 }
 
 fn prepare_item(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (Item, Bound) {
@@ -452,6 +475,8 @@ fn prepare_item(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (
     }
 }
 
+/// A leaf and its bound; its pattern frame, when its material has a pattern, goes to
+/// `shared.frames`.
 fn prepare_leaf(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (Leaf, Bound) {
     let materials = shared.materials;
     let object = &scene.objects[handle];
@@ -467,7 +492,7 @@ fn prepare_leaf(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (
             // Validation refuses a missing mesh; should one arrive, it is nothing.
             None => (
                 Geometry::Plane {
-                    normal: Vec3A::Y,
+                    normal: glam::Vec3::Y,
                     offset: 0.0,
                 },
                 Bound::Empty,
@@ -490,7 +515,7 @@ fn prepare_leaf(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (
         // one arrive anyway it is an empty solid.
         None => (
             Geometry::Plane {
-                normal: Vec3A::Y,
+                normal: glam::Vec3::Y,
                 offset: 0.0,
             },
             Bound::Empty,
@@ -500,18 +525,20 @@ fn prepare_leaf(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (
     let patterned = materials
         .get(object.material.index())
         .is_some_and(|m| m.pattern.is_some());
-    let pattern_frame = patterned.then(|| {
-        Box::new(PatternFrame {
+    if patterned {
+        let frame = PatternFrame {
             object_from_world: world_from_object.inverse().as_affine3a(),
             world_from_object: world_from_object.as_affine3a(),
             snap,
-        })
-    });
+        };
+        // A worker that panicked has already taken the preparation down with it.
+        let mut frames = shared.frames.lock().unwrap_or_else(|e| e.into_inner());
+        frames.push((handle, frame));
+    }
     let leaf = Leaf {
         geometry,
         object: handle,
         material: object.material,
-        pattern_frame,
     };
     (leaf, bound)
 }
@@ -631,6 +658,90 @@ mod tests {
     use super::*;
     use crate::render::{render, NoObserver, RenderOptions};
     use crate::testing::{sphere_grid, whitted_classic};
+
+    /// A patterned leaf finds its frame alone and as a CSG leaf: a checkered sphere
+    /// shows both its colours as a plain item, as the only child of a union, and as one of
+    /// two children whose other has no pattern (a lost frame would leave the pattern
+    /// material's own grey).
+    #[test]
+    fn patterned_leaves_keep_their_frames_alone_and_in_csg() {
+        use crate::testing::{matte, sphere, SceneBuilder};
+        use glam::{DMat4, DVec3};
+        use whitted_ir::{CsgOp, Pattern, PatternKind};
+        let id = DMat4::IDENTITY;
+        let scene = |csg: Option<bool>| {
+            let mut b = SceneBuilder::new();
+            b.camera(DVec3::new(0.0, 0.0, -4.0), DVec3::ZERO, 40.0);
+            b.point_light(DVec3::new(0.0, 0.0, -10.0), 1.0);
+            let red = b.material(matte(1.0, 0.0, 0.0));
+            let blue = b.material(matte(0.0, 0.0, 1.0));
+            let checker = b.material(Material {
+                pattern: Some(Pattern {
+                    kind: PatternKind::Checker,
+                    a: red,
+                    b: blue,
+                    scale: 0.25,
+                    pattern_from_object: DMat4::IDENTITY,
+                }),
+                ..Material::default()
+            });
+            let ball = sphere(0.0, 0.0, 0.0, 1.0);
+            match csg {
+                None => {
+                    b.add(ball, id, checker);
+                }
+                Some(with_plain_sibling) => {
+                    let mut children = Vec::new();
+                    if with_plain_sibling {
+                        let grey = b.material(matte(0.5, 0.5, 0.5));
+                        children.push(b.part(sphere(5.0, 0.0, 0.0, 0.5), id, grey));
+                    }
+                    children.push(b.part(ball, id, checker));
+                    b.csg(CsgOp::Union, children, checker);
+                }
+            }
+            b.prepare().expect("valid")
+        };
+        for csg in [None, Some(false), Some(true)] {
+            let prepared = scene(csg);
+            let mut options = RenderOptions::from_settings(&prepared.settings);
+            options.width = 32;
+            options.height = 32;
+            let pixels = render(&prepared, &options, &NoObserver)
+                .expect("done")
+                .0
+                .pixels;
+            let reds = pixels.iter().filter(|p| p[0] > 0.2 && p[2] < 0.01).count();
+            let blues = pixels.iter().filter(|p| p[2] > 0.2 && p[0] < 0.01).count();
+            assert!(reds > 20 && blues > 20, "{csg:?}: {reds} red, {blues} blue");
+        }
+    }
+
+    /// Each patterned leaf finds its own frame, whatever order parallel preparation handed
+    /// them over in; objects before, between and after them find none.
+    #[test]
+    fn pattern_frames_are_found_by_object() {
+        let frame = |x: f32| PatternFrame {
+            object_from_world: glam::Affine3A::from_translation(glam::Vec3::new(x, 0.0, 0.0)),
+            world_from_object: glam::Affine3A::from_translation(glam::Vec3::new(-x, 0.0, 0.0)),
+            snap: Snap::None,
+        };
+        let handles = [9, 3, 7, 5, 3].map(Handle::<Object>::from_index);
+        let frames = PatternFrames::new(
+            handles
+                .iter()
+                .map(|&h| (h, frame(h.index() as f32)))
+                .collect(),
+        );
+        for h in handles {
+            assert_eq!(frames.get(h), Some(&frame(h.index() as f32)), "{h}");
+        }
+        for missing in [0, 2, 4, 6, 8, 10, u32::MAX as usize] {
+            assert_eq!(frames.get(Handle::from_index(missing)), None, "{missing}");
+        }
+        assert_eq!(PatternFrames::default().get(handles[0]), None);
+        assert_eq!(PatternFrames::new(Vec::new()).get(handles[0]), None);
+    }
 
     /// Dropping the IR before the BVH build changes nothing a render sees.
     #[test]
@@ -759,14 +870,12 @@ mod tests {
         );
     }
 
-    /// A million of these must stay cheap to build and to walk.
+    /// A million of these must stay cheap to build and to walk: 32 MB, not 48.
     #[test]
     fn items_stay_small() {
-        assert!(
-            std::mem::size_of::<Item>() <= 48,
-            "{}",
-            std::mem::size_of::<Item>()
-        );
+        assert_eq!(std::mem::size_of::<Geometry>(), 24);
+        assert_eq!(std::mem::size_of::<Leaf>(), 32);
+        assert_eq!(std::mem::size_of::<Item>(), 32);
         assert_eq!(
             std::mem::size_of::<Option<Item>>(),
             std::mem::size_of::<Item>()

@@ -8,7 +8,7 @@
 //! go back through the inverse transpose, so non-uniform scale shades correctly. General
 //! quadrics are transformed into world space once (`S_world = M⁻ᵀ S M⁻¹`) and solved in f64.
 
-use glam::{DAffine3, DMat3, DMat4, DVec3, DVec4, Mat3A, Vec3A};
+use glam::{DAffine3, DMat3, DMat4, DVec3, DVec4, Mat3A, Vec3, Vec3A};
 use whitted_ir::{Quadric, Shape};
 
 use crate::hit_error::{self, BoundedPoint};
@@ -145,13 +145,16 @@ pub struct WorldTriangle {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Geometry {
+    /// The centre as a `Vec3` (read as a `Vec3A`): with the tag in the spare room, the
+    /// common shapes keep a `Geometry` at 24 bytes and a leaf at 32 (a `Vec3A` would align
+    /// it to 16 and make both larger).
     Sphere {
-        center: Vec3A,
+        center: Vec3,
         radius: f32,
     },
     /// `normal·p = offset` with a unit normal; the solid is `normal·p < offset`.
     Plane {
-        normal: Vec3A,
+        normal: Vec3,
         offset: f32,
     },
     /// Boxed, like the rarer shapes, so that the common ones keep leaves small.
@@ -173,7 +176,7 @@ impl Geometry {
                     let r = radius * scale;
                     let bound = Bound::from_f64(c - DVec3::splat(r), c + DVec3::splat(r));
                     let geometry = Geometry::Sphere {
-                        center: c.as_vec3a(),
+                        center: c.as_vec3(),
                         radius: r as f32,
                     };
                     (geometry, bound)
@@ -196,7 +199,7 @@ impl Geometry {
                 let world_normal = (normal_matrix(m) * *normal).normalize();
                 let world_point = m.transform_point3(point);
                 let geometry = Geometry::Plane {
-                    normal: world_normal.as_vec3a(),
+                    normal: world_normal.as_vec3(),
                     offset: world_normal.dot(world_point) as f32,
                 };
                 (geometry, Bound::Infinite)
@@ -317,7 +320,7 @@ impl Geometry {
             // only by a mesh missing from the scene, which validation refuses: nothing.
             Shape::Mesh { .. } => (
                 Geometry::Plane {
-                    normal: Vec3A::Y,
+                    normal: Vec3::Y,
                     offset: 0.0,
                 },
                 Bound::Empty,
@@ -365,10 +368,10 @@ impl Geometry {
     pub fn first_hit(&self, ray: &Ray, tmin: f32, tmax: f32) -> Option<(f32, Part)> {
         match self {
             Geometry::Sphere { center, radius } => {
-                sphere_first_hit(ray, *center, *radius, tmin, tmax).map(|t| (t, WALL))
+                sphere_first_hit(ray, Vec3A::from(*center), *radius, tmin, tmax).map(|t| (t, WALL))
             }
             Geometry::Plane { normal, offset } => {
-                plane_first_hit(ray, *normal, *offset, tmin, tmax).map(|t| (t, WALL))
+                plane_first_hit(ray, Vec3A::from(*normal), *offset, tmin, tmax).map(|t| (t, WALL))
             }
             Geometry::Disk(disk) => {
                 let t =
@@ -419,13 +422,15 @@ impl Geometry {
     /// for solids; surfaces without an inside have none.
     pub fn spans(&self, ray: &Ray) -> ShapeSpans {
         match self {
-            Geometry::Sphere { center, radius } => match sphere_roots(ray, *center, *radius) {
-                Some((t0, t1)) => ShapeSpans::one(t0, WALL, t1, WALL),
-                None => ShapeSpans::NONE,
-            },
+            Geometry::Sphere { center, radius } => {
+                match sphere_roots(ray, Vec3A::from(*center), *radius) {
+                    Some((t0, t1)) => ShapeSpans::one(t0, WALL, t1, WALL),
+                    None => ShapeSpans::NONE,
+                }
+            }
             Geometry::Plane { normal, offset } => {
-                let depth = offset - normal.dot(ray.origin);
-                let rate = normal.dot(ray.direction);
+                let depth = offset - Vec3A::from(*normal).dot(ray.origin);
+                let rate = Vec3A::from(*normal).dot(ray.direction);
                 if rate == 0.0 {
                     return if depth > 0.0 {
                         ShapeSpans::whole_line()
@@ -458,8 +463,8 @@ impl Geometry {
     /// The outward unit normal where the ray meets the surface at `t`, on `part`.
     pub fn normal(&self, ray: &Ray, t: f32, part: Part) -> Vec3A {
         let n = match self {
-            Geometry::Sphere { center, .. } => ray.at(t) - *center,
-            Geometry::Plane { normal, .. } => *normal,
+            Geometry::Sphere { center, .. } => ray.at(t) - Vec3A::from(*center),
+            Geometry::Plane { normal, .. } => Vec3A::from(*normal),
             Geometry::Disk(disk) => disk.normal,
             Geometry::Triangle(triangle) => triangle.edge1.cross(triangle.edge2),
             Geometry::Quadric(quadric) => quadric.gradient(ray, t),
@@ -483,9 +488,11 @@ impl Geometry {
     pub fn bounded_point(&self, ray: &Ray, t: f32, part: Part) -> BoundedPoint {
         match self {
             Geometry::Sphere { center, radius } => {
-                hit_error::on_sphere(*center, *radius, ray.at(t)).0
+                hit_error::on_sphere(Vec3A::from(*center), *radius, ray.at(t)).0
             }
-            Geometry::Plane { normal, offset } => hit_error::on_plane(*normal, *offset, ray.at(t)),
+            Geometry::Plane { normal, offset } => {
+                hit_error::on_plane(Vec3A::from(*normal), *offset, ray.at(t))
+            }
             Geometry::Disk(disk) => {
                 hit_error::on_plane(disk.normal, disk.normal.dot(disk.center), ray.at(t))
             }
