@@ -25,10 +25,10 @@
 //! reused across rays: no depth limit and no per-ray allocation or zeroing.
 //!
 //! The build frees each of its arrays once it is done with it, so that the largest never
-//! coexist: the binary tree (68 bytes a primitive) is converted into obvhs's 80-byte nodes
+//! coexist: the binary tree (64 bytes a primitive) is converted into obvhs's 80-byte nodes
 //! (about 9 bytes a primitive), then freed, and only then are those expanded into the
 //! walk's 256-byte nodes (about 30 bytes a primitive). For the 1M-sphere grid this took
-//! the conversion's plateau from 152 to 134 MiB.
+//! the conversion's plateau from 152 to 134 MiB (129 with `binary`'s 36-byte inner nodes).
 //!
 //! Up to eight rays of one octant can also walk together ([`Bvh::traverse_packet`]), each
 //! seeing exactly its single walk's visits; camera rays use it.
@@ -373,7 +373,7 @@ impl Bvh {
     }
 
     /// Converts the binary tree into obvhs's 80-byte wide nodes, frees the binary tree,
-    /// and only then expands the nodes into the walk's 256-byte ones: the binary tree (68
+    /// and only then expands the nodes into the walk's 256-byte ones: the binary tree (64
     /// bytes a primitive) and the walk's nodes (about 30) are never alive together.
     fn from_built(built: Built) -> (Bvh, Vec<u32>) {
         let scale = built.scale;
