@@ -10,7 +10,8 @@
 //! Here the binary build computes each inner node's costs on its way back up ([`decide`],
 //! from its children's, which are then dropped) and keeps only its 7 decisions, a byte
 //! each. Each wide node is handed to a caller's function as soon as it is complete, so the
-//! caller can store its own form of the node and never holds obvhs's.
+//! caller can store the node in the form it likes (the build keeps obvhs's 80-byte nodes,
+//! so that the binary tree is freed before the walk's 256-byte ones are made; see `walk`).
 //! Large trees are converted on several threads: the conversion is depth first, so each of
 //! the root's subtrees fills a contiguous range of the nodes and of the primitives; they are
 //! counted, then converted in parallel straight into their ranges (no copies, the same
