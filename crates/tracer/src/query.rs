@@ -14,7 +14,7 @@ use crate::csg::CsgScratch;
 use crate::hit_error;
 use crate::material::{Blend, Pick};
 use crate::scene::{Item, Leaf, PreparedScene};
-use crate::shapes::{plane_first_hit, sphere_first_hit, unit_normal, Geometry, Part};
+use crate::shapes::{plane_first_hit, sphere_first_hit, unit_normal, with_fourth, Geometry, Part};
 use whitted_bvh::Ray;
 use whitted_bvh::{Bvh, PacketEntry, Step, PACKET};
 
@@ -127,12 +127,12 @@ pub(crate) fn item_hit(
         Item::Shape(Leaf {
             geometry: Geometry::Sphere { center, radius },
             ..
-        }) => sphere_first_hit(ray, Vec3A::from(*center), *radius, tmin, tmax)
+        }) => sphere_first_hit(ray, with_fourth(*center, *radius), *radius, tmin, tmax)
             .map(|t| (t, 0, 0, false)),
         Item::Shape(Leaf {
             geometry: Geometry::Plane { normal, offset },
             ..
-        }) => plane_first_hit(ray, Vec3A::from(*normal), *offset, tmin, tmax)
+        }) => plane_first_hit(ray, with_fourth(*normal, *offset), *offset, tmin, tmax)
             .map(|t| (t, 0, 0, false)),
         _ => other_item_hit(item, ray, tmin, tmax, scratch),
     }
@@ -507,12 +507,12 @@ impl PreparedScene {
         let leaf = item.leaf(hit.leaf);
         let (bounded, normal) = match &leaf.geometry {
             Geometry::Sphere { center, radius } => {
-                hit_error::on_sphere(Vec3A::from(*center), *radius, ray.at(hit.t))
+                hit_error::on_sphere(with_fourth(*center, *radius), *radius, ray.at(hit.t))
             }
             // What `Geometry::normal` computes for a plane, inline: floors are hit often.
             Geometry::Plane { normal, offset } => (
-                hit_error::on_plane(Vec3A::from(*normal), *offset, ray.at(hit.t)),
-                unit_normal(Vec3A::from(*normal), ray),
+                hit_error::on_plane(with_fourth(*normal, *offset), *offset, ray.at(hit.t)),
+                unit_normal(with_fourth(*normal, *offset), ray),
             ),
             geometry => (
                 geometry.bounded_point(ray, hit.t, hit.part),
