@@ -704,26 +704,15 @@ mod tests {
     /// material's own grey).
     #[test]
     fn patterned_leaves_keep_their_frames_alone_and_in_csg() {
-        use crate::testing::{matte, sphere, SceneBuilder};
+        use crate::testing::{checker, matte, sphere, SceneBuilder};
         use glam::{DMat4, DVec3};
-        use whitted_ir::{CsgOp, Pattern, PatternKind};
+        use whitted_ir::CsgOp;
         let id = DMat4::IDENTITY;
         let scene = |csg: Option<bool>| {
             let mut b = SceneBuilder::new();
             b.camera(DVec3::new(0.0, 0.0, -4.0), DVec3::ZERO, 40.0);
             b.point_light(DVec3::new(0.0, 0.0, -10.0), 1.0);
-            let red = b.material(matte(1.0, 0.0, 0.0));
-            let blue = b.material(matte(0.0, 0.0, 1.0));
-            let checker = b.material(Material {
-                pattern: Some(Pattern {
-                    kind: PatternKind::Checker,
-                    a: red,
-                    b: blue,
-                    scale: 0.25,
-                    pattern_from_object: DMat4::IDENTITY,
-                }),
-                ..Material::default()
-            });
+            let checker = checker(&mut b, matte(1.0, 0.0, 0.0), matte(0.0, 0.0, 1.0), 0.25);
             let ball = sphere(0.0, 0.0, 0.0, 1.0);
             match csg {
                 None => {

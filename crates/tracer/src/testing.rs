@@ -263,7 +263,8 @@ pub fn glass() -> Material {
     }
 }
 
-fn checker(b: &mut SceneBuilder, a: Material, other: Material, scale: f64) -> Handle<Material> {
+/// A checker of materials `a` and `other` with cells of size `scale`.
+pub fn checker(b: &mut SceneBuilder, a: Material, other: Material, scale: f64) -> Handle<Material> {
     let a = b.material(a);
     let other = b.material(other);
     b.material(Material {
