@@ -241,9 +241,10 @@ pub struct PatternFrame {
 
 /// The pattern frames of a scene's patterned leaves, by IR object (a CSG leaf is an object
 /// of its own): kept beside the items rather than in each leaf, where a boxed frame cost
-/// every leaf of a million 8 bytes that almost all leave empty. Found in one step: a slot
-/// per object from the first patterned one to the last (4 bytes each, and none at all in
-/// a scene without patterns), read only for a material with a pattern.
+/// every leaf of a million 8 bytes that almost all leave empty. Found in one step (a
+/// subtraction and two range checks, for every shaded leaf): a slot per object from the
+/// first patterned one to the last (4 bytes each, and none at all in a scene without
+/// patterns).
 #[derive(Clone, Debug, Default)]
 pub struct PatternFrames {
     /// The first object with a frame.

@@ -145,9 +145,9 @@ pub struct WorldTriangle {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Geometry {
-    /// The centre as a `Vec3` (read as a `Vec3A`): with the tag in the spare room, the
-    /// common shapes keep a `Geometry` at 24 bytes and a leaf at 32 (a `Vec3A` would align
-    /// it to 16 and make both larger).
+    /// The centre as a `Vec3` (read with the radius as one `Vec3A`, [`with_fourth`]): with
+    /// the tag in the spare room, the common shapes keep a `Geometry` at 24 bytes and a
+    /// leaf at 32 (a `Vec3A` would align it to 16 and make both larger).
     Sphere {
         center: Vec3,
         radius: f32,
