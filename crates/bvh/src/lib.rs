@@ -14,6 +14,7 @@
 
 mod binary;
 mod bounds;
+mod permute;
 mod ray;
 mod simd;
 #[cfg(any(test, feature = "testing"))]
@@ -21,7 +22,9 @@ pub mod testing;
 mod walk;
 mod wide;
 
+pub use binary::PrimitiveBox;
 pub use bounds::{inverse_direction, Bound};
+pub use permute::permute_in_place;
 pub use ray::Ray;
 pub use walk::{
     force_traversal_path, Bvh, PacketEntry, PathUnavailable, Step, TraversalPath, MAX_PRIMITIVES,

@@ -46,8 +46,11 @@ use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::CwBvh;
 use rayon::prelude::*;
 
-use crate::binary::{build_bvh2, build_bvh2_with, round_down, round_up, BuildScale, Built};
+use crate::binary::{
+    boxes_of, build_boxes, build_boxes_with, round_down, round_up, BuildScale, Built, PrimitiveBox,
+};
 use crate::bounds::inverse_direction;
+use crate::permute::permute_checked;
 use crate::ray::Ray;
 use crate::simd::{self, SimdPath};
 use crate::wide;
@@ -331,7 +334,7 @@ pub enum Step {
 /// builds convert with `wide`, which makes the same nodes.
 #[cfg(test)]
 fn build_cwbvh(aabbs: &[Aabb]) -> (CwBvh, BuildScale) {
-    let built = build_bvh2(aabbs);
+    let built = crate::binary::build_bvh2(aabbs);
     let cwbvh = obvhs::cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh(&built.tree.to_bvh2(), 3, true, false);
     (cwbvh, built.scale)
 }
@@ -347,13 +350,27 @@ impl Bvh {
     /// it into obvhs's wide nodes (`wide`). Returns the BVH and `primitive_indices`: the input index of each
     /// BVH primitive id.
     pub fn build(aabbs: &[Aabb]) -> (Bvh, Vec<u32>) {
-        Self::build_from_vec(aabbs.to_vec())
+        let mut input_index: Vec<u32> = (0..aabbs.len() as u32).collect();
+        match Self::build_ordering(boxes_of(aabbs), &mut input_index) {
+            Some(bvh) => (bvh, input_index),
+            None => (Bvh::new(Vec::new()), Vec::new()),
+        }
     }
 
-    /// [`Bvh::build`] that consumes the boxes: the build scales them in place and frees
-    /// them before the conversion.
-    pub fn build_from_vec(aabbs: Vec<Aabb>) -> (Bvh, Vec<u32>) {
-        Self::from_built(build_bvh2(aabbs))
+    /// Builds the BVH over `boxes` (see [`PrimitiveBox`]), one for each of `items`, and
+    /// puts the items in its primitive order: primitive id `k` is `items[k]` afterwards.
+    /// The boxes become the binary tree's leaves in place and the items are moved in place
+    /// ([`permute_in_place`]), so that a million of either are never copied. `None` when
+    /// no BVH could be made (a node the walk cannot read, which obvhs's layout rules out,
+    /// or not one box for each item); the items are then as they were.
+    ///
+    /// [`permute_in_place`]: crate::permute_in_place
+    pub fn build_ordering<T>(boxes: Vec<PrimitiveBox>, items: &mut [T]) -> Option<Bvh> {
+        if boxes.len() != items.len() {
+            return None;
+        }
+        let (bvh, mut order) = Self::from_built(build_boxes(boxes));
+        (!bvh.nodes.is_empty() && permute_checked(items, &mut order)).then_some(bvh)
     }
 
     /// [`Bvh::build`] with the binned SAH at every size, never a Morton-ordered top: for a
@@ -362,7 +379,7 @@ impl Bvh {
     /// thread), which is worth its 0.3 s more build (the spheres of a big scene render as
     /// fast either way).
     pub fn build_binned_sah(aabbs: &[Aabb]) -> (Bvh, Vec<u32>) {
-        Self::from_built(build_bvh2_with(aabbs.to_vec(), usize::MAX))
+        Self::from_built(build_boxes_with(boxes_of(aabbs), usize::MAX))
     }
 
     fn new(nodes: Vec<WideNode>) -> Bvh {
@@ -373,7 +390,7 @@ impl Bvh {
     }
 
     /// Converts the binary tree into obvhs's 80-byte wide nodes, frees the binary tree,
-    /// and only then expands the nodes into the walk's 256-byte ones: the binary tree (64
+    /// and only then expands the nodes into the walk's 256-byte ones: the binary tree (44
     /// bytes a primitive) and the walk's nodes (about 30) are never alive together.
     fn from_built(built: Built) -> (Bvh, Vec<u32>) {
         let scale = built.scale;

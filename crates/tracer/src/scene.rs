@@ -20,8 +20,7 @@ use crate::material::{color, PatternFrame, PatternFrames, PreparedMaterial, Snap
 use crate::mesh::{MeshInstance, PreparedMesh};
 use crate::query::Surface;
 use crate::shapes::Geometry;
-use whitted_bvh::Bound;
-use whitted_bvh::Bvh;
+use whitted_bvh::{Bound, Bvh, PrimitiveBox};
 
 /// A primitive shape ready to intersect, with what shading needs to know about it. (A
 /// patterned leaf's frame is in [`PreparedScene`]'s `pattern_frames`, by `object`.)
@@ -195,7 +194,7 @@ struct Shapes {
     mesh_bvh_nodes: usize,
     /// Bounded items in scene order, with their boxes (the same length).
     bounded: Vec<Item>,
-    aabbs: Vec<Aabb>,
+    boxes: Vec<PrimitiveBox>,
     unbounded: Vec<Item>,
     pattern_frames: PatternFrames,
 }
@@ -209,9 +208,9 @@ impl Shapes {
             frames: Mutex::default(),
         };
         let roots = flatten_groups(scene);
-        let (items, aabbs) = prepare_items(scene, &shared, &roots);
+        let (items, boxes) = prepare_items(scene, &shared, &roots);
         let frames = shared.into_frames();
-        shapes.with_items(items, aabbs, frames)
+        shapes.with_items(items, boxes, frames)
     }
 
     /// [`Shapes::new`] that frees the scene's objects as it goes: the items are prepared
@@ -252,10 +251,10 @@ impl Shapes {
         }
         drop(scene);
         let frames = shared.into_frames();
-        let (mut items, mut aabbs): (Vec<Item>, Vec<Aabb>) = reversed;
+        let (mut items, mut boxes): (Vec<Item>, Vec<PrimitiveBox>) = reversed;
         items.reverse();
-        aabbs.reverse();
-        shapes.with_items(items, aabbs, frames)
+        boxes.reverse();
+        shapes.with_items(items, boxes, frames)
     }
 
     /// Everything but the items, and the prepared meshes the items will share.
@@ -296,7 +295,7 @@ impl Shapes {
             mesh_bvh_nodes: meshes.iter().map(|m| m.bvh_node_count()).sum(),
             materials,
             bounded: Vec::new(),
-            aabbs: Vec::new(),
+            boxes: Vec::new(),
             unbounded: Vec::new(),
             pattern_frames: PatternFrames::default(),
         };
@@ -308,7 +307,7 @@ impl Shapes {
     fn with_items(
         self,
         mut bounded: Vec<Item>,
-        mut aabbs: Vec<Aabb>,
+        mut boxes: Vec<PrimitiveBox>,
         pattern_frames: PatternFrames,
     ) -> Shapes {
         // The items without a finite bound leave the array in order: the unbounded are tested
@@ -317,7 +316,7 @@ impl Shapes {
         let mut infinite = Vec::new();
         let extracted: Vec<Item> = bounded
             .extract_if(.., |_| {
-                let bound = aabbs.get(position).map_or(Bound::Empty, box_as_bound);
+                let bound = boxes.get(position).map_or(Bound::Empty, box_as_bound);
                 position += 1;
                 let finite = matches!(bound, Bound::Finite(_));
                 if !finite {
@@ -331,10 +330,10 @@ impl Shapes {
             .zip(infinite)
             .filter_map(|(item, infinite)| infinite.then_some(item))
             .collect();
-        aabbs.retain(|aabb| matches!(box_as_bound(aabb), Bound::Finite(_)));
+        boxes.retain(|stored| matches!(box_as_bound(stored), Bound::Finite(_)));
         Shapes {
             bounded,
-            aabbs,
+            boxes,
             unbounded,
             pattern_frames,
             ..self
@@ -353,11 +352,11 @@ impl Shapes {
             mesh_triangles,
             mesh_bvh_nodes,
             bounded,
-            aabbs,
+            boxes,
             unbounded,
             pattern_frames,
         } = self;
-        let (bounded, bvh) = build_bvh(bounded, aabbs);
+        let (bounded, bvh) = build_bvh(bounded, boxes);
         PreparedScene {
             mesh_count,
             mesh_triangles,
@@ -395,24 +394,26 @@ fn flatten_groups(scene: &Scene) -> Vec<Handle<Object>> {
     out
 }
 
-/// A bound as a plain box, so that a million of them take 32 bytes each (a `Bound` takes
-/// 48): a finite bound is its box; the empty and the unbounded are boxes with a NaN corner,
-/// which no finite bound has (one that did would be tested as unbounded: always right).
-fn bound_as_box(bound: Bound) -> Aabb {
+/// A bound as the BVH build's plain box, so that a million of them take 28 bytes each (a
+/// `Bound` takes 48) and the build takes them over as they are: a finite bound is its box;
+/// the empty and the unbounded are boxes with a NaN corner, which no finite bound has (one
+/// that did would be tested as unbounded: always right).
+fn bound_as_box(bound: Bound) -> PrimitiveBox {
     let marked = |max: f32| Aabb::new(Vec3A::splat(f32::NAN), Vec3A::splat(max));
-    match bound {
+    PrimitiveBox::new(&match bound {
         Bound::Finite(aabb) if !(aabb.min.is_nan_mask().any() || aabb.max.is_nan_mask().any()) => {
             aabb
         }
         Bound::Empty => marked(0.0),
         Bound::Finite(_) | Bound::Infinite => marked(1.0),
-    }
+    })
 }
 
 /// The bound [`bound_as_box`] stored.
-fn box_as_bound(aabb: &Aabb) -> Bound {
+fn box_as_bound(stored: &PrimitiveBox) -> Bound {
+    let aabb = stored.aabb();
     if !aabb.min.x.is_nan() {
-        Bound::Finite(*aabb)
+        Bound::Finite(aabb)
     } else if aabb.max.x == 0.0 {
         Bound::Empty
     } else {
@@ -421,13 +422,13 @@ fn box_as_bound(aabb: &Aabb) -> Bound {
 }
 
 /// The items of `roots` (in parallel), each beside its bound stored as a box. Memory
-/// dominates scenes of a million objects: an item is made once, and its bound takes 32
+/// dominates scenes of a million objects: an item is made once, and its bound takes 28
 /// bytes this way (a `Bound` takes 48).
 fn prepare_items(
     scene: &Scene,
     shared: &Shared<'_>,
     roots: &[Handle<Object>],
-) -> (Vec<Item>, Vec<Aabb>) {
+) -> (Vec<Item>, Vec<PrimitiveBox>) {
     roots
         .par_iter()
         .map(|&handle| prepare_boxed_item(scene, shared, handle))
@@ -435,7 +436,11 @@ fn prepare_items(
 }
 
 /// An item beside its bound stored as a box (see [`bound_as_box`]).
-fn prepare_boxed_item(scene: &Scene, shared: &Shared<'_>, handle: Handle<Object>) -> (Item, Aabb) {
+fn prepare_boxed_item(
+    scene: &Scene,
+    shared: &Shared<'_>,
+    handle: Handle<Object>,
+) -> (Item, PrimitiveBox) {
     let (item, bound) = prepare_item(scene, shared, handle);
     (item, bound_as_box(bound))
 }
@@ -608,88 +613,18 @@ fn node_bound(node: &CsgNode) -> Bound {
     }
 }
 
-/// Builds the BVH over `aabbs` (one per item) and returns the items in BVH primitive
-/// order. The boxes are handed to the build, which frees them as soon as it has scaled
-/// them, and the items are moved in place, so that no second copy of a million items
-/// exists at any time.
-fn build_bvh(items: Vec<Item>, aabbs: Vec<Aabb>) -> (Vec<Item>, Option<Bvh>) {
+/// Builds the BVH over `boxes` (one per item) and returns the items in BVH primitive
+/// order. The boxes are handed to the build, which makes its leaves of them in place, and
+/// the items are moved in place beside them, so that no second copy of a million boxes or
+/// items exists at any time.
+fn build_bvh(mut items: Vec<Item>, boxes: Vec<PrimitiveBox>) -> (Vec<Item>, Option<Bvh>) {
     if items.is_empty() || items.len() > whitted_bvh::MAX_PRIMITIVES {
         return (items, None);
     }
-    let count = items.len();
-    let (bvh, primitive_indices) = Bvh::build_from_vec(aabbs);
-    match permute(items, primitive_indices) {
-        Ok(ordered) if ordered.len() == count => (ordered, Some(bvh)),
-        // Not a permutation (obvhs never does this without spatial splits): keep every item
-        // once and test them all, which is slow but right.
-        Ok(items) | Err(items) => (items, None),
-    }
-}
-
-/// `items` reordered so that entry `i` is `items[order[i]]`; `Err(items)` (in the original
-/// order) when `order` is not a permutation of the indices.
-///
-/// The items are moved in place along the permutation's cycles ([`permute_in_place`]), so
-/// a million of them never exist twice (a gather into a new array held both, 48 MB more
-/// at the end of the build).
-fn permute(mut items: Vec<Item>, mut order: Vec<u32>) -> Result<Vec<Item>, Vec<Item>> {
-    let mut seen = vec![false; items.len()];
-    let is_permutation = order.len() == items.len()
-        && order.iter().all(|&i| {
-            seen.get_mut(i as usize)
-                .is_some_and(|s| !std::mem::replace(s, true))
-        });
-    if !is_permutation {
-        return Err(items);
-    }
-    drop(seen);
-    permute_in_place(&mut items, &mut order);
-    Ok(items)
-}
-
-/// Cycle positions found ahead of the moves in [`permute_in_place`]. For the 1M grid (23
-/// cycles, the longest 447,031 items) on one thread: 8 took 43-45 ms, 1 and 2 about 47,
-/// 32 about 55, 256 about 65 (the look-ups then no longer overlap the moves); the gather
-/// into a second array took 41.
-const CYCLE_BATCH: usize = 8;
-
-/// Puts `items[order[i]]` at `i` for every `i` in place, `order` being a permutation of
-/// `items`' indices; `order` is left as the identity (an entry equal to its position marks
-/// it done).
-///
-/// Each cycle of the permutation is followed from its first position, a batch of
-/// [`CYCLE_BATCH`] positions at a time: the positions are found first (a chain of loads in
-/// `order`, 4 bytes a step, mostly in cache for a million), then the items are swapped
-/// along them. The swaps' reads of far items do not depend on one another, so the
-/// processor overlaps their cache misses with each other and with the next batch's
-/// look-ups.
-fn permute_in_place<T>(items: &mut [T], order: &mut [u32]) {
-    let mut batch = Vec::with_capacity(CYCLE_BATCH);
-    for start in 0..order.len() {
-        if order[start] as usize == start {
-            continue;
-        }
-        // `at` holds the item that belongs at the end of the cycle followed so far, and
-        // `next` is the last position whose source has been looked up.
-        let (mut at, mut next) = (start, start);
-        let mut closed = false;
-        while !closed {
-            batch.clear();
-            while batch.len() < CYCLE_BATCH {
-                let source = std::mem::replace(&mut order[next], next as u32) as usize;
-                if source == start {
-                    closed = true;
-                    break;
-                }
-                batch.push(source);
-                next = source;
-            }
-            for &source in &batch {
-                items.swap(at, source);
-                at = source;
-            }
-        }
-    }
+    // No BVH (obvhs never fails to make one without spatial splits): every item is still
+    // there once, and all are tested, which is slow but right.
+    let bvh = Bvh::build_ordering(boxes, &mut items);
+    (items, bvh)
 }
 
 #[cfg(test)]
@@ -829,9 +764,12 @@ mod tests {
         let key = |shapes: &Shapes| {
             let objects = |items: &[Item]| items.iter().map(Item::object).collect::<Vec<_>>();
             let boxes: Vec<_> = shapes
-                .aabbs
+                .boxes
                 .iter()
-                .map(|a| (a.min.to_array(), a.max.to_array()))
+                .map(|stored| {
+                    let a = stored.aabb();
+                    (a.min.to_array(), a.max.to_array())
+                })
                 .collect();
             (objects(&shapes.bounded), boxes, objects(&shapes.unbounded))
         };
@@ -842,95 +780,6 @@ mod tests {
             let scene = valid.scene().clone();
             let released = key(&Shapes::new_releasing(scene, chunk_len));
             assert!(released == whole, "chunks of {chunk_len}");
-        }
-    }
-
-    fn numbered(n: u32) -> Vec<Item> {
-        let builder = sphere_grid(n);
-        let valid = builder.build().expect("valid");
-        let shapes = Shapes::new(valid.scene());
-        shapes.bounded
-    }
-
-    #[test]
-    fn permute_moves_items_into_the_given_order() {
-        let objects: Vec<_> = numbered(4).iter().map(Item::object).collect();
-        let n = objects.len() as u32;
-        // Reversal (cycles of two), a rotation (one long cycle), and a mix of fixed points
-        // and cycles of several lengths.
-        let orders: [Vec<u32>; 3] = [
-            (0..n).rev().collect(),
-            (0..n).map(|i| (i + 3) % n).collect(),
-            (0..n).map(|i| (i * 5) % n).collect(),
-        ];
-        for order in orders {
-            let ordered =
-                permute(numbered(4), order.clone()).unwrap_or_else(|_| panic!("a permutation"));
-            let reordered: Vec<_> = ordered.iter().map(Item::object).collect();
-            let expected: Vec<_> = order.iter().map(|&i| objects[i as usize]).collect();
-            assert_eq!(reordered, expected, "{order:?}");
-        }
-    }
-
-    /// The in-place moves give what a plain gather gives, and leave the order as the
-    /// identity, on awkward permutations: none, one item, already in order, reversed, one
-    /// long cycle (longer than a batch of positions), cycles just under, at and just over a
-    /// batch's length, and shuffles.
-    #[test]
-    fn permuting_in_place_is_a_gather() {
-        let batch = CYCLE_BATCH as u32;
-        let mut orders: Vec<Vec<u32>> = vec![
-            vec![],
-            vec![0],
-            (0..10).collect(),
-            (0..9).rev().collect(),
-            (0..10).rev().collect(),
-            (0..5000).map(|i| (i + 1) % 5000).collect(),
-            (0..5000).map(|i| (i + 4999) % 5000).collect(),
-            (0..3 * batch).map(|i| (i * 7) % (3 * batch)).collect(),
-        ];
-        // One cycle of each length around the batch's, with a fixed point between them.
-        for len in [batch - 1, batch, batch + 1, 2 * batch, 2 * batch + 1] {
-            let mut order: Vec<u32> = (0..len).map(|i| (i + 1) % len).collect();
-            order.push(len);
-            let shifted = order.iter().map(|&i| i + len + 1);
-            order.extend(shifted.collect::<Vec<_>>());
-            orders.push(order);
-        }
-        // Shuffles (Fisher-Yates with a fixed LCG), mixing every cycle length.
-        let mut state = 0x2545_f491_u64;
-        for len in [2u32, 3, 100, 4097] {
-            let mut order: Vec<u32> = (0..len).collect();
-            for i in (1..order.len()).rev() {
-                state = state
-                    .wrapping_mul(6_364_136_223_846_793_005)
-                    .wrapping_add(1_442_695_040_888_963_407);
-                order.swap(i, (state >> 33) as usize % (i + 1));
-            }
-            orders.push(order);
-        }
-        for order in orders {
-            let n = order.len() as u32;
-            // Items that own heap memory, so that a lost or doubled item would show.
-            let items: Vec<String> = (0..n).map(|i| format!("item {i}")).collect();
-            let gathered: Vec<String> = order.iter().map(|&i| items[i as usize].clone()).collect();
-            let mut moved = items;
-            let mut marks = order.clone();
-            permute_in_place(&mut moved, &mut marks);
-            assert_eq!(moved, gathered, "{order:?}");
-            assert!(marks.iter().copied().eq(0..n), "{order:?}");
-        }
-    }
-
-    #[test]
-    fn permute_refuses_what_is_not_a_permutation() {
-        let items = numbered(2);
-        let n = items.len() as u32;
-        // A repeated index, an index out of range, a short order: each returns the items
-        // untouched.
-        for order in [vec![0, 0, 1, 2], vec![0, 1, 2, n], vec![0, 1]] {
-            let back = permute(numbered(2), order).expect_err("refused");
-            assert_eq!(back.len(), items.len());
         }
     }
 
