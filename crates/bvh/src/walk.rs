@@ -1551,9 +1551,9 @@ mod tests {
                     &node.child_min_z,
                     &node.child_max_z,
                 ][slot];
-                for child in 0..8 {
+                for (child, &byte) in bytes.iter().enumerate() {
                     let e = f64::from(f32::from_bits(u32::from(node.e[axis]) << 23));
-                    let exact = (f64::from(node.p[axis]) + e * f64::from(bytes[child])) * unscale;
+                    let exact = (f64::from(node.p[axis]) + e * f64::from(byte)) * unscale;
                     let expected = if slot % 2 == 1 {
                         round_up(exact)
                     } else {
