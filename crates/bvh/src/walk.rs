@@ -891,15 +891,7 @@ fn octant_inv4(direction: Vec3A) -> u32 {
 fn dequantise(node: &CwBvhNode, build_scale: BuildScale) -> NodePlanes {
     let unscale = build_scale.factor().recip();
     let mut out = NodePlanes::default();
-    let quantised = [
-        &node.child_min_x,
-        &node.child_max_x,
-        &node.child_min_y,
-        &node.child_max_y,
-        &node.child_min_z,
-        &node.child_max_z,
-    ];
-    for (slot, bytes) in quantised.iter().enumerate() {
+    for (slot, bytes) in quantised_rows(node).iter().enumerate() {
         let axis = slot / 2;
         let is_max = slot % 2 == 1;
         let origin = f64::from(node.p[axis]);
@@ -924,6 +916,19 @@ fn dequantise(node: &CwBvhNode, build_scale: BuildScale) -> NodePlanes {
         }
     }
     out
+}
+
+/// A node's quantised child planes in [`NodePlanes`]' row order: min x, max x, min y, max y,
+/// min z, max z.
+fn quantised_rows(node: &CwBvhNode) -> [&[u8; 8]; 6] {
+    [
+        &node.child_min_x,
+        &node.child_max_x,
+        &node.child_min_y,
+        &node.child_max_y,
+        &node.child_min_z,
+        &node.child_max_z,
+    ]
 }
 
 /// The next f32 up from `v` (`up`) or down, as `f32::next_up` and `next_down` give it for
@@ -1541,16 +1546,8 @@ mod tests {
             };
             let planes = dequantise(&node, scale);
             let unscale = scale.factor().recip();
-            for slot in 0..6 {
+            for (slot, bytes) in quantised_rows(&node).iter().enumerate() {
                 let axis = slot / 2;
-                let bytes = [
-                    &node.child_min_x,
-                    &node.child_max_x,
-                    &node.child_min_y,
-                    &node.child_max_y,
-                    &node.child_min_z,
-                    &node.child_max_z,
-                ][slot];
                 for (child, &byte) in bytes.iter().enumerate() {
                     let e = f64::from(f32::from_bits(u32::from(node.e[axis]) << 23));
                     let exact = (f64::from(node.p[axis]) + e * f64::from(byte)) * unscale;
