@@ -24,7 +24,6 @@ mod wide;
 
 pub use binary::PrimitiveBox;
 pub use bounds::{inverse_direction, Bound};
-pub use permute::permute_in_place;
 pub use ray::Ray;
 pub use walk::{
     force_traversal_path, Bvh, PacketEntry, PathUnavailable, Step, TraversalPath, MAX_PRIMITIVES,

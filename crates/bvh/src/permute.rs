@@ -8,7 +8,7 @@
 const BUCKET_BITS: u32 = 12;
 
 /// What [`permute_in_place`] moves: a slice, or two slices of the same length moved
-/// together (the build's boxes and the caller's items, moved in one pass).
+/// together (the items and their destinations, inside it).
 pub trait Swap {
     fn swap_at(&mut self, a: usize, b: usize);
 }
@@ -54,8 +54,8 @@ fn is_permutation(order: &[u32], len: usize) -> bool {
 ///
 /// Following the permutation's cycles one item at a time is a chain of dependent loads
 /// that jump anywhere in the arrays: for a million items a cache miss each, 40-50 ms on one
-/// thread, however the look-ups are batched (the tracer's items; the build's boxes and
-/// items together took 70). Instead each item's destination is found first (one pass of
+/// thread, however the look-ups are batched (the tracer's items; moving the build's boxes
+/// and the items together, tried, took 70). Instead each item's destination is found first (one pass of
 /// independent writes), then two passes of swaps, each swap putting one item where it
 /// belongs: the first moves every item into its bucket (the [`BUCKET_BITS`]-sized range
 /// of positions its destination lies in), writing at each bucket's next free position as

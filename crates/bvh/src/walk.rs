@@ -46,7 +46,9 @@ use obvhs::cwbvh::node::CwBvhNode;
 use obvhs::cwbvh::CwBvh;
 use rayon::prelude::*;
 
-use crate::binary::{boxes_of, build_boxes, build_boxes_with, BuildScale, Built, PrimitiveBox};
+use crate::binary::{
+    boxes_of, build_boxes, build_boxes_with, round_down, round_up, BuildScale, Built, PrimitiveBox,
+};
 use crate::bounds::inverse_direction;
 use crate::permute::permute_checked;
 use crate::ray::Ray;
@@ -362,7 +364,7 @@ impl Bvh {
     /// no BVH could be made (a node the walk cannot read, which obvhs's layout rules out,
     /// or not one box for each item); the items are then as they were.
     ///
-    /// [`permute_in_place`]: crate::permute_in_place
+    /// [`permute_in_place`]: crate::permute::permute_in_place
     pub fn build_ordering<T>(boxes: Vec<PrimitiveBox>, items: &mut [T]) -> Option<Bvh> {
         if boxes.len() != items.len() {
             return None;
@@ -891,67 +893,29 @@ fn octant_inv4(direction: Vec3A) -> u32 {
 fn dequantise(node: &CwBvhNode, build_scale: BuildScale) -> NodePlanes {
     let unscale = build_scale.factor().recip();
     let mut out = NodePlanes::default();
-    for (slot, bytes) in quantised_rows(node).iter().enumerate() {
-        let axis = slot / 2;
-        let is_max = slot % 2 == 1;
-        let origin = f64::from(node.p[axis]);
-        let scale = f64::from(f32::from_bits(u32::from(node.e[axis]) << 23));
-        let row = &mut out.rows[slot];
-        // `round_up` and `round_down` for the eight at once, without branches, so that
-        // the compiler keeps the row in vector registers (a third of the expansion's time
-        // went to the eight one at a time).
-        for (child, plane) in row.iter_mut().enumerate() {
-            let exact = (origin + scale * f64::from(bytes[child])) * unscale;
-            let nearest = exact as f32;
-            let past = if is_max {
-                f64::from(nearest) < exact
-            } else {
-                f64::from(nearest) > exact
-            };
-            *plane = if past {
-                step_outwards(nearest, is_max)
-            } else {
-                nearest
-            };
-        }
-    }
-    out
-}
-
-/// A node's quantised child planes in [`NodePlanes`]' row order: min x, max x, min y, max y,
-/// min z, max z.
-fn quantised_rows(node: &CwBvhNode) -> [&[u8; 8]; 6] {
-    [
+    let quantised = [
         &node.child_min_x,
         &node.child_max_x,
         &node.child_min_y,
         &node.child_max_y,
         &node.child_min_z,
         &node.child_max_z,
-    ]
-}
-
-/// The next f32 up from `v` (`up`) or down, as `f32::next_up` and `next_down` give it for
-/// every `v` but NaN, in integer steps the compiler can do for eight lanes at once.
-#[inline(always)]
-fn step_outwards(v: f32, up: bool) -> f32 {
-    let bits = v.to_bits();
-    let away_from_zero = (v > 0.0) == up;
-    let stepped = if v.is_infinite() && away_from_zero {
-        bits
-    } else if v == 0.0 {
-        // The smallest subnormal on the side of the step.
-        if up {
-            1
-        } else {
-            0x8000_0001
+    ];
+    for (slot, bytes) in quantised.iter().enumerate() {
+        let axis = slot / 2;
+        let is_max = slot % 2 == 1;
+        let origin = f64::from(node.p[axis]);
+        let scale = f64::from(f32::from_bits(u32::from(node.e[axis]) << 23));
+        for child in 0..8 {
+            let exact = (origin + scale * f64::from(bytes[child])) * unscale;
+            out.rows[slot][child] = if is_max {
+                round_up(exact)
+            } else {
+                round_down(exact)
+            };
         }
-    } else if away_from_zero {
-        bits + 1
-    } else {
-        bits - 1
-    };
-    f32::from_bits(stepped)
+    }
+    out
 }
 
 #[cfg(test)]
@@ -1483,87 +1447,6 @@ mod tests {
     fn nodes_fill_four_cache_lines() {
         assert_eq!(std::mem::size_of::<WideNode>(), 256);
         assert_eq!(std::mem::align_of::<WideNode>(), 64);
-    }
-
-    /// The steps outwards are `next_up` and `next_down`, at zeros, subnormals, the ends of
-    /// the range and the infinities, and on numbers of every size.
-    #[test]
-    fn steps_outwards_are_next_up_and_next_down() {
-        let mut values = vec![
-            0.0,
-            -0.0,
-            f32::from_bits(1),
-            -f32::from_bits(1),
-            f32::MIN_POSITIVE,
-            -f32::MIN_POSITIVE,
-            f32::MAX,
-            f32::MIN,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            1.0,
-            -1.0,
-        ];
-        let mut random = Random(7);
-        values.extend((0..10_000).map(|_| f32::from_bits(random.next_u32())));
-        for v in values.into_iter().filter(|v| !v.is_nan()) {
-            assert_eq!(
-                step_outwards(v, true).to_bits(),
-                v.next_up().to_bits(),
-                "{v:e} up"
-            );
-            assert_eq!(
-                step_outwards(v, false).to_bits(),
-                v.next_down().to_bits(),
-                "{v:e} down"
-            );
-        }
-    }
-
-    /// The planes equal each plane rounded outwards one at a time (`round_up`,
-    /// `round_down`), for random origins, exponents, bytes and build scales, including
-    /// planes beyond f32's range.
-    #[test]
-    fn dequantising_a_row_at_once_rounds_as_one_at_a_time() {
-        use crate::binary::{round_down, round_up};
-        let mut random = Random(11);
-        for round in 0..2_000 {
-            let mut node = CwBvhNode::default();
-            let magnitude = [1e-30, 1.0, 1e6, 3e38][round % 4];
-            node.p = [0; 3].map(|_| (random.unit() - 0.5) * magnitude).into();
-            node.e = [0; 3].map(|_| 60 + (random.next_u32() % 140) as u8);
-            for row in [
-                &mut node.child_min_x,
-                &mut node.child_max_x,
-                &mut node.child_min_y,
-                &mut node.child_max_y,
-                &mut node.child_min_z,
-                &mut node.child_max_z,
-            ] {
-                *row = [0; 8].map(|_| random.next_u32() as u8);
-            }
-            let scale = BuildScale {
-                exponent: (random.next_u32() % 200) as i32 - 100,
-            };
-            let planes = dequantise(&node, scale);
-            let unscale = scale.factor().recip();
-            for (slot, bytes) in quantised_rows(&node).iter().enumerate() {
-                let axis = slot / 2;
-                for (child, &byte) in bytes.iter().enumerate() {
-                    let e = f64::from(f32::from_bits(u32::from(node.e[axis]) << 23));
-                    let exact = (f64::from(node.p[axis]) + e * f64::from(byte)) * unscale;
-                    let expected = if slot % 2 == 1 {
-                        round_up(exact)
-                    } else {
-                        round_down(exact)
-                    };
-                    assert_eq!(
-                        planes.get(slot, child).to_bits(),
-                        expected.to_bits(),
-                        "{exact:e}"
-                    );
-                }
-            }
-        }
     }
 
     #[test]

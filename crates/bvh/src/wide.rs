@@ -587,34 +587,34 @@ impl<Tree: BinaryTree + Sync, Make> Converter<'_, Tree, Make> {
         for (offset, &child) in offsets.iter_mut().zip(&children[..child_count]) {
             *offset = self.tree.aabb(child).center() - p;
         }
-        // obvhs's greedy assignment: while a child and a slot are free, the free pair of
-        // least cost takes it, the first in (child, slot) order among equal costs, and a
-        // cost not below f32::MAX (or NaN) never. Each pair's cost, child and slot are one
-        // integer whose order is exactly that (the cost's bits made to sort as the number,
-        // -0.0 as 0.0 since they compare equal), so each round is a minimum over 64
-        // integers, with no branch on the data: a third of obvhs's scans' time.
-        let mut keys = [u64::MAX; 64];
-        for (c, offset) in offsets.iter().enumerate().take(child_count) {
-            for (s, direction) in DIRECTIONS.iter().enumerate() {
-                let cost = direction.dot(*offset) + 0.0;
-                if cost < f32::MAX {
-                    keys[c * 8 + s] = u64::from(sortable_bits(cost)) << 6 | (c * 8 + s) as u64;
-                }
+        let mut cost = [[f32::MAX; 8]; 8];
+        for (s, direction) in DIRECTIONS.iter().enumerate() {
+            for c in 0..child_count {
+                cost[c][s] = direction.dot(offsets[c]);
             }
         }
         let mut assignment = [usize::MAX; 8];
-        for _ in 0..child_count {
-            let least = keys.iter().copied().min().unwrap_or(u64::MAX);
-            if least == u64::MAX {
+        let mut slot_filled = [false; 8];
+        loop {
+            let mut min_cost = f32::MAX;
+            let mut min_slot = usize::MAX;
+            let mut min_index = usize::MAX;
+            for c in 0..child_count {
+                if assignment[c] == usize::MAX {
+                    for (s, &filled) in slot_filled.iter().enumerate() {
+                        if !filled && cost[c][s] < min_cost {
+                            min_cost = cost[c][s];
+                            min_slot = s;
+                            min_index = c;
+                        }
+                    }
+                }
+            }
+            if min_slot == usize::MAX {
                 break;
             }
-            let (c, s) = ((least as usize >> 3) & 7, least as usize & 7);
-            assignment[c] = s;
-            // The child and the slot are taken: every pair with either leaves the race.
-            for other in 0..8 {
-                keys[c * 8 + other] = u64::MAX;
-                keys[other * 8 + s] = u64::MAX;
-            }
+            slot_filled[min_slot] = true;
+            assignment[min_index] = min_slot;
         }
         let original = std::mem::replace(children, [u32::MAX; 8]);
         for c in 0..child_count {
@@ -623,17 +623,6 @@ impl<Tree: BinaryTree + Sync, Make> Converter<'_, Tree, Make> {
                 *slot = original[c];
             }
         }
-    }
-}
-
-/// The bits of a number below f32::MAX, other than -0.0, as an integer that orders as the
-/// number does.
-fn sortable_bits(v: f32) -> u32 {
-    let bits = v.to_bits();
-    if bits >> 31 == 1 {
-        !bits
-    } else {
-        bits | 1 << 31
     }
 }
 
