@@ -64,27 +64,50 @@ fn force_traversal_from_env() -> Result<(), Failure> {
         .map_err(|e| Failure::Message(format!("{TRAVERSAL_VARIABLE}={name}: {e}")))
 }
 
+/// Set to `off`, shadow rays walk the BVH instead of using the lights' light buffers, to
+/// compare their speed: the image is the same.
+const LIGHT_BUFFERS_VARIABLE: &str = "WHITTED_LIGHT_BUFFERS";
+
+/// Honours `WHITTED_LIGHT_BUFFERS` (`on`, the default, or `off`), if set.
+fn light_buffers_from_env() -> Result<(), Failure> {
+    let Some(value) = std::env::var_os(LIGHT_BUFFERS_VARIABLE).filter(|v| !v.is_empty()) else {
+        return Ok(());
+    };
+    match value.to_string_lossy().as_ref() {
+        "on" => whitted_tracer::use_light_buffers(true),
+        "off" => whitted_tracer::use_light_buffers(false),
+        other => {
+            return Err(Failure::Usage(format!(
+                "{LIGHT_BUFFERS_VARIABLE}={other:?}: use on or off"
+            )))
+        }
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     allocator::configure();
     let cli = Cli::parse();
-    let result = force_traversal_from_env().and_then(|()| match cli.command {
-        Command::Check(args) => scene_input::check(&args),
-        Command::Ir(args) => scene_input::ir(&args),
-        Command::Render(args) => render_cmd::render(&args),
-        Command::Trace(args) if args.against.is_some() || !args.against_set.is_empty() => {
-            diff_cmd::trace_against(&args)
-        }
-        Command::Trace(args) => trace_cmd::trace(&args),
-        Command::Diff(args) => diff_cmd::diff(&args),
-        Command::Query(args) => query_cmd::query(&args),
-        Command::Grade(args) => grade_cmd::grade(&args),
-        Command::Explain(args) => explain_cmd::explain_pixel(&args),
-        Command::Debug(args) => debug_cmd::debug(&args),
-        Command::Fmt(args) => fmt_cmd::fmt(&args),
-        Command::Mit6837(args) => mit6837_cmd::mit6837(&args.args),
-        Command::Lsp => lsp_cmd::lsp(),
-        Command::Farm(args) => farm::farm(&args),
-    });
+    let result = force_traversal_from_env()
+        .and_then(|()| light_buffers_from_env())
+        .and_then(|()| match cli.command {
+            Command::Check(args) => scene_input::check(&args),
+            Command::Ir(args) => scene_input::ir(&args),
+            Command::Render(args) => render_cmd::render(&args),
+            Command::Trace(args) if args.against.is_some() || !args.against_set.is_empty() => {
+                diff_cmd::trace_against(&args)
+            }
+            Command::Trace(args) => trace_cmd::trace(&args),
+            Command::Diff(args) => diff_cmd::diff(&args),
+            Command::Query(args) => query_cmd::query(&args),
+            Command::Grade(args) => grade_cmd::grade(&args),
+            Command::Explain(args) => explain_cmd::explain_pixel(&args),
+            Command::Debug(args) => debug_cmd::debug(&args),
+            Command::Fmt(args) => fmt_cmd::fmt(&args),
+            Command::Mit6837(args) => mit6837_cmd::mit6837(&args.args),
+            Command::Lsp => lsp_cmd::lsp(),
+            Command::Farm(args) => farm::farm(&args),
+        });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(failure) => {

@@ -223,3 +223,40 @@ fn the_binary_runs_on_older_cpus_with_the_same_image() {
     );
     assert!(!dir.path().join("forced.png").exists());
 }
+
+/// Shadow rays towards point and spot lights are answered from light buffers when the
+/// scene has them: every golden and benchmark scene renders the same bits with them and
+/// with every shadow ray walking the BVH.
+#[test]
+fn light_buffers_render_the_same_bits_as_walking_every_shadow_ray() {
+    let mut buffered_scenes = 0;
+    for scene in scene_paths() {
+        let loaded = load(&scene).scene;
+        let prepared = PreparedScene::new(&loaded);
+        buffered_scenes += usize::from(prepared.light_buffer_sizes().0 > 0);
+        let options = RenderOptions {
+            width: 96,
+            height: 72,
+            ..RenderOptions::from_settings(&loaded.settings)
+        };
+        let bits = |prepared: &PreparedScene| {
+            let (image, _) =
+                render(prepared, &options, &NoObserver).unwrap_or_else(|| panic!("cancelled"));
+            image
+                .pixels
+                .iter()
+                .map(|p| p.map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
+        let with_buffers = bits(&prepared);
+        let walked = bits(&prepared.without_light_buffers());
+        assert!(
+            with_buffers == walked,
+            "{scene}: light buffers changed the image"
+        );
+    }
+    assert!(
+        buffered_scenes >= 5,
+        "only {buffered_scenes} scenes had light buffers"
+    );
+}

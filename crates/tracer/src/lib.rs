@@ -12,6 +12,7 @@ pub mod display;
 mod filter;
 mod hit_error;
 mod light;
+mod light_buffer;
 mod material;
 mod media;
 mod mesh;
@@ -47,7 +48,7 @@ pub use render::{
     trace_pixel_preferring, trace_pixel_with, Image, NoObserver, PixelAccumulator, PixelRect,
     RenderObserver, RenderOptions, RenderStats, TileResult, TILE_SIZE,
 };
-pub use scene::PreparedScene;
+pub use scene::{use_light_buffers, PreparedScene};
 pub use whitted_bvh::{force_traversal_path, PathUnavailable, TraversalPath};
 
 /// Re-exported so that recorder users name the same vector type as the tracer.

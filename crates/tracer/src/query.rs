@@ -8,10 +8,12 @@
 //! found; BVH ids index `bounded` directly because items were reordered at build time.
 
 use glam::{UVec2, Vec3A};
+use obvhs::aabb::Aabb;
 use whitted_ir::{Handle, Material};
 
 use crate::csg::CsgScratch;
 use crate::hit_error;
+use crate::light_buffer::Lookup;
 use crate::material::{Blend, Pick};
 use crate::scene::{Item, Leaf, PreparedScene};
 use crate::shapes::{plane_first_hit, sphere_first_hit, unit_normal, with_fourth, Geometry, Part};
@@ -26,6 +28,45 @@ pub(crate) const LINEAR_LIMIT: usize = 4;
 pub enum ItemRef {
     Bounded(u32),
     Unbounded(u32),
+}
+
+/// How far (relative to the coordinates and distances involved) a shadow segment must pass
+/// inside a box for the BVH walk's f32 box tests to find it there too: a thousand times
+/// f32's rounding.
+const WALK_ROUNDING: f64 = 1.0 / (1u64 << 14) as f64;
+
+/// Whether the segment `(tmin, tmax)` of `ray` passes through `aabb` with room to spare:
+/// by [`WALK_ROUNDING`] of the largest coordinate or distance involved, computed in f64.
+/// The walk's boxes around an item hold its box, so the walk reaches the item for such a
+/// segment whatever its rounding.
+fn well_inside(aabb: &Aabb, ray: &Ray, tmin: f32, tmax: f32) -> bool {
+    let origin = ray.origin.as_dvec3();
+    let direction = ray.direction.as_dvec3();
+    let (lo, hi) = (aabb.min.as_dvec3(), aabb.max.as_dvec3());
+    let scale = origin.abs().max(lo.abs()).max(hi.abs()).max_element() + f64::from(tmax);
+    if !scale.is_finite() {
+        return false;
+    }
+    let margin = scale * WALK_ROUNDING;
+    let (lo, hi) = (lo + margin, hi - margin);
+    // A box thinner than the margin has no inside to spare.
+    if lo.cmpgt(hi).any() {
+        return false;
+    }
+    let (mut enter, mut exit) = (f64::from(tmin) + margin, f64::from(tmax) - margin);
+    for axis in 0..3 {
+        let (o, d) = (origin[axis], direction[axis]);
+        if d == 0.0 {
+            if !(lo[axis] <= o && o <= hi[axis]) {
+                return false;
+            }
+            continue;
+        }
+        let (a, b) = ((lo[axis] - o) / d, (hi[axis] - o) / d);
+        enter = enter.max(a.min(b));
+        exit = exit.min(a.max(b));
+    }
+    enter < exit
 }
 
 /// The cheap result of a closest-hit query.
@@ -330,6 +371,62 @@ impl PreparedScene {
                 item_hit(item, ray, tmin, tmax, &mut scratch.csg)
                     .map(|found| Hit::new(ItemRef::Bounded(i as u32), found))
             }),
+        }
+    }
+
+    /// [`PreparedScene::occluded`] for a shadow ray towards light `light` (the light's own
+    /// direction and distance): the same answer, and with `names_blocker` the same blocker.
+    /// With a light buffer (see `light_buffer.rs`), a ray that meets none of its candidates
+    /// is clear without a walk, and one that meets a candidate well inside its box is
+    /// blocked; otherwise the walk answers, as it always has.
+    pub(crate) fn occluded_towards(
+        &self,
+        light: usize,
+        names_blocker: bool,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut Scratch,
+    ) -> Option<Hit> {
+        let Some(buffer) = self.light_buffers.get(light).and_then(Option::as_ref) else {
+            return self.occluded(ray, tmin, tmax, scratch);
+        };
+        let (candidates, limit) = match buffer.lookup(ray, tmax) {
+            Lookup::Candidates(candidates, limit) => (candidates, limit),
+            Lookup::Unanswered => return self.occluded(ray, tmin, tmax, scratch),
+        };
+        for (i, item) in self.unbounded.iter().enumerate() {
+            if let Some(found) = item_hit(item, ray, tmin, tmax, &mut scratch.csg) {
+                return Some(Hit::new(ItemRef::Unbounded(i as u32), found));
+            }
+        }
+        let mut met = None;
+        for candidate in candidates {
+            if candidate.near > limit {
+                break;
+            }
+            let Some(item) = self.bounded.get(candidate.item as usize) else {
+                continue;
+            };
+            if let Some(found) = item_hit(item, ray, tmin, tmax, &mut scratch.csg) {
+                met = Some((candidate.item, found));
+                break;
+            }
+        }
+        let (index, found) = met?;
+        // A recorder names the blocker: the walk's. Otherwise, a segment well inside the
+        // blocker's box is one the walk reaches it by (the walk tests boxes holding it); one
+        // at its edge, within rounding, asks the walk.
+        let inside = self
+            .light_buffer_boxes
+            .get(index as usize)
+            .is_some_and(|aabb| well_inside(aabb, ray, tmin, tmax));
+        if inside && !names_blocker {
+            return Some(Hit::new(ItemRef::Bounded(index), found));
+        }
+        match self.walk_bvh() {
+            Some(bvh) => self.occluded_bvh(bvh, ray, tmin, tmax, scratch),
+            None => self.occluded(ray, tmin, tmax, scratch),
         }
     }
 

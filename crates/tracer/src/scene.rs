@@ -2,6 +2,7 @@
 //! from a validated IR scene: f32 shapes with their transforms folded in, resolved materials
 //! and lights, the camera basis, CSG trees, and the BVH over bounded objects.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
@@ -15,10 +16,11 @@ use whitted_ir::{
 use crate::camera::PreparedCamera;
 use crate::csg::{ChildAccel, CsgNode, CsgTree, NO_ACCEL};
 use crate::hit_error;
-use crate::light::PreparedLight;
+use crate::light::{PreparedLight, PreparedLightKind};
+use crate::light_buffer::LightBuffer;
 use crate::material::{color, PatternFrame, PatternFrames, PreparedMaterial, Snap};
 use crate::mesh::{MeshInstance, PreparedMesh};
-use crate::query::Surface;
+use crate::query::{Surface, LINEAR_LIMIT};
 use crate::shapes::Geometry;
 use whitted_bvh::{Bound, Bvh, PrimitiveBox};
 
@@ -80,6 +82,13 @@ pub struct PreparedScene {
     /// The frames of the leaves whose material has a pattern.
     pub(crate) pattern_frames: PatternFrames,
     pub(crate) bvh: Option<Bvh>,
+    /// Each light's light buffer (see `light_buffer.rs`), when it has one: point and spot
+    /// lights of scenes with opaque shadows and at most [`LIGHT_BUFFER_MAX_ITEMS`] bounded
+    /// items.
+    pub(crate) light_buffers: Vec<Option<LightBuffer>>,
+    /// The bounded items' boxes, when there are light buffers: a blocker they find is
+    /// taken when the shadow ray passes well inside its box.
+    pub(crate) light_buffer_boxes: Vec<Aabb>,
     pub(crate) background: Vec3A,
     pub(crate) ambient: Vec3A,
     /// The scene's explicit surface offset; `None` for error-bounded offsets.
@@ -129,6 +138,20 @@ impl PreparedScene {
         let shapes = Shapes::new_releasing(scene, RELEASE_CHUNK);
         let shapes_seconds = started.elapsed().as_secs_f64();
         shapes.finish(started, shapes_seconds)
+    }
+
+    /// The same scene answering every shadow ray by walking the BVH, as recorders do: for
+    /// tests and measurements that compare the two (the image must be the same).
+    pub fn without_light_buffers(mut self) -> PreparedScene {
+        self.light_buffers = Vec::new();
+        self.light_buffer_boxes = Vec::new();
+        self
+    }
+
+    /// How many lights have a light buffer, and the candidates in them all.
+    pub fn light_buffer_sizes(&self) -> (usize, usize) {
+        let buffers = self.light_buffers.iter().flatten();
+        (buffers.clone().count(), buffers.map(LightBuffer::len).sum())
     }
 
     /// Seconds spent in [`PreparedScene::new`]: shape preparation and the BVH build.
@@ -354,8 +377,19 @@ impl Shapes {
             unbounded,
             pattern_frames,
         } = self;
-        let (bounded, bvh) = build_bvh(bounded, boxes);
+        let wants_buffers = LIGHT_BUFFERS.load(Ordering::Relaxed)
+            && settings.shadows == ShadowMode::Opaque
+            && bounded.len() > LINEAR_LIMIT
+            && bounded.len() <= LIGHT_BUFFER_MAX_ITEMS
+            && lights.iter().any(|light| light_position(light).is_some());
+        let (bounded, bvh, kept_boxes) = build_bvh(bounded, boxes, wants_buffers);
+        let (light_buffers, light_buffer_boxes) = match (&bvh, kept_boxes) {
+            (Some(_), Some(boxes)) => (light_buffers(&lights, &boxes), boxes),
+            _ => (Vec::new(), Vec::new()),
+        };
         PreparedScene {
+            light_buffers,
+            light_buffer_boxes,
             mesh_count,
             mesh_triangles,
             mesh_bvh_nodes,
@@ -654,14 +688,68 @@ fn node_bound(node: &CsgNode) -> Bound {
 /// order. The boxes are handed to the build, which makes its leaves of them in place, and
 /// the items are moved in place beside them, so that no second copy of a million boxes or
 /// items exists at any time.
-fn build_bvh(mut items: Vec<Item>, boxes: Vec<PrimitiveBox>) -> (Vec<Item>, Option<Bvh>) {
+fn build_bvh(
+    mut items: Vec<Item>,
+    boxes: Vec<PrimitiveBox>,
+    keep_boxes: bool,
+) -> (Vec<Item>, Option<Bvh>, Option<Vec<Aabb>>) {
     if items.is_empty() || items.len() > whitted_bvh::MAX_PRIMITIVES {
-        return (items, None);
+        return (items, None, None);
+    }
+    if keep_boxes {
+        // A scene small enough for light buffers: its boxes move with its items.
+        let kept: Vec<Aabb> = boxes.iter().map(PrimitiveBox::aabb).collect();
+        let mut paired: Vec<(Item, Aabb)> = items.into_iter().zip(kept).collect();
+        let bvh = Bvh::build_ordering(boxes, &mut paired);
+        let (items, kept) = paired.into_iter().unzip();
+        return (items, bvh, Some(kept));
     }
     // No BVH (obvhs never fails to make one without spatial splits): every item is still
     // there once, and all are tested, which is slow but right.
     let bvh = Bvh::build_ordering(boxes, &mut items);
-    (items, bvh)
+    (items, bvh, None)
+}
+
+/// Whether scenes prepared from now on get light buffers (see [`use_light_buffers`]).
+static LIGHT_BUFFERS: AtomicBool = AtomicBool::new(true);
+
+/// Whether scenes prepared from now on give their point and spot lights light buffers
+/// (the default), or answer every shadow ray by walking the BVH: the image is the same
+/// either way, so this is for comparing their speed (`WHITTED_LIGHT_BUFFERS=off`).
+pub fn use_light_buffers(enabled: bool) {
+    LIGHT_BUFFERS.store(enabled, Ordering::Relaxed);
+}
+
+/// Up to this many bounded items, point and spot lights get light buffers (above it, their
+/// memory and build time would matter more than the shadow rays they save).
+pub(crate) const LIGHT_BUFFER_MAX_ITEMS: usize = 1 << 18;
+/// Most candidates (8 bytes each) in all the light buffers of a scene together: 32 MiB.
+const LIGHT_BUFFER_BUDGET: usize = 1 << 22;
+
+/// Where a light's shadow rays aim, for lights that have a position.
+fn light_position(light: &PreparedLight) -> Option<Vec3A> {
+    match light.kind {
+        PreparedLightKind::Point { position, .. } | PreparedLightKind::Spot { position, .. } => {
+            Some(position)
+        }
+        PreparedLightKind::Directional { .. } => None,
+    }
+}
+
+/// The lights' buffers over the bounded items' boxes (in BVH order), in the lights' order,
+/// while the budget lasts; each light's buffer holds at most 64 candidates an item.
+fn light_buffers(lights: &[PreparedLight], boxes: &[Aabb]) -> Vec<Option<LightBuffer>> {
+    let mut left = LIGHT_BUFFER_BUDGET;
+    lights
+        .iter()
+        .map(|light| {
+            let position = light_position(light)?;
+            let most = left.min(64 * boxes.len() + 4096);
+            let buffer = LightBuffer::new(position, boxes, most)?;
+            left -= buffer.len();
+            Some(buffer)
+        })
+        .collect()
 }
 
 #[cfg(test)]

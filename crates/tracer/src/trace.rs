@@ -823,7 +823,7 @@ impl<'a> Tracer<'a> {
         // `highlight_gate off` (the course's Phong): a light behind the surface still adds
         // its highlight, so it is not skipped when the material has one.
         let gated = scene.settings.highlight_gate || m.specular == Vec3A::ZERO;
-        for light in &scene.lights {
+        for (light_index, light) in scene.lights.iter().enumerate() {
             let incidence = light.incidence(outside);
             let n_dot_l = n.dot(incidence.to_light);
             let strength = incidence.attenuation * incidence.spot;
@@ -859,7 +859,7 @@ impl<'a> Tracer<'a> {
                 sample.no_shadow_ray = Some(NoShadowRay::ShadowsOff);
                 (Vec3A::ONE, None)
             } else {
-                self.cast_shadow::<R>(outside, incidence.to_light, incidence.distance)
+                self.cast_shadow::<R>(light_index, outside, incidence.to_light, incidence.distance)
             };
             sample.shadow_ray = shadow_ray;
             if passed != Vec3A::ZERO {
@@ -883,6 +883,7 @@ impl<'a> Tracer<'a> {
     /// the recorder wants one (finding the blocker's object is work for the recorder only).
     fn cast_shadow<R: Recorder>(
         &mut self,
+        light: usize,
         origin: Vec3A,
         to_light: Vec3A,
         distance: f32,
@@ -892,10 +893,19 @@ impl<'a> Tracer<'a> {
         self.counters.shadow += 1;
         self.sample_rays += 1;
         let shadow = match scene.shadows {
-            ShadowMode::Opaque => match scene.occluded(&ray, 0.0, distance, &mut self.scratch) {
-                Some(blocker) => Shadow::Blocked(blocker),
-                None => Shadow::Clear,
-            },
+            ShadowMode::Opaque => {
+                match scene.occluded_towards(
+                    light,
+                    R::RECORDS,
+                    &ray,
+                    0.0,
+                    distance,
+                    &mut self.scratch,
+                ) {
+                    Some(blocker) => Shadow::Blocked(blocker),
+                    None => Shadow::Clear,
+                }
+            }
             ShadowMode::Filtered => scene.filter_shadow(&ray, 0.0, distance, &mut self.scratch),
             // `local_illumination` casts no shadow ray with `shadows none`.
             ShadowMode::None => Shadow::Clear,
