@@ -338,6 +338,8 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         build_seconds: prepared.build_seconds(),
         shapes_seconds: prepared.shapes_seconds(),
         traversal: TraversalPath::chosen(),
+        light_buffers: prepared.light_buffer_sizes(),
+        lights: prepared.light_count(),
         stats: &stats,
         render_cpu_seconds,
         wall_seconds: started.elapsed().as_secs_f64(),
@@ -397,6 +399,9 @@ struct Summary<'a> {
     shapes_seconds: f64,
     /// The BVH walk's child test (every path gives the same image).
     traversal: TraversalPath,
+    /// How many lights have a light buffer, and the candidates in them.
+    light_buffers: (usize, usize),
+    lights: usize,
     stats: &'a RenderStats,
     /// The CPU time the render's threads spent on it, summed over the threads (each
     /// thread's own clock, so time other programs took on the machine is not counted).
@@ -407,6 +412,20 @@ struct Summary<'a> {
 }
 
 impl Summary<'_> {
+    /// Which lights answer shadow rays from a light buffer, and what the buffers hold
+    /// (8 bytes a candidate).
+    fn light_buffer_line(&self) -> String {
+        let (buffered, candidates) = self.light_buffers;
+        if buffered == 0 {
+            return "light buffers    none (every shadow ray walks the BVH)".to_string();
+        }
+        format!(
+            "light buffers    {buffered} of {} lights, {candidates} candidates ({:.1} MiB)",
+            self.lights,
+            candidates as f64 * 8.0 / (1024.0 * 1024.0)
+        )
+    }
+
     fn text(&self) -> String {
         let s = self.stats;
         let o = self.options;
@@ -427,6 +446,7 @@ impl Summary<'_> {
                 self.build_seconds - self.shapes_seconds
             ),
             format!("bvh walk         {}", self.traversal.name()),
+            self.light_buffer_line(),
             format!(
                 "render           {:.3} s on {} threads",
                 s.render_seconds, self.threads
@@ -486,6 +506,8 @@ impl Summary<'_> {
             "build_seconds": self.build_seconds,
             "shapes_seconds": self.shapes_seconds,
             "bvh_walk": self.traversal.name(),
+            "light_buffers": self.light_buffers.0,
+            "light_buffer_candidates": self.light_buffers.1,
             "render_seconds": s.render_seconds,
             "camera_rays": s.camera_rays,
             "shadow_rays": s.shadow_rays,

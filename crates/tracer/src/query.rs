@@ -43,7 +43,10 @@ fn well_inside(aabb: &Aabb, ray: &Ray, tmin: f32, tmax: f32) -> bool {
     let origin = ray.origin.as_dvec3();
     let direction = ray.direction.as_dvec3();
     let (lo, hi) = (aabb.min.as_dvec3(), aabb.max.as_dvec3());
-    let scale = origin.abs().max(lo.abs()).max(hi.abs()).max_element() + f64::from(tmax);
+    // The segment meets the box no further than its far side: the distance that rounds.
+    let reaches = (origin - (lo + hi) / 2.0).length() + (hi - lo).length();
+    let scale =
+        origin.abs().max(lo.abs()).max(hi.abs()).max_element() + reaches.min(f64::from(tmax));
     if !scale.is_finite() {
         return false;
     }

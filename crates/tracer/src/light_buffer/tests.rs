@@ -5,7 +5,7 @@
 //! silhouette or pass through a box's corner exactly as seen from the light.
 
 use glam::{DMat4, DVec3, Vec3A};
-use whitted_ir::Shape;
+use whitted_ir::{Color, Light, LightKind, Shape};
 
 use super::*;
 use crate::query::Scratch;
@@ -47,6 +47,7 @@ impl Rng {
 
 /// Where a cloud is, how big, and where its light is (relative to the centre, in units
 /// of the scale).
+#[derive(Clone)]
 struct Cloud {
     name: &'static str,
     center: DVec3,
@@ -62,14 +63,36 @@ struct Made {
     spheres: Vec<(DVec3, f64)>,
     boxes: Vec<(DVec3, DVec3)>,
     light: DVec3,
+    /// For a directional light, the unit vector towards it.
+    toward: Option<DVec3>,
 }
 
-fn make(cloud: &Cloud, rng: &mut Rng) -> Made {
+/// The unit vector towards a cloud's directional light: towards where its point light
+/// would be, or along an axis when that is at the centre.
+fn toward(cloud: &Cloud) -> DVec3 {
+    if cloud.light.length() > 0.5 {
+        cloud.light.normalize()
+    } else {
+        DVec3::Y
+    }
+}
+
+fn make(cloud: &Cloud, rng: &mut Rng, directional: bool) -> Made {
     let s = cloud.scale;
     let mut b = SceneBuilder::new();
     b.camera(cloud.center - DVec3::Z * 10.0 * s, cloud.center, 40.0);
     let light = cloud.center + cloud.light * s;
-    b.point_light(light, 1.0);
+    if directional {
+        b.light(Light {
+            name: None,
+            color: Color::gray(1.0),
+            kind: LightKind::Directional {
+                direction: -toward(cloud),
+            },
+        });
+    } else {
+        b.point_light(light, 1.0);
+    }
     let m = b.material(matte(0.5, 0.5, 0.5));
     let mut spheres = Vec::new();
     let mut boxes = Vec::new();
@@ -138,6 +161,7 @@ fn make(cloud: &Cloud, rng: &mut Rng) -> Made {
         spheres,
         boxes,
         light,
+        toward: directional.then(|| toward(cloud)),
     }
 }
 
@@ -192,7 +216,10 @@ fn check(made: &Made, name: &str, origins: impl IntoIterator<Item = DVec3>) -> T
 
 /// Origins whose rays to the light graze a sphere's silhouette as seen from the light, or
 /// pass through a box's corner, from beyond them.
-fn grazing(made: &Made, rng: &mut Rng) -> Vec<DVec3> {
+fn grazing(made: &Made, rng: &mut Rng, scale: f64) -> Vec<DVec3> {
+    if let Some(w) = made.toward {
+        return grazing_parallel(made, rng, w, scale);
+    }
     let l = made.light;
     let mut origins = Vec::new();
     for &(c, r) in &made.spheres {
@@ -220,6 +247,34 @@ fn grazing(made: &Made, rng: &mut Rng) -> Vec<DVec3> {
                 pick(4, lo.z, hi.z),
             );
             origins.push(l + (p - l) * rng.range(1.001, 2.0));
+        }
+    }
+    origins
+}
+
+/// [`grazing`] for a directional light towards `w`: rays along `w` from behind each
+/// sphere's silhouette and each box's corner.
+fn grazing_parallel(made: &Made, rng: &mut Rng, w: DVec3, scale: f64) -> Vec<DVec3> {
+    let mut origins = Vec::new();
+    for &(c, r) in &made.spheres {
+        for _ in 0..8 {
+            let e = rng
+                .direction()
+                .reject_from_normalized(w)
+                .normalize_or_zero();
+            let tangent = c + r * e;
+            origins.push(tangent - w * rng.range(0.001, 3.0) * scale);
+        }
+    }
+    for &(lo, hi) in &made.boxes {
+        for corner in 0..8 {
+            let pick = |bit: usize, a: f64, b: f64| if corner & bit == 0 { a } else { b };
+            let p = DVec3::new(
+                pick(1, lo.x, hi.x),
+                pick(2, lo.y, hi.y),
+                pick(4, lo.z, hi.z),
+            );
+            origins.push(p - w * rng.range(0.001, 3.0) * scale);
         }
     }
     origins
@@ -307,14 +362,18 @@ fn clouds() -> Vec<Cloud> {
 #[test]
 fn the_buffer_answers_every_shadow_ray_as_the_bvh_walk() {
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-    for cloud in clouds() {
-        let made = make(&cloud, &mut rng);
+    for (cloud, directional) in clouds()
+        .into_iter()
+        .flat_map(|cloud| [false, true].map(|directional| (cloud.clone(), directional)))
+    {
+        let made = make(&cloud, &mut rng, directional);
         let random: Vec<DVec3> = (0..2000)
             .map(|_| rng.point(cloud.center, 3.0 * cloud.scale))
             .collect();
         let surfaces = on_surfaces(&made, &cloud, &mut rng, 2000);
-        let grazing = grazing(&made, &mut rng);
-        let name = cloud.name;
+        let grazing = grazing(&made, &mut rng, cloud.scale);
+        let light = if directional { "directional" } else { "point" };
+        let name = &format!("{}, {light} light", cloud.name);
         let random = check(&made, name, random);
         let surfaces = check(&made, name, surfaces);
         let grazing = check(&made, name, grazing);
@@ -343,7 +402,7 @@ fn the_buffer_answers_every_shadow_ray_as_the_bvh_walk() {
 fn a_ray_from_beyond_the_buffer_s_reach_walks_the_bvh() {
     let mut rng = Rng(7);
     let cloud = &clouds()[0];
-    let made = make(cloud, &mut rng);
+    let made = make(cloud, &mut rng, false);
     let Some(buffer) = made.scene.light_buffers[0].as_ref() else {
         panic!("no buffer");
     };
@@ -457,6 +516,7 @@ fn rays_at_the_edges_of_a_footprint_are_answered_as_the_walk() {
             spheres: Vec::new(),
             boxes: boxes.clone(),
             light,
+            toward: None,
         };
         let mut origins = Vec::new();
         for &(lo, hi) in &boxes {
