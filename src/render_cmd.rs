@@ -399,8 +399,8 @@ struct Summary<'a> {
     shapes_seconds: f64,
     /// The BVH walk's child test (every path gives the same image).
     traversal: TraversalPath,
-    /// How many lights have a light buffer, and the candidates in them.
-    light_buffers: (usize, usize),
+    /// How many lights have a light buffer, the candidates in them, and their bytes.
+    light_buffers: (usize, usize, usize),
     lights: usize,
     stats: &'a RenderStats,
     /// The CPU time the render's threads spent on it, summed over the threads (each
@@ -412,17 +412,16 @@ struct Summary<'a> {
 }
 
 impl Summary<'_> {
-    /// Which lights answer shadow rays from a light buffer, and what the buffers hold
-    /// (8 bytes a candidate).
+    /// Which lights answer shadow rays from a light buffer, and what the buffers hold.
     fn light_buffer_line(&self) -> String {
-        let (buffered, candidates) = self.light_buffers;
+        let (buffered, candidates, bytes) = self.light_buffers;
         if buffered == 0 {
             return "light buffers    none (every shadow ray walks the BVH)".to_string();
         }
         format!(
             "light buffers    {buffered} of {} lights, {candidates} candidates ({:.1} MiB)",
             self.lights,
-            candidates as f64 * 8.0 / (1024.0 * 1024.0)
+            bytes as f64 / (1024.0 * 1024.0)
         )
     }
 
@@ -508,6 +507,7 @@ impl Summary<'_> {
             "bvh_walk": self.traversal.name(),
             "light_buffers": self.light_buffers.0,
             "light_buffer_candidates": self.light_buffers.1,
+            "light_buffer_bytes": self.light_buffers.2,
             "render_seconds": s.render_seconds,
             "camera_rays": s.camera_rays,
             "shadow_rays": s.shadow_rays,

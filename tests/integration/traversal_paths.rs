@@ -260,3 +260,50 @@ fn light_buffers_render_the_same_bits_as_walking_every_shadow_ray() {
         "only {buffered_scenes} scenes had light buffers"
     );
 }
+
+/// `render --stats` says which lights have light buffers; `WHITTED_LIGHT_BUFFERS=off`
+/// turns them off with the same image, and a value that is neither on nor off is refused
+/// with a message naming the variable, before anything is written.
+#[test]
+fn the_binary_reports_and_switches_light_buffers() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let run = |value: Option<&str>, name: &str| {
+        let png = dir.path().join(name);
+        let mut command = Command::new(env!("CARGO_BIN_EXE_whitted"));
+        command
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(["render", "scenes/bench/grid.scene", "--stats", "-o"])
+            .arg(&png)
+            .env_remove("WHITTED_LIGHT_BUFFERS");
+        if let Some(value) = value {
+            command.env("WHITTED_LIGHT_BUFFERS", value);
+        }
+        let output = command.output().unwrap_or_else(|e| panic!("whitted: {e}"));
+        (
+            output.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&output.stdout).into_owned(),
+            String::from_utf8_lossy(&output.stderr).into_owned(),
+            std::fs::read(&png).ok(),
+        )
+    };
+    let (code, stats, stderr, on) = run(None, "on.png");
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stats.contains("light buffers    2 of 2 lights, "),
+        "{stats}"
+    );
+    let (code, stats, stderr, off) = run(Some("off"), "off.png");
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stats.contains("light buffers    none (every shadow ray walks the BVH)\n"),
+        "{stats}"
+    );
+    assert!(on.is_some() && on == off, "the images differ");
+    let (code, _, stderr, bad) = run(Some("maybe"), "bad.png");
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("WHITTED_LIGHT_BUFFERS=\"maybe\": use on or off"),
+        "{stderr}"
+    );
+    assert!(bad.is_none());
+}

@@ -27,8 +27,9 @@ use whitted_bvh::Ray;
 
 /// Cells across the median footprint, each way.
 const CELLS_ACROSS: f64 = 1.0;
-/// Most cells of a face's grid for each item on the face.
-const MAX_CELLS_PER_ITEM: f64 = 16.0;
+/// Most cells of a face's grid for each item on the face: items scattered all round a
+/// light would otherwise ask for a face's area in cells of their own small size.
+const MAX_CELLS_PER_ITEM: f64 = 4.0;
 /// Most cells along one side of a face's grid.
 const MAX_SIDE: u32 = 1024;
 /// The relative rounding a shadow ray's direction and a point on it may carry, many times
@@ -221,14 +222,19 @@ impl LightBuffer {
             *grid = FaceGrid::over(footprints.iter().filter(|f| f.face == face), first_cell);
             first_cell += grid.columns * grid.rows;
         }
-        // Counted first, so that a buffer over budget is never allocated.
+        // Counted first, so that a buffer over budget is never allocated: its cells (three
+        // arrays of 4 bytes while it is made) and its candidates (8 bytes) together.
+        let cells = first_cell as usize + 1;
+        if cells > max_candidates {
+            return None;
+        }
         let mut counts = vec![0u32; first_cell as usize + 1];
         let mut total = 0usize;
         for footprint in footprints {
             let grid = &faces[footprint.face];
             let (columns, rows) = grid.cells_of(footprint);
             total += columns.len() * rows.len();
-            if total > max_candidates {
+            if cells + total > max_candidates {
                 return None;
             }
             for row in rows {
@@ -274,9 +280,20 @@ impl LightBuffer {
         })
     }
 
-    /// Candidates in all the buffer's cells (for the statistics and the memory budget).
+    /// Candidates in all the buffer's cells (for the statistics).
     pub(crate) fn len(&self) -> usize {
         self.candidates.len()
+    }
+
+    /// The bytes of its cells and candidates.
+    pub(crate) fn bytes(&self) -> usize {
+        std::mem::size_of_val(self.candidates.as_slice())
+            + std::mem::size_of_val(self.cell_starts.as_slice())
+    }
+
+    /// What the buffer counts against the scene's budget: its candidates and its cells.
+    pub(crate) fn budget_used(&self) -> usize {
+        self.candidates.len() + self.cell_starts.len()
     }
 
     /// The candidates of a shadow ray towards this light that stops at `tmax` (infinite

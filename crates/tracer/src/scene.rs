@@ -153,10 +153,17 @@ impl PreparedScene {
         self.lights.len()
     }
 
-    /// How many lights have a light buffer, and the candidates in them all.
-    pub fn light_buffer_sizes(&self) -> (usize, usize) {
+    /// How many lights have a light buffer, the candidates in them all, and the bytes
+    /// they take (their cells and candidates, and the objects' boxes they share).
+    pub fn light_buffer_sizes(&self) -> (usize, usize, usize) {
         let buffers = self.light_buffers.iter().flatten();
-        (buffers.clone().count(), buffers.map(LightBuffer::len).sum())
+        let bytes = buffers.clone().map(LightBuffer::bytes).sum::<usize>()
+            + std::mem::size_of_val(self.light_buffer_boxes.as_slice());
+        (
+            buffers.clone().count(),
+            buffers.map(LightBuffer::len).sum(),
+            bytes,
+        )
     }
 
     /// Seconds spent in [`PreparedScene::new`]: shape preparation and the BVH build.
@@ -730,7 +737,8 @@ pub fn use_light_buffers(enabled: bool) {
 /// of 0.049 and rendered 640x480 8 ms faster (13.0 -> 14.4 Mrays per CPU-second), so above
 /// this the build can cost more than the shadow rays save.
 pub(crate) const LIGHT_BUFFER_MAX_ITEMS: usize = 1 << 16;
-/// Most candidates (8 bytes each) in all the light buffers of a scene together: 32 MiB.
+/// Most candidates (8 bytes each) and cells (4) in all the light buffers of a scene
+/// together: at most 32 MiB.
 const LIGHT_BUFFER_BUDGET: usize = 1 << 22;
 
 /// The lights' buffers over the bounded items' boxes (in BVH order), in the lights' order,
@@ -750,7 +758,7 @@ fn light_buffers(lights: &[PreparedLight], boxes: &[Aabb]) -> Vec<Option<LightBu
                     LightBuffer::new_parallel(to_light, boxes, most)
                 }
             }?;
-            left -= buffer.len();
+            left -= buffer.budget_used().min(left);
             Some(buffer)
         })
         .collect()

@@ -425,7 +425,7 @@ fn a_buffer_over_its_budget_is_not_made() {
             Aabb::new(c - 0.4, c + 0.4)
         })
         .collect();
-    let made = LightBuffer::new(Vec3A::ZERO, &boxes, usize::MAX).map(|b| b.len());
+    let made = LightBuffer::new(Vec3A::ZERO, &boxes, usize::MAX).map(|b| b.budget_used());
     let Some(needed) = made else {
         panic!("no buffer without a budget");
     };
@@ -550,4 +550,26 @@ fn rays_at_the_edges_of_a_footprint_are_answered_as_the_walk() {
             "{name}: {tally:?}"
         );
     }
+}
+
+/// Small objects scattered all round a light would ask, at cells of their own size, for
+/// millions of cells per face: the grid stays within a few cells an object.
+#[test]
+fn objects_all_round_a_light_get_a_few_cells_each() {
+    let mut rng = Rng(11);
+    let boxes: Vec<Aabb> = (0..2000)
+        .map(|_| {
+            let c = (rng.direction() * rng.range(5.0, 50.0)).as_vec3a();
+            Aabb::new(c - 0.01, c + 0.01)
+        })
+        .collect();
+    let Some(buffer) = LightBuffer::new(Vec3A::ZERO, &boxes, usize::MAX) else {
+        panic!("no buffer");
+    };
+    let cells = buffer.cell_starts.len();
+    assert!(
+        cells < 6 * boxes.len(),
+        "{cells} cells for {} objects",
+        boxes.len()
+    );
 }
