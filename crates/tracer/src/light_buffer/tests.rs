@@ -214,6 +214,18 @@ fn check(made: &Made, name: &str, origins: impl IntoIterator<Item = DVec3>) -> T
     tally
 }
 
+/// The eight corners of the box `[lo, hi]`.
+fn corners(lo: DVec3, hi: DVec3) -> impl Iterator<Item = DVec3> {
+    (0..8).map(move |corner: u32| {
+        let pick = |bit: u32, a: f64, b: f64| if corner & bit == 0 { a } else { b };
+        DVec3::new(
+            pick(1, lo.x, hi.x),
+            pick(2, lo.y, hi.y),
+            pick(4, lo.z, hi.z),
+        )
+    })
+}
+
 /// Origins whose rays to the light graze a sphere's silhouette as seen from the light, or
 /// pass through a box's corner, from beyond them.
 fn grazing(made: &Made, rng: &mut Rng, scale: f64) -> Vec<DVec3> {
@@ -239,13 +251,7 @@ fn grazing(made: &Made, rng: &mut Rng, scale: f64) -> Vec<DVec3> {
         }
     }
     for &(lo, hi) in &made.boxes {
-        for corner in 0..8 {
-            let pick = |bit: usize, a: f64, b: f64| if corner & bit == 0 { a } else { b };
-            let p = DVec3::new(
-                pick(1, lo.x, hi.x),
-                pick(2, lo.y, hi.y),
-                pick(4, lo.z, hi.z),
-            );
+        for p in corners(lo, hi) {
             origins.push(l + (p - l) * rng.range(1.001, 2.0));
         }
     }
@@ -267,13 +273,7 @@ fn grazing_parallel(made: &Made, rng: &mut Rng, w: DVec3, scale: f64) -> Vec<DVe
         }
     }
     for &(lo, hi) in &made.boxes {
-        for corner in 0..8 {
-            let pick = |bit: usize, a: f64, b: f64| if corner & bit == 0 { a } else { b };
-            let p = DVec3::new(
-                pick(1, lo.x, hi.x),
-                pick(2, lo.y, hi.y),
-                pick(4, lo.z, hi.z),
-            );
+        for p in corners(lo, hi) {
             origins.push(p - w * rng.range(0.001, 3.0) * scale);
         }
     }
@@ -521,13 +521,7 @@ fn rays_at_the_edges_of_a_footprint_are_answered_as_the_walk() {
         let mut origins = Vec::new();
         for &(lo, hi) in &boxes {
             let middle = (lo + hi) / 2.0;
-            for corner in 0..8 {
-                let pick = |bit: usize, a: f64, b: f64| if corner & bit == 0 { a } else { b };
-                let p = DVec3::new(
-                    pick(1, lo.x, hi.x),
-                    pick(2, lo.y, hi.y),
-                    pick(4, lo.z, hi.z),
-                );
+            for p in corners(lo, hi) {
                 // Inwards by a few roundings of the corner's coordinates.
                 let size = p.abs().max_element().max(scale);
                 for inwards in [0.0, 3e-8, 6e-8, 1.2e-7, 2.4e-7, 4.8e-7, 1e-6, 2e-6, 4e-6] {
