@@ -25,8 +25,6 @@ use glam::{DVec3, Vec3A};
 use obvhs::aabb::Aabb;
 use whitted_bvh::Ray;
 
-/// Cells across the median footprint, each way.
-const CELLS_ACROSS: f64 = 1.0;
 /// Most cells of a face's grid for each item on the face: items scattered all round a
 /// light would otherwise ask for a face's area in cells of their own small size.
 const MAX_CELLS_PER_ITEM: f64 = 4.0;
@@ -117,18 +115,7 @@ impl LightBuffer {
     /// items), or `None` when it would hold more than `max_candidates` entries.
     pub(crate) fn new(position: Vec3A, boxes: &[Aabb], max_candidates: usize) -> Option<Self> {
         let light = position.as_dvec3();
-        // Well beyond the items, so that shadow rays from planes around them are answered
-        // too; the widening grows with it.
-        let reach = REACH_FACTOR
-            * boxes
-                .iter()
-                .flat_map(|b| [b.min, b.max])
-                .chain([position])
-                .map(|p| p.abs().max_element())
-                .fold(0.0f32, f32::max);
-        if !reach.is_finite() {
-            return None;
-        }
+        let reach = reach(boxes, Some(position))?;
         let mut footprints = Vec::new();
         for (item, aabb) in boxes.iter().enumerate() {
             let lo = aabb.min.as_dvec3() - light;
@@ -164,14 +151,10 @@ impl LightBuffer {
         boxes: &[Aabb],
         max_candidates: usize,
     ) -> Option<Self> {
-        let reach = REACH_FACTOR
-            * boxes
-                .iter()
-                .flat_map(|b| [b.min, b.max])
-                .map(|p| p.abs().max_element())
-                .fold(0.0f32, f32::max);
+        let reach = reach(boxes, None)?;
         let w = toward.as_dvec3();
-        if !(reach.is_finite() && (w.length() - 1.0).abs() < 1e-3) {
+        let unit = (w.length() - 1.0).abs() < 1e-3;
+        if !unit {
             return None;
         }
         let first = w.any_orthonormal_vector();
@@ -183,16 +166,8 @@ impl LightBuffer {
         let mut footprints = Vec::with_capacity(boxes.len());
         for (item, aabb) in boxes.iter().enumerate() {
             let (lo, hi) = (aabb.min.as_dvec3(), aabb.max.as_dvec3());
-            let corners = (0..8).map(|corner: u32| {
-                DVec3::new(
-                    if corner & 1 == 0 { lo.x } else { hi.x },
-                    if corner & 2 == 0 { lo.y } else { hi.y },
-                    if corner & 4 == 0 { lo.z } else { hi.z },
-                )
-            });
             let span = |axis: DVec3| {
-                corners
-                    .clone()
+                corners(lo, hi)
                     .map(|p| p.dot(axis))
                     .fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)))
             };
@@ -228,7 +203,8 @@ impl LightBuffer {
         if cells > max_candidates {
             return None;
         }
-        let mut counts = vec![0u32; first_cell as usize + 1];
+        // Each cell's count, then (summed in place) where its candidates start.
+        let mut cell_starts = vec![0u32; cells];
         let mut total = 0usize;
         for footprint in footprints {
             let grid = &faces[footprint.face];
@@ -239,14 +215,14 @@ impl LightBuffer {
             }
             for row in rows {
                 for column in columns.clone() {
-                    counts[grid.cell(column, row)] += 1;
+                    cell_starts[grid.cell(column, row)] += 1;
                 }
             }
         }
-        let mut cell_starts = Vec::with_capacity(counts.len());
         let mut start = 0u32;
-        for count in &counts {
-            cell_starts.push(start);
+        for entry in &mut cell_starts {
+            let count = *entry;
+            *entry = start;
             start += count;
         }
         let mut fill = cell_starts.clone();
@@ -367,8 +343,7 @@ impl LightBuffer {
 impl FaceGrid {
     /// A grid over the window the footprints cover, whose cells are as wide and high as the
     /// median footprint (finer cells, half as wide, listed 2.3 times the candidates and
-    /// rendered no faster),
-    /// with at most [`MAX_CELLS_PER_ITEM`] cells for each footprint.
+    /// rendered no faster), with at most [`MAX_CELLS_PER_ITEM`] cells for each footprint.
     fn over<'f>(footprints: impl Iterator<Item = &'f Footprint>, first_cell: u32) -> FaceGrid {
         let (mut widths, mut heights) = (Vec::new(), Vec::new());
         let (mut u_lo, mut u_hi, mut v_lo, mut v_hi) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
@@ -390,8 +365,8 @@ impl FaceGrid {
         // Never narrower than slack, so that the scales stay finite.
         let width = (u_hi - u_lo).max(MIN_SLACK);
         let height = (v_hi - v_lo).max(MIN_SLACK);
-        let cell_width = median(&mut widths).max(MIN_SLACK) / CELLS_ACROSS;
-        let cell_height = median(&mut heights).max(MIN_SLACK) / CELLS_ACROSS;
+        let cell_width = median(&mut widths).max(MIN_SLACK);
+        let cell_height = median(&mut heights).max(MIN_SLACK);
         let mut columns = (width / cell_width).ceil().min(f64::from(MAX_SIDE));
         let mut rows = (height / cell_height).ceil().min(f64::from(MAX_SIDE));
         let most = MAX_CELLS_PER_ITEM * count as f64;
@@ -431,6 +406,31 @@ impl FaceGrid {
             ..index(f.v.1, self.v0, self.v_scale, self.rows) + 1;
         (columns, rows)
     }
+}
+
+/// [`REACH_FACTOR`] times the largest coordinate (in magnitude) of the boxes and the light
+/// (a directional one has none); `None` when that is not finite. Well beyond the items, so
+/// that shadow rays from planes around them are answered too; the widening grows with it.
+fn reach(boxes: &[Aabb], light: Option<Vec3A>) -> Option<f32> {
+    let largest = boxes
+        .iter()
+        .flat_map(|b| [b.min, b.max])
+        .chain(light)
+        .map(|p| p.abs().max_element())
+        .fold(0.0f32, f32::max);
+    Some(REACH_FACTOR * largest).filter(|reach| reach.is_finite())
+}
+
+/// The eight corners of the box `[lo, hi]`.
+fn corners(lo: DVec3, hi: DVec3) -> impl Iterator<Item = DVec3> {
+    (0..8).map(move |corner: u32| {
+        let pick = |bit: u32, a: f64, b: f64| if corner & bit == 0 { a } else { b };
+        DVec3::new(
+            pick(1, lo.x, hi.x),
+            pick(2, lo.y, hi.y),
+            pick(4, lo.z, hi.z),
+        )
+    })
 }
 
 /// The median of `values` (reordered).

@@ -363,10 +363,8 @@ impl PreparedScene {
         tmax: f32,
         scratch: &mut Scratch,
     ) -> Option<Hit> {
-        for (i, item) in self.unbounded.iter().enumerate() {
-            if let Some(found) = item_hit(item, ray, tmin, tmax, &mut scratch.csg) {
-                return Some(Hit::new(ItemRef::Unbounded(i as u32), found));
-            }
+        if let Some(blocker) = self.unbounded_blocker(ray, tmin, tmax, scratch) {
+            return Some(blocker);
         }
         match self.walk_bvh() {
             Some(bvh) => self.occluded_bvh(bvh, ray, tmin, tmax, scratch),
@@ -375,6 +373,22 @@ impl PreparedScene {
                     .map(|found| Hit::new(ItemRef::Bounded(i as u32), found))
             }),
         }
+    }
+
+    /// The first unbounded item found in the segment (they are tested one by one, before
+    /// the bounded ones, by both shadow queries).
+    #[inline(always)]
+    fn unbounded_blocker(
+        &self,
+        ray: &Ray,
+        tmin: f32,
+        tmax: f32,
+        scratch: &mut Scratch,
+    ) -> Option<Hit> {
+        self.unbounded.iter().enumerate().find_map(|(i, item)| {
+            item_hit(item, ray, tmin, tmax, &mut scratch.csg)
+                .map(|found| Hit::new(ItemRef::Unbounded(i as u32), found))
+        })
     }
 
     /// [`PreparedScene::occluded`] for a shadow ray towards light `light` (the light's own
@@ -398,10 +412,8 @@ impl PreparedScene {
             Lookup::Candidates(candidates, limit) => (candidates, limit),
             Lookup::Unanswered => return self.occluded(ray, tmin, tmax, scratch),
         };
-        for (i, item) in self.unbounded.iter().enumerate() {
-            if let Some(found) = item_hit(item, ray, tmin, tmax, &mut scratch.csg) {
-                return Some(Hit::new(ItemRef::Unbounded(i as u32), found));
-            }
+        if let Some(blocker) = self.unbounded_blocker(ray, tmin, tmax, scratch) {
+            return Some(blocker);
         }
         let mut met = None;
         for candidate in candidates {

@@ -214,18 +214,6 @@ fn check(made: &Made, name: &str, origins: impl IntoIterator<Item = DVec3>) -> T
     tally
 }
 
-/// The eight corners of the box `[lo, hi]`.
-fn corners(lo: DVec3, hi: DVec3) -> impl Iterator<Item = DVec3> {
-    (0..8).map(move |corner: u32| {
-        let pick = |bit: u32, a: f64, b: f64| if corner & bit == 0 { a } else { b };
-        DVec3::new(
-            pick(1, lo.x, hi.x),
-            pick(2, lo.y, hi.y),
-            pick(4, lo.z, hi.z),
-        )
-    })
-}
-
 /// Origins whose rays to the light graze a sphere's silhouette as seen from the light, or
 /// pass through a box's corner, from beyond them.
 fn grazing(made: &Made, rng: &mut Rng, scale: f64) -> Vec<DVec3> {
