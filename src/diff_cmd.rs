@@ -88,8 +88,8 @@ fn pixel_diff(
     for options in [&options_a, &options_b] {
         crate::request::check_pixel(options, [x, y], None)?;
     }
-    let prepared_a = PreparedScene::new(&loaded_a.scene);
-    let prepared_b = PreparedScene::new(&loaded_b.scene);
+    let prepared_a = PreparedScene::for_ray_trees(&loaded_a.scene);
+    let prepared_b = PreparedScene::for_ray_trees(&loaded_b.scene);
     let side_a = Side {
         prepared: &prepared_a,
         scene: &loaded_a.scene,

@@ -16,7 +16,7 @@ pub fn explain_pixel(args: &ExplainArgs) -> Result<(), Failure> {
     // A pixel the image cannot have is found before the BVH build (the size was checked
     // when the flags were applied).
     crate::request::check_pixel(&options, args.pixel, None)?;
-    let prepared = PreparedScene::new(&loaded.scene);
+    let prepared = PreparedScene::for_ray_trees(&loaded.scene);
     let explanation = explain(&prepared, &loaded.scene, &options, x, y)
         .map_err(|error| crate::request::trace_failure(&error))?;
     if args.json {

@@ -66,7 +66,7 @@ pub fn query(args: &QueryArgs) -> Result<(), Failure> {
         .map_err(|error| Failure::Usage(format!("in the query: {}", error.render(&args.expr))))?;
     let pool = crate::render_cmd::thread_pool(args.threads)?;
     let started = Instant::now();
-    let prepared = PreparedScene::new(&loaded.scene);
+    let prepared = PreparedScene::for_ray_trees(&loaded.scene);
     let result = pool.install(|| run(&prepared, &options, &query));
     let seconds = started.elapsed().as_secs_f64();
     if let Some(path) = &args.mask {

@@ -20,7 +20,7 @@ pub fn trace(args: &TraceArgs) -> Result<(), Failure> {
     };
     // Check the request before the BVH build, which is the slow part on big scenes.
     crate::request::check_pixel(&options, args.pixel, args.sample)?;
-    let prepared = PreparedScene::new(&loaded.scene);
+    let prepared = PreparedScene::for_ray_trees(&loaded.scene);
     let tree = trace_pixel(&prepared, &loaded.scene, &options, x, y, which)
         .map_err(|error| crate::request::trace_failure(&error))?;
     if args.json {

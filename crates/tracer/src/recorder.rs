@@ -372,6 +372,11 @@ pub struct PixelStats {
 }
 
 impl Recorder for PixelStats {
+    /// The counts need no blocker named and no coincident surface looked for, so a render
+    /// with per-pixel statistics asks the light buffers as a plain render does (on the grid
+    /// of 10,000 spheres it had taken half as long again).
+    const RECORDS: bool = false;
+
     #[inline]
     fn ray_started(&mut self, ray: &RayStart) {
         self.rays = self.rays.saturating_add(1);
@@ -380,7 +385,9 @@ impl Recorder for PixelStats {
 
     #[inline]
     fn light_sampled(&mut self, sample: &LightSample) {
-        if sample.shadow_ray.is_some() {
+        // A shadow ray was cast unless the sample says why not (its record is left out
+        // when `RECORDS` is false).
+        if sample.no_shadow_ray.is_none() {
             self.rays = self.rays.saturating_add(1);
         }
     }

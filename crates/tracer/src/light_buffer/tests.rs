@@ -452,6 +452,10 @@ fn a_scene_renders_the_same_with_and_without_light_buffers() {
         );
         let walked = bits(&with.without_light_buffers());
         assert!(buffered == walked, "{name}: the images differ");
+        // Prepared for ray trees (`trace`, `explain`): no buffers built, the same image.
+        let for_trees = PreparedScene::for_ray_trees(&valid);
+        assert_eq!(for_trees.light_buffer_sizes(), (0, 0, 0), "{name}");
+        assert!(bits(&for_trees) == buffered, "{name}: the images differ");
     }
 }
 
