@@ -121,10 +121,7 @@ impl PreparedScene {
     /// and builds the BVH. The IR stays with the caller (the debugger, `trace` and the
     /// explanations need its names, spans and provenance).
     pub fn new(valid: &ValidScene) -> PreparedScene {
-        let started = Instant::now();
-        let shapes = Shapes::new(valid.scene());
-        let shapes_seconds = started.elapsed().as_secs_f64();
-        shapes.finish(started, shapes_seconds, Purpose::Render)
+        PreparedScene::prepare(valid, Purpose::Render)
     }
 
     /// [`PreparedScene::new`] for a caller that records every ray it traces (`trace`,
@@ -133,10 +130,14 @@ impl PreparedScene {
     /// memory (on a grid of 65,025 spheres with two lights, about 20-40 ms and 9 MiB). Any
     /// unrecorded ray it traces is answered by the walk, with the same result.
     pub fn for_ray_trees(valid: &ValidScene) -> PreparedScene {
+        PreparedScene::prepare(valid, Purpose::RayTrees)
+    }
+
+    fn prepare(valid: &ValidScene, purpose: Purpose) -> PreparedScene {
         let started = Instant::now();
         let shapes = Shapes::new(valid.scene());
         let shapes_seconds = started.elapsed().as_secs_f64();
-        shapes.finish(started, shapes_seconds, Purpose::RayTrees)
+        shapes.finish(started, shapes_seconds, purpose)
     }
 
     /// [`PreparedScene::new`] for a caller that needs nothing of the IR afterwards (`render`
