@@ -337,6 +337,7 @@ pub fn render(args: &RenderArgs) -> Result<(), Failure> {
         compile_seconds,
         build_seconds: prepared.build_seconds(),
         shapes_seconds: prepared.shapes_seconds(),
+        light_buffer_seconds: prepared.light_buffer_seconds(),
         traversal: TraversalPath::chosen(),
         light_buffers: prepared.light_buffer_sizes(),
         lights: prepared.light_count(),
@@ -395,8 +396,10 @@ struct Summary<'a> {
     objects: usize,
     compile_seconds: f64,
     build_seconds: f64,
-    /// The part of `build_seconds` that prepared the shapes; the rest built the BVH.
+    /// The part of `build_seconds` that prepared the shapes.
     shapes_seconds: f64,
+    /// The part that built the light buffers; the rest built the BVH.
+    light_buffer_seconds: f64,
     /// The BVH walk's child test (every path gives the same image).
     traversal: TraversalPath,
     /// How many lights have a light buffer, the candidates in them, and their bytes.
@@ -425,6 +428,20 @@ impl Summary<'_> {
         )
     }
 
+    /// The build's time and its parts: shapes, the BVH, and the light buffers when built.
+    fn build_line(&self) -> String {
+        let tree = self.build_seconds - self.shapes_seconds - self.light_buffer_seconds;
+        let buffers = if self.light_buffers.0 > 0 {
+            format!(", light buffers {:.3} s", self.light_buffer_seconds)
+        } else {
+            String::new()
+        };
+        format!(
+            "bvh build        {:.3} s (shapes {:.3} s, tree {:.3} s{buffers})",
+            self.build_seconds, self.shapes_seconds, tree
+        )
+    }
+
     fn text(&self) -> String {
         let s = self.stats;
         let o = self.options;
@@ -438,12 +455,7 @@ impl Summary<'_> {
             ),
             format!("objects          {}", self.objects),
             format!("compile          {:.3} s", self.compile_seconds),
-            format!(
-                "bvh build        {:.3} s (shapes {:.3} s, tree {:.3} s)",
-                self.build_seconds,
-                self.shapes_seconds,
-                self.build_seconds - self.shapes_seconds
-            ),
+            self.build_line(),
             format!("bvh walk         {}", self.traversal.name()),
             self.light_buffer_line(),
             format!(
@@ -504,6 +516,7 @@ impl Summary<'_> {
             "compile_seconds": self.compile_seconds,
             "build_seconds": self.build_seconds,
             "shapes_seconds": self.shapes_seconds,
+            "light_buffer_seconds": self.light_buffer_seconds,
             "bvh_walk": self.traversal.name(),
             "light_buffers": self.light_buffers.0,
             "light_buffer_candidates": self.light_buffers.1,

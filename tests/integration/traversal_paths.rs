@@ -274,6 +274,17 @@ fn light_buffers_render_the_same_bits_as_walking_every_shadow_ray() {
 /// `render --stats` says which lights have light buffers; `WHITTED_LIGHT_BUFFERS=off`
 /// turns them off with the same image, and a value that is neither on nor off is refused
 /// with a message naming the variable, before anything is written.
+/// The seconds of `render --stats`'s "bvh build" line: the whole build, then its parts.
+fn build_parts(stats: &str) -> Vec<f64> {
+    let line = stats
+        .lines()
+        .find(|line| line.starts_with("bvh build"))
+        .unwrap_or_default();
+    line.split([' ', '(', ')', ','])
+        .filter_map(|word| word.parse().ok())
+        .collect()
+}
+
 #[test]
 fn the_binary_reports_and_switches_light_buffers() {
     let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
@@ -290,12 +301,21 @@ fn the_binary_reports_and_switches_light_buffers() {
         stats.contains("light buffers    2 of 2 lights, "),
         "{stats}"
     );
+    // The build's parts add up: shapes, tree and light buffers.
+    let [build, shapes, tree, buffers] = build_parts(&stats)[..] else {
+        panic!("no build line with its light buffers: {stats}");
+    };
+    assert!(
+        buffers > 0.0 && (shapes + tree + buffers - build).abs() <= 0.002,
+        "{stats}"
+    );
     let (code, stats, stderr, off) = run(Some("off"), "off.png");
     assert_eq!(code, 0, "{stderr}");
     assert!(
         stats.contains("light buffers    none (every shadow ray walks the BVH)\n"),
         "{stats}"
     );
+    assert_eq!(build_parts(&stats).len(), 3, "{stats}");
     assert!(!on.is_empty() && on == off, "the images differ");
     let (code, _, stderr, bad) = run(Some("maybe"), "bad.png");
     assert_eq!(code, 2, "{stderr}");

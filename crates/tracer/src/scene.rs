@@ -104,6 +104,7 @@ pub struct PreparedScene {
     mesh_bvh_nodes: usize,
     build_seconds: f64,
     shapes_seconds: f64,
+    light_buffer_seconds: f64,
 }
 
 impl PreparedScene {
@@ -182,6 +183,12 @@ impl PreparedScene {
     /// Seconds spent in [`PreparedScene::new`]: shape preparation and the BVH build.
     pub fn build_seconds(&self) -> f64 {
         self.build_seconds
+    }
+
+    /// The part of [`PreparedScene::build_seconds`] spent building the light buffers (after
+    /// the BVH, whose boxes they take).
+    pub fn light_buffer_seconds(&self) -> f64 {
+        self.light_buffer_seconds
     }
 
     /// The part of [`PreparedScene::build_seconds`] spent preparing the shapes (and, for a
@@ -409,10 +416,12 @@ impl Shapes {
             && bounded.len() <= LIGHT_BUFFER_MAX_ITEMS
             && !lights.is_empty();
         let (bounded, bvh, kept_boxes) = build_bvh(bounded, boxes, wants_buffers);
+        let buffers_started = Instant::now();
         let (light_buffers, light_buffer_boxes) = match (&bvh, kept_boxes) {
             (Some(_), Some(boxes)) => (light_buffers(&lights, &boxes), boxes),
             _ => (Vec::new(), Vec::new()),
         };
+        let light_buffer_seconds = buffers_started.elapsed().as_secs_f64();
         PreparedScene {
             light_buffers,
             light_buffer_boxes,
@@ -434,6 +443,7 @@ impl Shapes {
             settings,
             build_seconds: started.elapsed().as_secs_f64(),
             shapes_seconds,
+            light_buffer_seconds,
         }
     }
 }

@@ -155,8 +155,12 @@ struct Stats {
     objects: u64,
     compile_seconds: f64,
     build_seconds: f64,
-    /// The part of `build_seconds` that prepared the shapes; the rest built the BVH.
+    /// The part of `build_seconds` that prepared the shapes.
     shapes_seconds: f64,
+    /// The part that built the light buffers (0 from a binary before them); the rest built
+    /// the BVH.
+    #[serde(default)]
+    light_buffer_seconds: f64,
     render_seconds: f64,
     /// The render threads' own CPU time, summed (`CLOCK_THREAD_CPUTIME_ID`).
     render_cpu_seconds: f64,
@@ -499,7 +503,7 @@ fn render_table(
          render and wall by the clock, cpu = the render threads' CPU time with its spread \
          (most - least) / least, Mray/cpu = rays per CPU-second, scaling = best 1-thread \
          render / best many-thread render; shapes = preparing the shapes for the BVH, bvh = \
-         building it)"
+         building it, light buffers not counted)"
     );
     println!(
         "{:<30} {:>3} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>6} {:>8} {:>10} {:>8} {:>7} {:>8}",
@@ -556,7 +560,7 @@ fn render_table(
                 stats.objects,
                 stats.compile_seconds,
                 stats.shapes_seconds,
-                stats.build_seconds - stats.shapes_seconds,
+                stats.build_seconds - stats.shapes_seconds - stats.light_buffer_seconds,
                 summary.best_render,
                 summary.least_cpu,
                 summary.cpu_spread * 100.0,
