@@ -4,14 +4,20 @@
 
 use std::sync::OnceLock;
 
-/// The sRGB transfer function (IEC 61966-2-1) of a linear value, clamped to [0, 1]: a display
-/// cannot show more than white. NaN shows as black rather than poisoning anything.
-pub fn linear_to_srgb(linear: f32) -> f32 {
-    let v = if linear.is_nan() {
+/// A linear value as a display can show it: clamped to [0, 1] (no more than white), NaN as
+/// black rather than poisoning anything. The formula and its table both start here.
+fn displayable(linear: f32) -> f32 {
+    if linear.is_nan() {
         0.0
     } else {
         linear.clamp(0.0, 1.0)
-    };
+    }
+}
+
+/// The sRGB transfer function (IEC 61966-2-1) of a linear value, clamped to [0, 1] (see
+/// [`displayable`]).
+pub fn linear_to_srgb(linear: f32) -> f32 {
+    let v = displayable(linear);
     if v <= 0.003_130_8 {
         12.92 * v
     } else {
@@ -81,11 +87,7 @@ impl Srgb8Table {
     }
 
     fn encode(&self, linear: f32) -> u8 {
-        let v = if linear.is_nan() {
-            0.0
-        } else {
-            linear.clamp(0.0, 1.0)
-        };
+        let v = displayable(linear);
         // -0.0 (which the clamp keeps) goes to the bucket of +0.0.
         let bucket = (v.to_bits() & 0x7fff_ffff) >> BUCKET_SHIFT;
         let mut code = self.first_codes.get(bucket as usize).copied().unwrap_or(0);
@@ -123,11 +125,7 @@ const HEAT_STOPS: [[f32; 3]; 5] = [
 /// The heat-map colour (8-bit sRGB) of `fraction` from 0 (black) to 1 (pale yellow),
 /// interpolated between the stops in sRGB.
 pub fn heat_color(fraction: f32) -> [u8; 3] {
-    let f = if fraction.is_nan() {
-        0.0
-    } else {
-        fraction.clamp(0.0, 1.0)
-    };
+    let f = displayable(fraction);
     let position = f * (HEAT_STOPS.len() - 1) as f32;
     let index = (position.floor() as usize).min(HEAT_STOPS.len() - 2);
     let local = position - index as f32;
